@@ -1,0 +1,220 @@
+"""The ``tpm-viz`` command line: CSV in, CSV out, SI units.
+
+Subcommands ``kinematics``, ``dynamics``, ``trajectory`` and ``serve`` live here; ``replay``,
+``crosscheck`` and ``figures`` (the Pinocchio model) are registered by
+:mod:`tpm_viz.cli_multibody`. Bad input exits with status 2 and one line on stderr.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+import numpy as np
+
+from .csvio import read_columns, write_columns
+from .dynamics import inverse_dynamics_detail
+from .errors import InputError, TpmVizError
+from .jacobians import STATUS_LABELS, classify, condition_number, jacobians
+from .kinematics import in_stroke, inverse_kinematics, leg_angles, reachable
+from .params import PARAM_INFO, Params
+from .trajectories import paper_trajectory
+
+__all__ = ["build_parser", "main", "params_from_args"]
+
+DYN_IN = ["p1", "p2", "dp1", "dp2", "ddp1", "ddp2"]
+DYN_OUT = ["d1", "d2", "dd1", "dd2", "ddd1", "ddd2", "tau1", "tau2"]
+KIN_OUT = ["d1", "d2", "theta1", "theta2", "det_jx", "det_jq", "cond", "reachable", "status"]
+
+
+def params_from_args(args: argparse.Namespace) -> Params:
+    """The parameter set from ``--set NAME=VALUE`` options (SI units) over the paper's defaults."""
+    overrides: dict[str, str] = {}
+    for item in getattr(args, "set", None) or []:
+        name, sep, value = item.partition("=")
+        if not sep:
+            raise InputError(f"--set expects NAME=VALUE, got {item!r}")
+        overrides[name.strip()] = value.strip()
+    return Params.paper().with_overrides(overrides)
+
+
+def _parse_fext(text: str | None) -> np.ndarray | None:
+    if text is None:
+        return None
+    parts = text.split(",")
+    try:
+        f = np.array([float(x) for x in parts])
+    except ValueError:
+        raise InputError(f"--fext expects FX,FY in newtons, got {text!r}") from None
+    if f.shape != (2,) or not np.all(np.isfinite(f)):
+        raise InputError(f"--fext expects two finite numbers FX,FY in newtons, got {text!r}")
+    return f
+
+
+def _kinematics_columns(params: Params, p: np.ndarray) -> dict[str, np.ndarray]:
+    ok = reachable(params, p)
+    safe = np.where(ok[:, None], p, 0.0)
+    d = inverse_kinematics(params, safe)
+    theta = leg_angles(params, safe, d)
+    jac = jacobians(params, safe, d)
+    cond = condition_number(params, safe, d)
+    nan = np.full(len(p), np.nan)
+    status = classify(params, p)
+    return {
+        "d1": np.where(ok, d[:, 0], nan),
+        "d2": np.where(ok, d[:, 1], nan),
+        "theta1": np.where(ok, theta[:, 0], nan),
+        "theta2": np.where(ok, theta[:, 1], nan),
+        "det_jx": np.where(ok, jac.det_jx, nan),
+        "det_jq": np.where(ok, jac.det_jq, nan),
+        "cond": np.where(ok, cond, nan),
+        "reachable": ok.astype(int),
+        "status": np.array([STATUS_LABELS[int(s)].replace(" ", "_") for s in status]),
+    }
+
+
+def _dynamics_columns(params: Params, p, dp, ddp, fext, model: str) -> dict[str, np.ndarray]:
+    res = inverse_dynamics_detail(params, p, dp, ddp, fext)
+    tau = res.tau
+    if model == "pinocchio":
+        from . import multibody  # lazy: Pinocchio only when asked for
+
+        tau = multibody.inverse_dynamics(params, p, dp, ddp, fext)
+    cols = {}
+    for name, arr in (("d", res.d), ("dd", res.dd), ("ddd", res.ddd), ("tau", tau)):
+        cols[name + "1"], cols[name + "2"] = arr[:, 0], arr[:, 1]
+    return cols
+
+
+def _check_reachable(params: Params, p: np.ndarray) -> None:
+    ok = reachable(params, p)
+    if not np.all(ok):
+        r = int(np.argmax(~ok))
+        raise InputError(
+            f"row {r + 2}: platform position ({p[r, 0]:g}, {p[r, 1]:g}) m is unreachable "
+            f"(|p_j| must be below l_a = {params.l_a:g} m)"
+        )
+
+
+def _cmd_kinematics(args) -> int:
+    params = params_from_args(args)
+    table = read_columns(args.input, ["p1", "p2"])
+    p = np.stack([table["p1"], table["p2"]], -1)
+    cols = dict(table)
+    cols.update(_kinematics_columns(params, p))
+    write_columns(args.output, cols)
+    return 0
+
+
+def _cmd_dynamics(args) -> int:
+    params = params_from_args(args)
+    table = read_columns(args.input, DYN_IN)
+    p, dp, ddp = (np.stack([table[a], table[b]], -1) for a, b in zip(DYN_IN[::2], DYN_IN[1::2], strict=True))
+    _check_reachable(params, p)
+    cols = dict(table)
+    cols.update(_dynamics_columns(params, p, dp, ddp, _parse_fext(args.fext), args.model))
+    write_columns(args.output, cols)
+    return 0
+
+
+def _cmd_trajectory(args) -> int:
+    params = params_from_args(args)
+    traj = paper_trajectory(args.kind, args.duration, args.samples)
+    _check_reachable(params, traj.p)
+    cols: dict[str, np.ndarray] = {"t": traj.t}
+    for name, arr in (("p", traj.p), ("dp", traj.dp), ("ddp", traj.ddp)):
+        cols[name + "1"], cols[name + "2"] = arr[:, 0], arr[:, 1]
+    kin = _kinematics_columns(params, traj.p)
+    cols.update({k: kin[k] for k in ("theta1", "theta2", "det_jx", "det_jq", "cond", "reachable", "status")})
+    cols.update(_dynamics_columns(params, traj.p, traj.dp, traj.ddp, _parse_fext(args.fext), args.model))
+    write_columns(args.output, cols)
+    return 0
+
+
+def _cmd_serve(args) -> int:
+    from .ui.app import main as serve  # lazy: viser only for the app
+
+    serve(host=args.host, port=args.port)
+    return 0
+
+
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
+    if not np.isfinite(value) or value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a positive, finite number of seconds, got {text!r}")
+    return value
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argparse parser whose usage errors are one line and exit status 2."""
+
+    def error(self, message: str):  # pragma: no cover - exercised through main()
+        raise InputError(f"{self.prog}: {message}")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``tpm-viz`` argument parser with every subcommand."""
+    known = ", ".join(k for k in PARAM_INFO if k not in ("stroke", "pivot_spacing"))
+    common = _Parser(add_help=False)
+    common.add_argument(
+        "--set", action="append", metavar="NAME=VALUE",
+        help=f"override a parameter in SI units (repeatable); names: {', '.join(PARAM_INFO)} (paper: {known})",
+    )
+    parser = _Parser(prog="tpm-viz", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    k = sub.add_parser("kinematics", parents=[common], help="inverse kinematics, angles, singularity measures")
+    k.add_argument("--input", required=True, help="CSV with columns p1,p2 [m]")
+    k.add_argument("--output", help="output CSV (default: stdout)")
+    k.set_defaults(func=_cmd_kinematics)
+
+    d = sub.add_parser("dynamics", parents=[common], help="actuator forces for platform states (eqs. 28-31)")
+    d.add_argument("--input", required=True, help="CSV with columns p1,p2,dp1,dp2,ddp1,ddp2 (SI)")
+    d.add_argument("--output", help="output CSV (default: stdout)")
+    d.add_argument("--model", choices=["paper", "pinocchio"], default="paper", help="dynamic model")
+    d.add_argument("--fext", metavar="FX,FY", help="external force on the platform [N]")
+    d.set_defaults(func=_cmd_dynamics)
+
+    t = sub.add_parser("trajectory", parents=[common], help="the paper's line or circle, sampled (Figs. 4-5)")
+    t.add_argument("--kind", choices=["line", "circle"], required=True)
+    t.add_argument("--duration", type=_positive_float, help="duration T [s] (default: line 0.2, circle 0.5)")
+    t.add_argument("--samples", type=int, default=201, help="number of samples (default 201)")
+    t.add_argument("--output", help="output CSV (default: stdout)")
+    t.add_argument("--model", choices=["paper", "pinocchio"], default="paper", help="dynamic model")
+    t.add_argument("--fext", metavar="FX,FY", help="external force on the platform [N]")
+    t.set_defaults(func=_cmd_trajectory)
+
+    s = sub.add_parser("serve", help="start the browser app")
+    s.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1, loopback only)")
+    s.add_argument("--port", type=int, default=8080, help="port (default 8080; the next free one if busy)")
+    s.set_defaults(func=_cmd_serve)
+
+    try:
+        from . import cli_multibody
+    except ImportError:  # pragma: no cover - only while the module is absent
+        pass
+    else:
+        cli_multibody.register(sub, common)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``tpm-viz``; returns the exit status (2 for bad input)."""
+    try:
+        args = build_parser().parse_args(argv)
+        return int(args.func(args) or 0)
+    except TpmVizError as exc:
+        print(f"tpm-viz: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:
+        print(f"tpm-viz: error: {exc.strerror or exc}: {exc.filename or ''}".rstrip(": "), file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    raise SystemExit(main())
