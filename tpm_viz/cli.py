@@ -16,7 +16,7 @@ from .csvio import read_columns, write_columns
 from .dynamics import inverse_dynamics_detail
 from .errors import InputError, TpmVizError
 from .jacobians import STATUS_LABELS, classify, condition_number, jacobians
-from .kinematics import in_stroke, inverse_kinematics, leg_angles, reachable
+from .kinematics import inverse_kinematics, leg_angles, reachable
 from .params import PARAM_INFO, Params
 from .trajectories import paper_trajectory
 

@@ -24,9 +24,9 @@ from .kinematics import as_xy, in_stroke, inverse_kinematics, leg_components, re
 from .params import Params
 
 __all__ = [
-    "SingularityThresholds",
     "STATUS_LABELS",
     "Jacobians",
+    "SingularityThresholds",
     "actuator_acceleration",
     "actuator_forces_from_platform_force",
     "actuator_velocity",
