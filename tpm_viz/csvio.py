@@ -62,7 +62,7 @@ def parse_columns(text: str, required: Sequence[str], source: str = "input") -> 
             if not math.isfinite(value):
                 raise InputError(f"{source}: row {r}, column {header[k]!r}: {cell.strip()!r} is not finite")
             data[r - 2, k] = value
-    ordered = [c for c in OPTIONAL_COLUMNS if c in header] + list(required)
+    ordered = [c for c in OPTIONAL_COLUMNS if c in header and c not in required] + list(required)
     return {c: data[:, header.index(c)] for c in ordered}
 
 

@@ -17,7 +17,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .errors import InputError, UnreachablePoseError
+from .errors import InputError, SingularConfigurationError, UnreachablePoseError
 from .params import Params
 
 __all__ = [
@@ -105,8 +105,11 @@ class FkSolutions(NamedTuple):
     """Both assembly modes of the forward kinematics (platform positions in m).
 
     ``plus`` has ``det J_x = cos(θ_1 + θ_2) >= 0`` (the mode containing the home pose),
-    ``minus`` has ``det J_x <= 0``; they coincide at the direct singularity (eq. 12).
-    ``exists`` is False where the two leg circles do not meet (positions are NaN there).
+    ``minus`` has ``det J_x <= 0``. The direct singularity (eq. 12, ``s_1`` parallel to ``s_2``)
+    takes two forms: ``s_1 = -s_2``, the circles touch and the two modes merge (in the working
+    mode: the arc ``p_1² + p_2² = l_a²`` in the third quadrant); ``s_1 = s_2``, the circles
+    coincide (``d_1 = d_2 = a - b``, first-quadrant arc) and the position is undetermined.
+    ``exists`` is False where the circles do not meet or coincide (positions are NaN there).
     """
 
     plus: np.ndarray
@@ -128,9 +131,9 @@ def forward_kinematics_both(params: Params, d) -> FkSolutions:
     dist = np.linalg.norm(delta, axis=-1)
     half = dist / 2.0
     with np.errstate(invalid="ignore", divide="ignore"):
-        h = np.sqrt(params.l_a**2 - half**2)
+        h = np.sqrt(np.maximum(params.l_a**2 - half**2, 0.0))  # tangency within rounding: h = 0
         u = delta / dist[..., None]
-    exists = (half <= params.l_a) & (dist > 0)
+    exists = (half <= params.l_a * (1 + 1e-12)) & (dist > 1e-12 * params.l_a)
     h = np.where(exists, h, np.nan)
     mid = (c1 + c2) / 2.0
     normal = np.stack([-u[..., 1], u[..., 0]], axis=-1)  # u rotated by +90 deg
@@ -150,28 +153,41 @@ def _cross_s(params: Params, p: np.ndarray, d: np.ndarray) -> np.ndarray:
     return c[..., 0] * c[..., 1] - s[..., 0] * s[..., 1]
 
 
+def _raise_if_missing(params: Params, d: np.ndarray, sol: FkSolutions) -> None:
+    if np.all(sol.exists):
+        return
+    bad = np.asarray(d)[~sol.exists][0] if np.ndim(sol.exists) else np.asarray(d)
+    k = params.a - params.b
+    if np.hypot(bad[0] - k, bad[1] - k) <= 1e-12 * params.l_a:
+        raise SingularConfigurationError(
+            f"d1 = d2 = a - b = {k * 1e3:.1f} mm: the two leg circles coincide, the platform position "
+            "is undetermined (direct singularity, eq. 12)"
+        )
+    raise UnreachablePoseError(
+        f"actuators at ({bad[0] * 1e3:.1f}, {bad[1] * 1e3:.1f}) mm cannot be assembled: "
+        "the leg circles are more than 2 l_a apart"
+    )
+
+
 def forward_kinematics(params: Params, d, mode: int = +1) -> np.ndarray:
     """Platform position [m] for actuator positions ``d`` [m] in assembly ``mode`` (+1 or -1).
 
-    Raises :class:`UnreachablePoseError` if the two leg circles do not meet.
+    Raises :class:`UnreachablePoseError` if the two leg circles do not meet and
+    :class:`SingularConfigurationError` if they coincide.
     """
     if mode not in (1, -1):
         raise InputError(f"assembly mode must be +1 or -1, got {mode!r}")
+    d = as_xy(d, "d")
     sol = forward_kinematics_both(params, d)
-    if not np.all(sol.exists):
-        raise UnreachablePoseError(
-            "actuator positions cannot be assembled: the leg circles are more than 2 l_a apart"
-        )
+    _raise_if_missing(params, d, sol)
     return sol.plus if mode == 1 else sol.minus
 
 
 def forward_kinematics_nearest(params: Params, d, p_prev) -> tuple[np.ndarray, int]:
     """The assembly mode nearest a previous platform position: ``(p, mode)`` for one pose."""
+    d = as_xy(d, "d")
     sol = forward_kinematics_both(params, d)
-    if not bool(np.all(sol.exists)):
-        raise UnreachablePoseError(
-            "actuator positions cannot be assembled: the leg circles are more than 2 l_a apart"
-        )
+    _raise_if_missing(params, d, sol)
     p_prev = as_xy(p_prev, "p_prev")
     if np.linalg.norm(sol.plus - p_prev) <= np.linalg.norm(sol.minus - p_prev):
         return sol.plus, 1

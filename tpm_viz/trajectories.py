@@ -14,13 +14,12 @@ A user's path (timed samples ``t, p1, p2``) is differentiated through a natural 
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from .csvio import parse_columns
 from .errors import InputError
 from .spline import CubicSpline
 
@@ -136,26 +135,7 @@ def trajectory_from_samples(t, p, name: str = "custom") -> Trajectory:
 
 def parse_trajectory_csv(text: str, name: str = "custom", max_rows: int = 100_000) -> Trajectory:
     """A trajectory from CSV text with header columns ``t,p1,p2`` (s, m, m); one-line errors."""
-    if not text.strip():
-        raise InputError("the trajectory CSV is empty")
-    rows = list(csv.reader(io.StringIO(text)))
-    header = [h.strip() for h in rows[0]]
-    for col in ("t", "p1", "p2"):
-        if col not in header:
-            raise InputError(f"the trajectory CSV has no column {col!r} (header: {','.join(header)})")
-    idx = [header.index(c) for c in ("t", "p1", "p2")]
-    body = [r for r in rows[1:] if any(cell.strip() for cell in r)]
-    if len(body) > max_rows:
-        raise InputError(f"the trajectory CSV has {len(body)} rows; the limit is {max_rows}")
-    data = np.empty((len(body), 3))
-    for r, row in enumerate(body, start=2):
-        if len(row) != len(header):
-            raise InputError(f"row {r} has {len(row)} cells, the header has {len(header)}")
-        for k, col in enumerate(idx):
-            try:
-                data[r - 2, k] = float(row[col])
-            except ValueError:
-                raise InputError(f"row {r}, column {header[col]!r}: {row[col]!r} is not a number") from None
-            if not math.isfinite(data[r - 2, k]):
-                raise InputError(f"row {r}, column {header[col]!r}: {row[col]!r} is not finite")
-    return trajectory_from_samples(data[:, 0], data[:, 1:], name)
+    if text.count("\n") > max_rows + 1:
+        raise InputError(f"the trajectory CSV has more than {max_rows} rows")
+    cols = parse_columns(text, ["t", "p1", "p2"], source="the trajectory CSV")
+    return trajectory_from_samples(cols["t"], np.stack([cols["p1"], cols["p2"]], -1), name)

@@ -5,7 +5,11 @@ In the working mode (eq. 4) ``sin θ_1 = p_2 / l_a`` and ``sin θ_2 = p_1 / l_a`
 
 - the inverse singularity ``cos θ_1 cos θ_2 = 0`` (eq. 11) is the square ``|p_j| = l_a``;
 - the direct singularity ``cos(θ_1 + θ_2) = 0`` (eq. 12) is ``p_1² + p_2² = l_a²`` with
-  ``p_1 p_2 > 0``: two quarter circles of radius ``l_a`` in the first and third quadrants;
+  ``p_1 p_2 > 0``: two quarter circles of radius ``l_a`` of different nature. In the third
+  quadrant ``s_1 = -s_2``: the leg circles touch and the two assembly modes merge. In the first
+  quadrant ``s_1 = s_2``: ``d_1 = d_2 = a - b``, the leg circles coincide and, with the actuators
+  locked, the platform can still slide along the arc (outside the paper's stroke, since
+  ``a - b = 390 mm > Δd = 300 mm``);
 - the stroke limits ``d_i = 0`` and ``d_i = Δd`` are the curves
   ``p_i = d_i - (a - b) + sqrt(l_a² - p_j²)``.
 """
@@ -75,7 +79,10 @@ def workspace_map(params: Params, n: int = 200, extent: float | None = None) -> 
 
 
 def direct_singularity_locus(params: Params, n: int = 90) -> list[np.ndarray]:
-    """The direct-singularity curves ``cos(θ1+θ2) = 0`` in the working mode: two ``(n, 2)`` arcs [m]."""
+    """The direct-singularity curves ``cos(θ1+θ2) = 0`` in the working mode: two ``(n, 2)`` arcs [m].
+
+    First the quadrant-I arc (coincident leg circles), then the quadrant-III arc (tangent circles).
+    """
     phi = np.linspace(0.0, np.pi / 2, n)
     arc = params.l_a * np.stack([np.cos(phi), np.sin(phi)], -1)
     return [arc, -arc]

@@ -1,0 +1,101 @@
+"""The tpm-viz command line end to end (subprocess), including every kind of bad input."""
+
+from __future__ import annotations
+
+import csv
+import io
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from reference import ik_quadratic, minimal_coordinate_forces
+
+from tpm_viz import Params
+
+P = Params.paper()
+
+
+def run(*args: str, stdin: str | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "tpm_viz", *args], input=stdin, capture_output=True, text=True, timeout=120
+    )
+
+
+def rows(text: str) -> list[dict[str, str]]:
+    return list(csv.DictReader(io.StringIO(text)))
+
+
+def test_kinematics_keeps_unreachable_rows_flagged(tmp_path):
+    src = tmp_path / "poses.csv"
+    src.write_text("p1,p2\n0.05,-0.02\n0.3,0\n-0.135,0\n")
+    out = tmp_path / "out.csv"
+    res = run("kinematics", "--input", str(src), "--output", str(out))
+    assert res.returncode == 0, res.stderr
+    r = rows(out.read_text())
+    assert [x["reachable"] for x in r] == ["1", "0", "1"]
+    assert [x["status"] for x in r] == ["regular", "unreachable", "out_of_stroke"]
+    assert [float(r[0]["d1"]), float(r[0]["d2"])] == pytest.approx(ik_quadratic(P, [0.05, -0.02]), abs=1e-15)
+    assert float(r[0]["theta1"]) == pytest.approx(np.arcsin(-0.02 / 0.26), abs=1e-15)
+    assert r[1]["d1"] == ""  # no value for an unreachable pose, never NaN
+
+
+def test_dynamics_matches_the_minimal_coordinate_reference_and_set_overrides(tmp_path):
+    src = tmp_path / "states.csv"
+    src.write_text("p1,p2,dp1,dp2,ddp1,ddp2\n0.04,0.03,0.5,-0.7,8,3\n")
+    res = run("dynamics", "--input", str(src), "--set", "m_p=3.0", "--set", "l_a=0.3", "--fext", "5,-2")
+    assert res.returncode == 0, res.stderr
+    r = rows(res.stdout)[0]
+    params = P.replace(m_p=3.0, l_a=0.3)
+    ref = minimal_coordinate_forces(params, [0.04, 0.03], [0.5, -0.7], [8, 3], f_ext=(5, -2))
+    assert [float(r["tau1"]), float(r["tau2"])] == pytest.approx(ref, rel=1e-6)
+
+
+def test_trajectory_samples_the_cubic_line(tmp_path):
+    res = run("trajectory", "--kind", "line", "--duration", "0.4", "--samples", "5")
+    assert res.returncode == 0, res.stderr
+    r = rows(res.stdout)
+    t = np.array([float(x["t"]) for x in r])
+    s = 3 * (t / 0.4) ** 2 - 2 * (t / 0.4) ** 3  # conventions.md time law
+    assert t == pytest.approx([0, 0.1, 0.2, 0.3, 0.4])
+    assert [float(x["p1"]) for x in r] == pytest.approx(-0.1 + 0.2 * s, abs=1e-15)
+    assert float(r[0]["tau1"]) == pytest.approx(0.0, abs=1e-12)  # at rest at the start, no load
+    assert {"d1", "dd1", "ddd1", "tau1", "tau2", "theta1", "det_jx", "cond"} <= set(r[0])
+
+
+@pytest.mark.parametrize(
+    ("args", "content", "message"),
+    [
+        (["kinematics"], "", "is empty"),
+        (["kinematics"], "p1\n0\n", "missing column 'p2'"),
+        (["kinematics"], "p1,p2,p3\n0,0,0\n", "unknown column 'p3'"),
+        (["kinematics"], "p1,p2\n0,zero\n", "'zero' is not a number"),
+        (["kinematics"], "p1,p2\n0,nan\n", "'nan' is not finite"),
+        (["dynamics"], "p1,p2,dp1,dp2,ddp1,ddp2\n0.3,0,0,0,0,0\n", "unreachable"),
+        (["kinematics", "--set", "l_c=1"], "p1,p2\n0,0\n", "unknown parameter 'l_c'"),
+        (["kinematics", "--set", "l_a=-0.2"], "p1,p2\n0,0\n", "l_a must be positive"),
+        (["kinematics", "--set", "a=5"], "p1,p2\n0,0\n", "no reachable pose"),
+        (["dynamics", "--fext", "1"], "p1,p2,dp1,dp2,ddp1,ddp2\n0,0,0,0,0,0\n", "--fext"),
+    ],
+)
+def test_bad_input_exits_2_with_one_line(tmp_path, args, content, message):
+    src = tmp_path / "in.csv"
+    src.write_text(content)
+    res = run(*args, "--input", str(src))
+    assert res.returncode == 2
+    assert res.stdout == ""
+    assert message in res.stderr and res.stderr.count("\n") == 1 and "Traceback" not in res.stderr
+
+
+@pytest.mark.parametrize("duration", ["0", "-1", "nan", "soon"])
+def test_bad_duration_exits_2(duration):
+    res = run("trajectory", "--kind", "circle", "--duration", duration)
+    assert res.returncode == 2 and "duration" in res.stderr and res.stderr.count("\n") == 1
+
+
+def test_missing_file_and_stdin():
+    res = run("kinematics", "--input", "/nonexistent/poses.csv")
+    assert res.returncode == 2 and "No such file" in res.stderr and "Traceback" not in res.stderr
+    res = run("kinematics", "--input", "-", stdin="p1,p2\n0,0\n")
+    assert res.returncode == 0, res.stderr
+    assert float(rows(res.stdout)[0]["d1"]) == pytest.approx(0.482 - 0.092 - 0.260, abs=1e-15)
