@@ -21,12 +21,13 @@ No gravity (horizontal plane, ``U = 0``), no friction. Forces in N, SI throughou
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from .errors import SingularConfigurationError
-from .jacobians import actuator_acceleration, actuator_velocity
+from .jacobians import actuator_velocity, eq14_row
 from .kinematics import as_xy, inverse_kinematics, leg_components
 from .params import Params
 
@@ -49,15 +50,8 @@ class DynamicsResult:
     tau: np.ndarray  # (e) actuator forces τ_i [N]
 
 
-def _v_terms(params: Params, p, dp, ddp, d, dd, ddd, c) -> np.ndarray:
-    """``v_i`` below eq. (29) [N] (``i`` along the last axis, ``j`` the other leg)."""
-    mp, mb = params.m_p, params.m_b
-    pi, pj = p, p[..., ::-1]
-    dpi, dpj = dp, dp[..., ::-1]
-    ddpi = ddp
-    ddi, ddj = dd, dd[..., ::-1]
-    dddj = ddd[..., ::-1]
-    ci, cj = c, c[..., ::-1]
+def _v_leg(mp, mb, pi, pj, dpi, dpj, ddpi, ci, cj, ddi, ddj, dddj):
+    """``v_i`` below eq. (29) [N]; ``j`` is the other leg. Floats or arrays."""
     return (
         (mp + mb / 3.0) * ddpi
         - mb * pj * ddi * dpj / (2.0 * ci**2)
@@ -68,18 +62,56 @@ def _v_terms(params: Params, p, dp, ddp, d, dd, ddd, c) -> np.ndarray:
     )
 
 
-def _w_terms(params: Params, p, dp, ddp, ddd, c) -> np.ndarray:
-    """``w_i`` below eq. (31) [N]."""
-    ma, mb = params.m_a, params.m_b
-    pj = p[..., ::-1]
-    dpi, dpj = dp, dp[..., ::-1]
-    ddpj = ddp[..., ::-1]
+def _w_leg(ma, mb, pj, dpi, dpj, ddpj, ci, dddi):
+    """``w_i`` below eq. (31) [N]. Floats or arrays."""
     return (
-        (ma + mb) * ddd
-        - mb * dpj**2 / (2.0 * c)
-        - mb * pj**2 * dpj**2 / (3.0 * c**3)
-        + mb * pj * (dpi * dpj - c * ddpj) / (2.0 * c**2)
+        (ma + mb) * dddi
+        - mb * dpj**2 / (2.0 * ci)
+        - mb * pj**2 * dpj**2 / (3.0 * ci**3)
+        + mb * pj * (dpi * dpj - ci * ddpj) / (2.0 * ci**2)
     )
+
+
+def _procedure(params: Params, p1, p2, dp1, dp2, ddp1, ddp2, c1, c2, f1, f2) -> tuple:
+    """Steps (b)-(e) on components (floats or equal-shape arrays); ``c_i = p_i - d_i + a - b``.
+
+    Returns ``(dd1, dd2, ddd1, ddd2, v1, v2, w1, w2, lam1, lam2, tau1, tau2)``.
+    """
+    dd1 = dp1 + p2 * dp2 / c1  # (b) eq. (9): ḋ_i = ṗ_i + tan θ_i ṗ_j
+    dd2 = dp2 + p1 * dp1 / c2
+    ddd1 = eq14_row(p1, p2, dp1, dp2, ddp1, ddp2, c1, dd1)  # (c) eq. (14)
+    ddd2 = eq14_row(p2, p1, dp2, dp1, ddp2, ddp1, c2, dd2)
+    mp, ma, mb = params.m_p, params.m_a, params.m_b
+    v1 = _v_leg(mp, mb, p1, p2, dp1, dp2, ddp1, c1, c2, dd1, dd2, ddd2) - f1  # eq. (28): v - f
+    v2 = _v_leg(mp, mb, p2, p1, dp2, dp1, ddp2, c2, c1, dd2, dd1, ddd1) - f2
+    # (d) eq. (29): [[2c1, 2p1], [2p2, 2c2]] λ = v; determinant 4 (c1 c2 - p1 p2) = 4 l_a² det J_x.
+    det = 4.0 * (c1 * c2 - p1 * p2)
+    lam1 = (2.0 * c2 * v1 - 2.0 * p1 * v2) / det
+    lam2 = (2.0 * c1 * v2 - 2.0 * p2 * v1) / det
+    w1 = _w_leg(ma, mb, p2, dp1, dp2, ddp2, c1, ddd1)
+    w2 = _w_leg(ma, mb, p1, dp2, dp1, ddp1, c2, ddd2)
+    return dd1, dd2, ddd1, ddd2, v1, v2, w1, w2, lam1, lam2, w1 + 2.0 * lam1 * c1, w2 + 2.0 * lam2 * c2  # (e)
+
+
+_SINGULAR_TOL = 1e-12
+
+
+def _check_regular(params: Params, c1, c2, p1, p2) -> None:
+    l2 = params.l_a**2
+    if np.any(np.abs(c1 * c2) < _SINGULAR_TOL * l2):
+        raise SingularConfigurationError("singular configuration: cos θ1 cos θ2 = 0 (eq. 11)")
+    if np.any(np.abs(c1 * c2 - p1 * p2) < _SINGULAR_TOL * l2):
+        raise SingularConfigurationError("singular configuration: cos(θ1 + θ2) = 0 (eq. 12)")
+
+
+def _vectorised(params: Params, p, dp, ddp, f_ext, d) -> tuple:
+    p, dp, ddp = np.broadcast_arrays(as_xy(p), as_xy(dp, "dp"), as_xy(ddp, "ddp"))
+    d = inverse_kinematics(params, p) if d is None else np.broadcast_to(as_xy(d, "d"), p.shape)  # (a)
+    f = np.zeros(2) if f_ext is None else as_xy(f_ext, "f_ext")
+    c, _ = leg_components(params, p, d)
+    _check_regular(params, c[..., 0], c[..., 1], p[..., 0], p[..., 1])
+    out = _procedure(params, *(x[..., k] for x in (p, dp, ddp, c) for k in (0, 1)), f[..., 0], f[..., 1])
+    return p, dp, ddp, d, out
 
 
 def inverse_dynamics_detail(params: Params, p, dp, ddp, f_ext=None, d=None) -> DynamicsResult:
@@ -90,34 +122,45 @@ def inverse_dynamics_detail(params: Params, p, dp, ddp, f_ext=None, d=None) -> D
     (default: working mode, eq. 4). Raises :class:`SingularConfigurationError` at a singular
     configuration (``cos θ_i = 0`` or ``cos(θ1 + θ2) = 0``).
     """
-    p, dp, ddp = as_xy(p), as_xy(dp, "dp"), as_xy(ddp, "ddp")
-    p, dp, ddp = np.broadcast_arrays(p, dp, ddp)
-    d = inverse_kinematics(params, p) if d is None else np.broadcast_to(as_xy(d, "d"), p.shape)  # (a)
-    dd = actuator_velocity(params, p, dp, d)  # (b)
-    ddd = actuator_acceleration(params, p, dp, ddp, d, dd)  # (c)
-    c, _ = leg_components(params, p, d)
-    v = _v_terms(params, p, dp, ddp, d, dd, ddd, c)
-    if f_ext is not None:
-        v = v - as_xy(f_ext, "f_ext")  # eq. (28): the bracket is v - f
-    # (d) eq. (29): [[2c1, 2p1], [2p2, 2c2]] λ = v; determinant 4 (c1 c2 - p1 p2) ∝ det J_x.
-    g11, g12, g21, g22 = 2 * c[..., 0], 2 * p[..., 0], 2 * p[..., 1], 2 * c[..., 1]
-    det = g11 * g22 - g12 * g21
-    if np.any(np.abs(det) < 1e-12 * params.l_a**2):
-        raise SingularConfigurationError("singular configuration: cos(θ1 + θ2) = 0 (eq. 12)")
-    lam = np.stack(
-        [(g22 * v[..., 0] - g12 * v[..., 1]) / det, (-g21 * v[..., 0] + g11 * v[..., 1]) / det], -1
-    )
-    w = _w_terms(params, p, dp, ddp, ddd, c)
-    tau = w + 2.0 * lam * c  # (e) eq. (31)
+    p, dp, ddp, d, out = _vectorised(params, p, dp, ddp, f_ext, d)
+    dd, ddd, v, w, lam, tau = (np.stack(out[k : k + 2], -1) for k in range(0, 12, 2))
     return DynamicsResult(p=p, dp=dp, ddp=ddp, d=d, dd=dd, ddd=ddd, v=v, w=w, lam=lam, tau=tau)
+
+
+def _inverse_dynamics_one(params: Params, p, dp, ddp, f_ext) -> np.ndarray | None:
+    """Fast path for one state given as length-2 sequences: pure ``math``, no temporaries.
+
+    Returns None when the input is not a plain single state (the caller then vectorises).
+    """
+    try:
+        p1, p2 = float(p[0]), float(p[1])
+        dp1, dp2 = float(dp[0]), float(dp[1])
+        ddp1, ddp2 = float(ddp[0]), float(ddp[1])
+        f1, f2 = (0.0, 0.0) if f_ext is None else (float(f_ext[0]), float(f_ext[1]))
+    except (TypeError, ValueError, IndexError):
+        return None
+    vals = (p1, p2, dp1, dp2, ddp1, ddp2, f1, f2)
+    if not all(map(math.isfinite, vals)) or not abs(p1) < params.l_a or not abs(p2) < params.l_a:
+        return None  # let the vectorised path raise the precise error
+    la2 = params.l_a**2
+    c1, c2 = math.sqrt(la2 - p2 * p2), math.sqrt(la2 - p1 * p1)  # eq. (4): c_i = sqrt(l_a² - p_j²)
+    _check_regular(params, c1, c2, p1, p2)
+    out = _procedure(params, p1, p2, dp1, dp2, ddp1, ddp2, c1, c2, f1, f2)
+    return np.array(out[10:12])
 
 
 def inverse_dynamics(params: Params, p, dp, ddp, f_ext=None, d=None) -> np.ndarray:
     """Actuator forces ``τ`` [N], shape ``(..., 2)``, by the paper's closed form (eqs. 29, 31).
 
-    See :func:`inverse_dynamics_detail` for the arguments and the intermediates.
+    See :func:`inverse_dynamics_detail` for the arguments and the intermediates. One state of
+    shape ``(2,)`` takes a scalar fast path (same formulas, ~10 µs).
     """
-    return inverse_dynamics_detail(params, p, dp, ddp, f_ext, d).tau
+    if d is None and np.ndim(p) == 1 and np.ndim(dp) == 1 and np.ndim(ddp) == 1 and np.ndim(f_ext) <= 1:
+        if len(p) == 2 and len(dp) == 2 and len(ddp) == 2:
+            tau = _inverse_dynamics_one(params, p, dp, ddp, f_ext)
+            if tau is not None:
+                return tau
+    return np.stack(_vectorised(params, p, dp, ddp, f_ext, d)[4][10:12], -1)
 
 
 def kinetic_energy(params: Params, p, dp, d=None) -> np.ndarray:

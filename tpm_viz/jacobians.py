@@ -32,6 +32,7 @@ __all__ = [
     "actuator_velocity",
     "classify",
     "condition_number",
+    "eq14_row",
     "jacobians",
     "platform_force_from_actuator_forces",
     "platform_velocity",
@@ -150,25 +151,38 @@ def theta_dot(params: Params, p, dp, d=None) -> np.ndarray:
     return as_xy(dp, "dp")[..., ::-1] / (params.l_a * cos)
 
 
+def eq14_row(pi, pj, dpi, dpj, ddpi, ddpj, ci, ddi):
+    """Row ``i`` of eq. (14) with the corrected eq. (15), for floats or arrays [m/s²].
+
+    With ``cos θ_i = c_i / l_a``, ``sin θ_i = p_j / l_a`` and ``θ̇_i = ṗ_j / c_i`` (eq. 24),
+    ``d̈_i = [(J̇_x ṗ)_i + (J_x p̈)_i - (J̇_q ḋ)_i] / cos θ_i`` becomes
+    ``θ̇_i (ṗ_j - t_i ṗ_i) + p̈_i + t_i p̈_j + t_i θ̇_i ḋ_i`` where ``t_i = tan θ_i = p_j / c_i``.
+    The last term carries the corrected sign of ``J̇_q``.
+    """
+    ti = pj / ci
+    thi = dpj / ci
+    return thi * (dpj - ti * dpi) + ddpi + ti * ddpj + ti * thi * ddi
+
+
 def actuator_acceleration(params: Params, p, dp, ddp, d=None, dd=None) -> np.ndarray:
     """Actuator accelerations [m/s²], eq. (14) with the corrected eq. (15).
 
     ``d̈ = J_q^{-1} (J̇_x ṗ + J_x p̈ - J̇_q ḋ)`` with
     ``J̇_x = [[-sin θ1 θ̇1, cos θ1 θ̇1], [cos θ2 θ̇2, -sin θ2 θ̇2]]`` and
-    ``J̇_q = diag(-sin θ1 θ̇1, -sin θ2 θ̇2)`` (the paper prints ``+sin``: erratum).
+    ``J̇_q = diag(-sin θ1 θ̇1, -sin θ2 θ̇2)`` (the paper prints ``+sin``: erratum). See :func:`eq14_row`.
     """
-    p, d, cos, sin = _cos_sin(params, p, d)
+    p, d, cos, _ = _cos_sin(params, p, d)
     dp, ddp = as_xy(dp, "dp"), as_xy(ddp, "ddp")
-    jac = jacobians(params, p, d)
-    _check_regular(jac, "inverse")
+    if np.any(np.abs(cos) < 1e-12):
+        raise SingularConfigurationError("singular configuration: cos θ1 cos θ2 = 0 (eq. 11)")
     if dd is None:
-        dd = np.einsum("...ij,...j->...i", jac.j, dp)
-    th_dot = dp[..., ::-1] / (params.l_a * cos)
-    # Row i of J̇_x ṗ: d/dt of (cos θ_i, sin θ_i) . (ṗ_i, ṗ_j) with ṗ_j = l_a cos θ_i θ̇_i.
-    jx_dot_dp = th_dot * (-sin * dp + cos * dp[..., ::-1])
-    jx_ddp = np.einsum("...ij,...j->...i", jac.jx, ddp)
-    jq_dot_dd = -sin * th_dot * dd
-    return (jx_dot_dp + jx_ddp - jq_dot_dd) / cos
+        dd = actuator_velocity(params, p, dp, d)
+    c = cos * params.l_a
+    rows = [
+        eq14_row(p[..., i], p[..., j], dp[..., i], dp[..., j], ddp[..., i], ddp[..., j], c[..., i], dd[..., i])
+        for i, j in ((0, 1), (1, 0))
+    ]
+    return np.stack(rows, -1)
 
 
 def actuator_forces_from_platform_force(params: Params, p, f, d=None) -> np.ndarray:
