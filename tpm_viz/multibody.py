@@ -1,0 +1,499 @@
+"""An independent closed-loop multibody model of the 2-PPa TPM in Pinocchio (the role ADAMS played).
+
+This is the only module of tpm-viz that imports :mod:`pinocchio`. The model is built from a
+:class:`~tpm_viz.Params` (no model file), zero gravity (the paper's ``U = 0``), SI units.
+
+Tree (``nq = nv = 7``; ``q = (d_1, d_2, φ_10, φ_11, φ_20, φ_21, φ_p)``)::
+
+    universe ─PX─ slider1 (origin A_1 = (d_1 - a) e_1) ─RZ─ link1_0 (pivot A_1) ─RZ─ platform (pivot B_1)
+                                                      └RZ─ link1_1 (pivot A_1 + s e_2)
+    universe ─PY─ slider2 (origin A_2 = (d_2 - a) e_2) ─RZ─ link2_0 (pivot A_2)
+                                                      └RZ─ link2_1 (pivot A_2 + s e_1)
+
+``s`` is the pivot spacing; each link frame has its x axis along the link, so ``φ_1k = θ_1``,
+``φ_2k = -θ_2`` (conventions.md) and ``φ_p = -θ_1`` keeps the platform translating. Loop closures:
+three ``RigidConstraintModel(CONTACT_3D, LOCAL_WORLD_ALIGNED)`` joining the tips of link1_1,
+link2_0 and link2_1 to ``B_1 + s e_2``, ``B_2 = P - b e_2`` and ``B_2 + s e_1`` on the platform.
+Masses (conventions.md): sliders ``m_a`` and platform ``m_p`` as point masses (the platform never
+rotates, so its rotational inertia does not enter), each link a uniform slender rod of mass
+``m_b / 2`` along its x axis: ``I_xx = 0``, ``I_yy = I_zz = m l_a² / 12`` about its centre.
+
+Over-constraint. The 9 closure rows have rank 5: the 3 out-of-plane rows vanish identically and
+one in-plane row is redundant (both parallelograms fix the platform's orientation, the paper's
+"overlapped rotational constraints"). Every solve therefore goes through an SVD of the stacked
+constraint Jacobian ``J_c`` that reveals its rank (:mod:`tpm_viz.rank`) and its null space ``N``
+(the 2 admissible motions). Inverse dynamics solves ``rnea(q, v, a) - J_Pᵀ f_ext = Sᵀ τ + J_cᵀ λ``
+in the least-squares sense by projecting on ``N``: ``Nᵀ Sᵀ τ = Nᵀ (rnea - J_Pᵀ f_ext)``. Only
+``J_cᵀ λ`` is defined (the redundant part of ``λ`` is not), and since ``N`` is the same for every
+maximal independent subset of rows, ``τ`` does not depend on which redundant row one would keep.
+Forward dynamics (:meth:`MultibodyModel.forward_dynamics`) is our own KKT solve on the same null
+space (Gauss's principle) with Pinocchio's ``crba``, ``nle`` and constraint Jacobian; see its
+docstring for why not ``pinocchio.constraintDynamics``.
+"""
+
+from __future__ import annotations
+
+import functools
+import threading
+
+import numpy as np
+import pinocchio as pin
+
+from .errors import InputError, SingularConfigurationError, UnreachablePoseError
+from .kinematics import as_xy
+from .params import Params
+from .rank import ranked_svd
+
+__all__ = ["PART_NAMES", "MultibodyModel", "inverse_dynamics", "model_for"]
+
+PART_NAMES = ("slider1", "slider2", "link1_0", "link1_1", "link2_0", "link2_1", "platform")
+"""Keys of :meth:`MultibodyModel.placements`, also the Pinocchio joint names (and frame names)."""
+
+_DOF = 2
+_NEWTON_TOL = 1e-13  # m, on the closure and platform/actuator residuals
+_NEWTON_MAX_ITER = 40
+_MAX_ANGLE_STEP = 0.5  # rad, Newton step limit on the revolute coordinates
+_SINGULAR_RTOL = 1e-9
+
+
+def _se3(xyz, angle: float = 0.0) -> pin.SE3:
+    c, s = np.cos(angle), np.sin(angle)
+    return pin.SE3(np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]), np.asarray(xyz, dtype=float))
+
+
+def _rod(mass: float, length: float) -> pin.Inertia:
+    """Uniform slender rod along local x from the origin: COM at ``l/2``, ``I = m l²/12`` (y, z)."""
+    i_t = mass * length**2 / 12.0
+    return pin.Inertia(mass, np.array([length / 2.0, 0.0, 0.0]), np.diag([0.0, i_t, i_t]))
+
+
+def _point_mass(mass: float, xyz=(0.0, 0.0, 0.0)) -> pin.Inertia:
+    return pin.Inertia(mass, np.asarray(xyz, dtype=float), np.zeros((3, 3)))
+
+
+def _build(params: Params):
+    """The Pinocchio model, its constraint models (LOCAL_WORLD_ALIGNED) and the part frame ids."""
+    a, b, la, sp = params.a, params.b, params.l_a, params.pivot_spacing
+    model = pin.Model()
+    model.gravity = pin.Motion.Zero()  # horizontal mechanism, U = 0
+    e = np.eye(3)
+    rod, leg2 = _rod(params.m_b / 2.0, la), np.pi / 2  # leg 2's link frames: x along e_2 at φ = 0
+    # Depth-first order (Pinocchio's crba needs every subtree contiguous in v):
+    # (name, parent, joint, placement in parent, body inertia).
+    tree = [
+        ("slider1", "universe", pin.JointModelPX(), _se3(-a * e[0]), _point_mass(params.m_a)),
+        ("link1_0", "slider1", pin.JointModelRZ(), _se3([0, 0, 0]), rod),
+        ("platform", "link1_0", pin.JointModelRZ(), _se3([la, 0, 0]), _point_mass(params.m_p, [b, 0, 0])),
+        ("link1_1", "slider1", pin.JointModelRZ(), _se3(sp * e[1]), rod),
+        ("slider2", "universe", pin.JointModelPY(), _se3(-a * e[1]), _point_mass(params.m_a)),
+        ("link2_0", "slider2", pin.JointModelRZ(), _se3([0, 0, 0], leg2), rod),
+        ("link2_1", "slider2", pin.JointModelRZ(), _se3(sp * e[0], leg2), rod),
+    ]
+    joints = {"universe": 0}
+    for name, parent, joint, placement, inertia in tree:
+        joints[name] = model.addJoint(joints[parent], joint, placement, name)
+        model.appendBodyToJoint(joints[name], inertia, pin.SE3.Identity())
+    del joints["universe"]
+    frames = {}
+    for name, jid in joints.items():
+        origin = [b, 0, 0] if name == "platform" else [0, 0, 0]  # platform frame at P = B_1 + b e_1
+        frames[name] = model.addFrame(pin.Frame(name, jid, _se3(origin), pin.FrameType.OP_FRAME), False)
+    tip = _se3([la, 0, 0])
+    on_platform = {"link1_1": [0, sp, 0], "link2_0": [b, -b, 0], "link2_1": [b + sp, -b, 0]}  # from B_1
+    closures = [
+        pin.RigidConstraintModel(
+            pin.ContactType.CONTACT_3D,
+            model,
+            joints[link],
+            tip,
+            joints["platform"],
+            _se3(xyz),
+            pin.ReferenceFrame.LOCAL_WORLD_ALIGNED,
+        )
+        for link, xyz in on_platform.items()
+    ]
+    return model, closures, frames
+
+
+def _locked(method):
+    @functools.wraps(method)
+    def wrapper(self, *args, **kwargs):
+        with self._lock:
+            return method(self, *args, **kwargs)
+
+    return wrapper
+
+
+class MultibodyModel:
+    """The closed-loop Pinocchio model of one parameter set (see the module docstring).
+
+    Public methods take platform quantities as ``(2,)`` (or ``(..., 2)`` where stated) arrays in SI
+    units and raise :mod:`tpm_viz.errors` exceptions with one-line messages. Methods are serialised
+    by a lock (Pinocchio's ``Data`` is shared scratch memory).
+    """
+
+    def __init__(self, params: Params):
+        if not isinstance(params, Params):
+            raise InputError(f"MultibodyModel needs a tpm_viz.Params, got {type(params).__name__}")
+        self.params = params
+        self.model, self._closures, self._frames = _build(params)
+        self.data = self.model.createData()
+        self._cdatas = [c.createData() for c in self._closures]
+        self._lock = threading.RLock()
+        self.index = {n: self.model.joints[self.model.getJointId(n)].idx_q for n in PART_NAMES}
+        """Position of each joint coordinate in ``q`` (and ``v``): Pinocchio's depth-first order."""
+        self._slider_idx = np.array([self.index["slider1"], self.index["slider2"]])
+        self._angle_idx = np.array([self.index[n] for n in PART_NAMES[2:]])  # φ_10, φ_11, φ_20, φ_21, φ_p
+        self._s_t = np.zeros((self.model.nv, _DOF))  # Sᵀ: actuator forces -> generalised forces
+        self._s_t[self._slider_idx, [0, 1]] = 1.0
+        self._select_platform = np.zeros((len(self._closures) * 3 + _DOF, _DOF))  # [0; I]
+        self._select_platform[-_DOF:] = np.eye(_DOF)
+        self._q_last: np.ndarray | None = None
+
+    # ----------------------------------------------------------------- Pinocchio evaluations
+    def _closure_terms(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """World closure residual ``Φ(q)`` (9,) [m] and its Jacobian ``J_c`` (9, 7).
+
+        Order matters (pinocchio-notes.md): joint Jacobians and placements at ``q`` first, then
+        ``calc`` of each constraint, then ``getConstraintJacobian``.
+        """
+        m, d = self.model, self.data
+        pin.computeJointJacobians(m, d, q)  # also runs forwardKinematics(q)
+        res, jac = [], []
+        for cm, cd in zip(self._closures, self._cdatas, strict=True):
+            cm.calc(m, d, cd)
+            res.append(cd.oMc1.translation - cd.oMc2.translation)
+            jac.append(pin.getConstraintJacobian(m, d, cm, cd))
+        return np.concatenate(res), np.vstack(jac)
+
+    def _platform_jacobian(self) -> np.ndarray:
+        """In-plane translational Jacobian ``J_P`` (2, 7) of P (after :meth:`_closure_terms`)."""
+        j = pin.getFrameJacobian(self.model, self.data, self._frames["platform"], pin.LOCAL_WORLD_ALIGNED)
+        return j[:2]
+
+    def _drifts(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``γ_c = J̇_c v`` (9,) and ``J̇_P v`` (2,): classical accelerations at ``a = 0`` [m/s²]."""
+        m, d = self.model, self.data
+        pin.forwardKinematics(m, d, q, v, np.zeros(m.nv))
+        lwa = pin.LOCAL_WORLD_ALIGNED
+        gamma = [
+            pin.getFrameClassicalAcceleration(m, d, c.joint1_id, c.joint1_placement, lwa).linear
+            - pin.getFrameClassicalAcceleration(m, d, c.joint2_id, c.joint2_placement, lwa).linear
+            for c in self._closures
+        ]
+        fp = m.frames[self._frames["platform"]]
+        acc_p = pin.getFrameClassicalAcceleration(m, d, fp.parentJoint, fp.placement, lwa).linear
+        return np.concatenate(gamma), acc_p[:2]
+
+    def _closure_svd(self, jc: np.ndarray):
+        """Rank-revealing SVD of ``J_c``; its null space is the 2 admissible motions (rank 5 expected)."""
+        svd = ranked_svd(jc)
+        if self.model.nv - svd.rank != _DOF:
+            raise SingularConfigurationError(
+                f"singular configuration: the closure Jacobian has rank {svd.rank}, not {self.model.nv - _DOF} "
+                "(a parallelogram is folded, cos θ_i = 0, eq. 11)"
+            )
+        return svd
+
+    # ----------------------------------------------------------------- closed-loop kinematics
+    def _newton(self, q: np.ndarray, target: np.ndarray, driven: str):
+        """Gauss-Newton on ``[Φ(q); x(q) - target] = 0``, ``x`` = platform P or actuators d.
+
+        Returns ``(q, converged, J_c, J_x)`` with the Jacobians at the returned ``q``.
+        """
+        q = q.copy()
+        for _ in range(_NEWTON_MAX_ITER):
+            phi, jc = self._closure_terms(q)
+            if driven == "platform":
+                x, jx = self._platform_position_now(), self._platform_jacobian()
+            else:
+                x, jx = q[self._slider_idx], self._s_t.T
+            r = np.concatenate([phi, x - target])
+            if np.max(np.abs(r)) < _NEWTON_TOL:
+                return q, True, jc, jx
+            dq = -ranked_svd(np.vstack([jc, jx])).solve(r)
+            big = np.max(np.abs(dq[self._angle_idx]))
+            if big > _MAX_ANGLE_STEP:
+                dq *= _MAX_ANGLE_STEP / big
+            q += dq
+        return q, False, jc, jx
+
+    def _platform_position_now(self) -> np.ndarray:
+        return pin.updateFramePlacement(self.model, self.data, self._frames["platform"]).translation[:2].copy()
+
+    def _is_parallelogram(self, q: np.ndarray) -> bool:
+        """Both links of each leg parallel and the platform translating (``φ_p = -φ_10``)."""
+        f10, f11, f20, f21, fp = q[self._angle_idx]
+        wrap = np.angle(np.exp(1j * np.array([f11 - f10, f21 - f20, fp + f10])))
+        return bool(np.all(np.abs(wrap) < 1e-6))
+
+    def _wrap(self, q: np.ndarray) -> np.ndarray:
+        q = q.copy()
+        q[self._angle_idx] = np.angle(np.exp(1j * q[self._angle_idx]))
+        return q
+
+    def _pack(self, d, phi1: float, phi2: float) -> np.ndarray:
+        """``q`` from actuator positions and the link angles ``φ_1 = θ_1``, ``φ_2 = -θ_2`` of a parallelogram."""
+        q = np.empty(self.model.nq)
+        q[self._slider_idx] = d
+        q[self._angle_idx] = [phi1, phi1, phi2, phi2, -phi1]
+        return q
+
+    def _link_angles(self, q: np.ndarray) -> tuple[float, float]:
+        """``(φ_10, φ_20) = (θ_1, -θ_2)``."""
+        return float(q[self.index["link1_0"]]), float(q[self.index["link2_0"]])
+
+    def _guess_from_platform(self, p: np.ndarray, d: np.ndarray | None) -> np.ndarray:
+        """Starting point: links along their rails (θ = 0, the working mode), or pointing at the
+        platform pivots from given actuator positions ``d`` (which selects the branch)."""
+        k = self.params.a - self.params.b
+        if d is None:
+            return self._pack(p + k - self.params.l_a, 0.0, 0.0)
+        return self._guess_from_both(p, d)
+
+    def _guess_from_both(self, p: np.ndarray, d: np.ndarray) -> np.ndarray:
+        """Links pointing from the slider joints ``A_i`` towards the platform pivots ``B_i``."""
+        a, b = self.params.a, self.params.b
+        u1 = (p[0] - b) - (d[0] - a), p[1]  # B_1 - A_1
+        u2 = p[0], (p[1] - b) - (d[1] - a)  # B_2 - A_2
+        t1 = np.arctan2(u1[1], u1[0])
+        t2 = np.arctan2(-u2[0], u2[1])  # link frame of leg 2 is rotated by +90 deg
+        return self._pack(d, t1, t2)
+
+    @_locked
+    def configuration(self, p, d=None) -> np.ndarray:
+        """Full configuration ``q`` (7,) for platform position ``p`` (2,) [m], by Newton on Pinocchio's
+        closure residual. Working mode (eq. 4: ``cos θ_i > 0``) unless actuator positions ``d`` (2,)
+        are given: they are the starting point and so select the branch."""
+        p = self._one(p, "p")
+        return self._configure(p, None if d is None else self._one(d, "d"))[0]
+
+    def _configure(self, p: np.ndarray, d: np.ndarray | None):
+        """``(q, J_c, J_P)`` at the closed-loop configuration of platform position ``p``."""
+        la = self.params.l_a
+        if np.any(np.abs(p) >= la):
+            raise UnreachablePoseError(
+                f"platform position ({p[0] * 1e3:.1f}, {p[1] * 1e3:.1f}) mm is unreachable: "
+                f"each |p_j| must be below l_a = {la * 1e3:.1f} mm"
+            )
+        starts = [self._guess_from_platform(p, d)]
+        if d is None and self._q_last is not None:
+            starts.insert(0, self._q_last)
+        for q0 in starts:
+            q, ok, jc, jp = self._newton(q0, p, "platform")
+            working = np.all(np.cos(self._link_angles(q)) > 0)  # c_i = l_a cos θ_i > 0 (eq. 4)
+            if ok and self._is_parallelogram(q) and (d is not None or working):
+                q = self._wrap(q)
+                if d is None:
+                    self._q_last = q
+                return q, jc, jp
+        raise SingularConfigurationError(
+            f"no closed-loop configuration found at ({p[0] * 1e3:.1f}, {p[1] * 1e3:.1f}) mm "
+            "(too close to cos θ_i = 0, eq. 11)"
+        )
+
+    @_locked
+    def configuration_from_actuators(self, d, mode: int = +1) -> np.ndarray:
+        """Full configuration ``q`` (7,) for actuator positions ``d`` (2,) [m] in assembly ``mode``
+        (+1: ``cos(θ1 + θ2) > 0``, the home mode; -1: the other), by Newton on the closures."""
+        if mode not in (1, -1):
+            raise InputError(f"assembly mode must be +1 or -1, got {mode!r}")
+        d = self._one(d, "d")
+        k, la = self.params.a - self.params.b, self.params.l_a
+        c1, c2 = np.array([d[0] - k, 0.0]), np.array([0.0, d[1] - k])  # leg circle centres
+        gap = np.linalg.norm(c2 - c1)
+        if gap >= 2 * la or gap == 0:
+            raise UnreachablePoseError(
+                "actuator positions cannot be assembled: the leg circles are more than 2 l_a apart"
+            )
+        normal = np.array([c1[1] - c2[1], c2[0] - c1[0]]) / gap
+        found = []
+        for side in (1.0, -1.0):  # a guess on each side of the line of centres
+            p0 = (c1 + c2) / 2 + side * (la / np.sqrt(2.0)) * normal
+            q, ok, _, _ = self._newton(self._guess_from_both(p0, d), d, "actuators")
+            if ok and self._is_parallelogram(q):
+                found.append(self._wrap(q))
+        for q in found:
+            if np.sign(np.cos(np.subtract(*self._link_angles(q)))) == mode:  # det J_x = cos(θ1 + θ2), eq. 12
+                return q
+        raise SingularConfigurationError(f"assembly mode {mode:+d} not found: d is at or near the direct singularity")
+
+    @_locked
+    def platform_position(self, q) -> np.ndarray:
+        """Platform position ``P`` (2,) [m] of configuration ``q``."""
+        pin.forwardKinematics(self.model, self.data, self._as_q(q))
+        return self._platform_position_now()
+
+    @_locked
+    def closure_terms(self, q) -> tuple[np.ndarray, np.ndarray]:
+        """Loop-closure residual ``Φ(q)`` (9,) [m] (world, 3 rows per closure) and Jacobian ``J_c`` (9, 7)."""
+        phi, jc = self._closure_terms(self._as_q(q))
+        return phi.copy(), jc.copy()
+
+    @_locked
+    def constraint_violation(self, q) -> float:
+        """Largest loop-closure gap [m] (distance between the two sides of a closure) at ``q``."""
+        phi, _ = self._closure_terms(self._as_q(q))
+        return float(np.max(np.linalg.norm(phi.reshape(-1, 3), axis=1)))
+
+    @_locked
+    def placements(self, q) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """``{part: (position (3,) [m], quaternion wxyz (4,))}`` for :data:`PART_NAMES`.
+
+        Sliders: at ``A_i``; links: at their slider-side pivot, local x along the link (length
+        ``l_a``); platform: at ``P``. Every part lies in the plane ``z = 0``.
+        """
+        m, d = self.model, self.data
+        pin.forwardKinematics(m, d, self._as_q(q))
+        out = {}
+        for name in PART_NAMES:
+            placement = pin.updateFramePlacement(m, d, self._frames[name])
+            x, y, z, w = pin.Quaternion(placement.rotation).coeffs()
+            out[name] = (placement.translation.copy(), np.array([w, x, y, z]))
+        return out
+
+    def _as_q(self, q) -> np.ndarray:
+        q = np.asarray(q, dtype=float)
+        if q.shape != (self.model.nq,) or not np.all(np.isfinite(q)):
+            raise InputError(f"q must be a finite array of shape ({self.model.nq},), got shape {q.shape}")
+        return q
+
+    # ----------------------------------------------------------------- dynamics
+    def _motion(self, p: np.ndarray, dp: np.ndarray, ddp: np.ndarray):
+        """``(q, v, a, N, J_P)`` for a prescribed platform motion, with ``J_c v = 0``, ``J_c a + γ = 0``.
+
+        ``A = [J_c; J_P]`` (11, 7) must have full column rank (else eq. 11). ``N = A⁺ [0; I]`` (7, 2)
+        maps platform velocities to joint velocities; its columns span the null space of ``J_c``
+        (checked: this is where a lost closure rank would show).
+        """
+        q, jc, jp = self._configure(p, None)
+        svd = ranked_svd(np.vstack([jc, jp]))
+        if svd.rank < self.model.nv:
+            raise SingularConfigurationError("singular configuration: cos θ1 cos θ2 = 0 (eq. 11)")
+        n = svd.solve(self._select_platform)
+        if np.max(np.abs(jc @ n)) > _SINGULAR_RTOL * np.max(np.abs(n)):
+            raise SingularConfigurationError("singular configuration: the closures allow a platform-free motion")
+        v = n @ dp
+        gamma, jp_dot_v = self._drifts(q, v)
+        a = svd.solve(np.concatenate([-gamma, ddp - jp_dot_v]))
+        return q, v, a, n, jp
+
+    def _tau(self, q, v, a, n, jp, f_ext) -> tuple[np.ndarray, np.ndarray]:
+        """``τ`` from ``(Nᵀ Sᵀ) τ = Nᵀ (rnea(q, v, a) - J_Pᵀ f_ext)`` (λ eliminated); also the right side.
+
+        ``Nᵀ Sᵀ`` is the paper's ``Jᵀ`` (eq. 10, ``ḋ = J ṗ``): singular at ``cos(θ1 + θ2) = 0`` (eq. 12).
+        """
+        rhs = pin.rnea(self.model, self.data, q, v, a) - jp.T @ f_ext
+        nst = n[self._slider_idx].T  # Nᵀ Sᵀ
+        # |det| / (product of row norms) = |sin| of the angle between the rows; 0 when singular.
+        if abs(np.linalg.det(nst)) < _SINGULAR_RTOL * np.prod(np.linalg.norm(nst, axis=1)):
+            raise SingularConfigurationError("singular configuration: cos(θ1 + θ2) = 0 (eq. 12)")
+        return np.linalg.solve(nst, n.T @ rhs), rhs
+
+    @_locked
+    def constrained_motion(self, p, dp, ddp) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Joint ``(q, v, a)`` (7,) each, consistent with the closures, for one platform state (2,) each."""
+        p, dp, ddp = (self._one(x, n) for x, n in ((p, "p"), (dp, "dp"), (ddp, "ddp")))
+        return self._motion(p, dp, ddp)[:3]
+
+    @_locked
+    def inverse_dynamics(self, p, dp, ddp, f_ext=None) -> np.ndarray:
+        """Actuator forces ``τ`` [N], shape ``(..., 2)``, for platform ``p, ṗ, p̈`` [m, m/s, m/s²].
+
+        ``f_ext`` [N] is a force applied to the platform (as in eq. 28), broadcastable to ``(..., 2)``.
+        Batches are solved one state at a time (each Newton solve warm-starts from the previous).
+        """
+        p, dp, ddp = as_xy(p), as_xy(dp, "dp"), as_xy(ddp, "ddp")
+        f = np.zeros(2) if f_ext is None else as_xy(f_ext, "f_ext")
+        try:
+            p, dp, ddp, f = np.broadcast_arrays(p, dp, ddp, f)
+        except ValueError:
+            raise InputError("p, dp, ddp and f_ext have incompatible shapes") from None
+        shape = p.shape
+        flat = [x.reshape(-1, 2) for x in (p, dp, ddp, f)]
+        tau = np.empty((flat[0].shape[0], 2))
+        for k, (pk, dpk, ddpk, fk) in enumerate(zip(*flat, strict=True)):
+            tau[k] = self._tau(*self._motion(pk, dpk, ddpk), fk)[0]
+        return tau.reshape(shape)
+
+    @_locked
+    def generalized_forces(self, p, dp, ddp, f_ext=None) -> dict[str, np.ndarray]:
+        """Every term of ``rnea - J_Pᵀ f_ext = Sᵀ τ + J_cᵀ λ`` at one state (for checks and teaching):
+        ``q, v, a, tau, rhs`` (the left side), ``S_T`` (7, 2), ``J_c`` (9, 7), ``lam`` (minimum-norm λ)."""
+        p, dp, ddp = (self._one(x, n) for x, n in ((p, "p"), (dp, "dp"), (ddp, "ddp")))
+        f = np.zeros(2) if f_ext is None else self._one(f_ext, "f_ext")
+        q, v, a, n, jp = self._motion(p, dp, ddp)
+        tau, rhs = self._tau(q, v, a, n, jp, f)
+        jc = self._closure_terms(q)[1]
+        lam = np.linalg.lstsq(jc.T, rhs - self._s_t @ tau, rcond=None)[0]
+        return {"q": q, "v": v, "a": a, "tau": tau, "rhs": rhs, "S_T": self._s_t.copy(), "J_c": jc, "lam": lam}
+
+    @_locked
+    def forward_dynamics(self, q, v, tau) -> np.ndarray:
+        """Joint accelerations ``a`` (7,) [m/s², rad/s²] under actuator forces ``τ`` (2,) [N].
+
+        Our own KKT solve (Gauss's principle) on the rank-revealed null space ``N`` of ``J_c``:
+        ``a = a_c + N z`` with ``a_c = -J_c⁺ γ`` and ``(Nᵀ M N) z = Nᵀ (Sᵀ τ - nle - M a_c)``, ``M`` from
+        ``crba`` and ``nle`` from Pinocchio. It is direct and exact with the redundant rows. The proximal
+        ``pinocchio.constraintDynamics`` returns the same ``a`` (the tests check it), but with these
+        redundant rows its reported residual never converges and it often runs to ``max_iter``, so it
+        cannot tell a good step from a bad one.
+        """
+        q, v = self._as_q(q), self._as_q(v)
+        m, d = self.model, self.data
+        svd = self._closure_svd(self._closure_terms(q)[1])
+        n = svd.null_space
+        gamma, _ = self._drifts(q, v)
+        mass = pin.crba(m, d, q)
+        mass = np.triu(mass) + np.triu(mass, 1).T  # C++ crba fills the upper triangle only
+        a_c = -svd.solve(gamma)
+        rhs = self._s_t @ np.asarray(tau, dtype=float) - pin.nle(m, d, q, v) - mass @ a_c
+        return a_c + n @ np.linalg.solve(n.T @ mass @ n, n.T @ rhs)
+
+    @_locked
+    def project(self, q, v) -> tuple[np.ndarray, np.ndarray]:
+        """Constraint stabilisation: the nearest ``q`` on the closures (minimum-norm Newton steps)
+        and ``v`` projected on the admissible motions ``N Nᵀ v``."""
+        q, v = self._as_q(q).copy(), self._as_q(v)
+        for _ in range(_NEWTON_MAX_ITER):
+            phi, jc = self._closure_terms(q)
+            svd = self._closure_svd(jc)
+            if np.max(np.abs(phi)) < _NEWTON_TOL:
+                break
+            q -= svd.solve(phi)
+        else:
+            raise SingularConfigurationError("the closures cannot be re-assembled (constraint drift too large)")
+        n = svd.null_space
+        return q, n @ (n.T @ v)
+
+    @_locked
+    def platform_velocity(self, q, v) -> np.ndarray:
+        """Platform velocity ``J_P v`` (2,) [m/s]."""
+        self._closure_terms(self._as_q(q))
+        return self._platform_jacobian() @ self._as_q(v)
+
+    @_locked
+    def kinetic_energy(self, q, v) -> float:
+        """Total kinetic energy [J] of the tree at ``(q, v)`` (Pinocchio)."""
+        return float(pin.computeKineticEnergy(self.model, self.data, self._as_q(q), self._as_q(v)))
+
+    @staticmethod
+    def _one(x, name: str) -> np.ndarray:
+        x = as_xy(x, name)
+        if x.shape != (2,):
+            raise InputError(f"{name} must have shape (2,), got {x.shape}")
+        return x
+
+
+@functools.lru_cache(maxsize=16)
+def model_for(params: Params) -> MultibodyModel:
+    """The cached :class:`MultibodyModel` of a parameter set (``Params`` is frozen and hashable)."""
+    return MultibodyModel(params)
+
+
+def inverse_dynamics(params: Params, p, dp, ddp, f_ext=None) -> np.ndarray:
+    """Actuator forces ``τ`` [N], shape ``(..., 2)``, from the Pinocchio model (see
+    :meth:`MultibodyModel.inverse_dynamics`); one cached model per ``params``."""
+    if not isinstance(params, Params):
+        raise InputError(f"inverse_dynamics needs a tpm_viz.Params, got {type(params).__name__}")
+    return model_for(params).inverse_dynamics(p, dp, ddp, f_ext)
