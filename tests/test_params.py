@@ -28,6 +28,12 @@ def test_bad_values_are_refused_naming_the_parameter(name, value):
     assert "\n" not in str(exc.value)
 
 
+@pytest.mark.parametrize(("name", "value"), [("l_a", 1e154), ("a", 1e-300), ("m_p", 1e9)])
+def test_absurd_magnitudes_are_refused(name, value):
+    with pytest.raises(InvalidParametersError, match=f"{name} = .* outside the supported range"):
+        Params.paper(**{name: value})
+
+
 def test_non_numbers_and_unknown_names_are_refused():
     with pytest.raises(InvalidParametersError, match="a must be a number"):
         Params(a="big")

@@ -28,7 +28,7 @@ import numpy as np
 
 from .errors import SingularConfigurationError
 from .jacobians import actuator_velocity, eq14_row
-from .kinematics import as_xy, inverse_kinematics, leg_components
+from .kinematics import as_xy, finite_result, inverse_kinematics, leg_components
 from .params import Params
 
 __all__ = ["DynamicsResult", "inverse_dynamics", "inverse_dynamics_detail", "kinetic_energy"]
@@ -110,7 +110,8 @@ def _vectorised(params: Params, p, dp, ddp, f_ext, d) -> tuple:
     f = np.zeros(2) if f_ext is None else as_xy(f_ext, "f_ext")
     c, _ = leg_components(params, p, d)
     _check_regular(params, c[..., 0], c[..., 1], p[..., 0], p[..., 1])
-    out = _procedure(params, *(x[..., k] for x in (p, dp, ddp, c) for k in (0, 1)), f[..., 0], f[..., 1])
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = _procedure(params, *(x[..., k] for x in (p, dp, ddp, c) for k in (0, 1)), f[..., 0], f[..., 1])
     return p, dp, ddp, d, out
 
 
@@ -124,6 +125,7 @@ def inverse_dynamics_detail(params: Params, p, dp, ddp, f_ext=None, d=None) -> D
     """
     p, dp, ddp, d, out = _vectorised(params, p, dp, ddp, f_ext, d)
     dd, ddd, v, w, lam, tau = (np.stack(out[k : k + 2], -1) for k in range(0, 12, 2))
+    finite_result(tau, "the actuator forces")
     return DynamicsResult(p=p, dp=dp, ddp=ddp, d=d, dd=dd, ddd=ddd, v=v, w=w, lam=lam, tau=tau)
 
 
@@ -145,8 +147,11 @@ def _inverse_dynamics_one(params: Params, p, dp, ddp, f_ext) -> np.ndarray | Non
     la2 = params.l_a**2
     c1, c2 = math.sqrt(la2 - p2 * p2), math.sqrt(la2 - p1 * p1)  # eq. (4): c_i = sqrt(l_a² - p_j²)
     _check_regular(params, c1, c2, p1, p2)
-    out = _procedure(params, p1, p2, dp1, dp2, ddp1, ddp2, c1, c2, f1, f2)
-    return np.array(out[10:12])
+    try:
+        out = _procedure(params, p1, p2, dp1, dp2, ddp1, ddp2, c1, c2, f1, f2)
+    except OverflowError:
+        out = (math.inf,) * 12
+    return finite_result(np.array(out[10:12]), "the actuator forces")
 
 
 def inverse_dynamics(params: Params, p, dp, ddp, f_ext=None, d=None) -> np.ndarray:
@@ -160,7 +165,7 @@ def inverse_dynamics(params: Params, p, dp, ddp, f_ext=None, d=None) -> np.ndarr
             tau = _inverse_dynamics_one(params, p, dp, ddp, f_ext)
             if tau is not None:
                 return tau
-    return np.stack(_vectorised(params, p, dp, ddp, f_ext, d)[4][10:12], -1)
+    return finite_result(np.stack(_vectorised(params, p, dp, ddp, f_ext, d)[4][10:12], -1), "the actuator forces")
 
 
 def kinetic_energy(params: Params, p, dp, d=None) -> np.ndarray:

@@ -20,7 +20,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .errors import SingularConfigurationError
-from .kinematics import as_xy, in_stroke, inverse_kinematics, leg_components, reachable
+from .kinematics import as_xy, finite_result, in_stroke, inverse_kinematics, leg_components, reachable
 from .params import Params
 
 __all__ = [
@@ -132,15 +132,17 @@ def actuator_velocity(params: Params, p, dp, d=None) -> np.ndarray:
     """Actuator velocities ``ḋ = J ṗ`` [m/s], eq. (9)."""
     jac = jacobians(params, p, d)
     _check_regular(jac, "inverse")
-    return np.einsum("...ij,...j->...i", jac.j, as_xy(dp, "dp"))
+    with np.errstate(over="ignore", invalid="ignore"):
+        return finite_result(np.einsum("...ij,...j->...i", jac.j, as_xy(dp, "dp")), "the actuator velocities")
 
 
 def platform_velocity(params: Params, p, dd, d=None) -> np.ndarray:
     """Platform velocity ``ṗ = J^{-1} ḋ`` [m/s] (inverse of eq. 9; needs ``det J_x != 0``)."""
     jac = jacobians(params, p, d)
     _check_regular(jac, "direct")
-    rhs = np.einsum("...ij,...j->...i", jac.jq, as_xy(dd, "dd"))
-    return np.linalg.solve(jac.jx, rhs[..., None])[..., 0]
+    with np.errstate(over="ignore", invalid="ignore"):
+        rhs = np.einsum("...ij,...j->...i", jac.jq, as_xy(dd, "dd"))
+        return finite_result(np.linalg.solve(jac.jx, rhs[..., None])[..., 0], "the platform velocity")
 
 
 def theta_dot(params: Params, p, dp, d=None) -> np.ndarray:
@@ -148,7 +150,8 @@ def theta_dot(params: Params, p, dp, d=None) -> np.ndarray:
     _, _, cos, _ = _cos_sin(params, p, d)
     if np.any(np.abs(cos) < 1e-12):
         raise SingularConfigurationError("singular configuration: cos θ1 cos θ2 = 0 (eq. 11)")
-    return as_xy(dp, "dp")[..., ::-1] / (params.l_a * cos)
+    with np.errstate(over="ignore", invalid="ignore"):
+        return finite_result(as_xy(dp, "dp")[..., ::-1] / (params.l_a * cos), "the leg angular rates")
 
 
 def eq14_row(pi, pj, dpi, dpj, ddpi, ddpj, ci, ddi):
@@ -178,11 +181,12 @@ def actuator_acceleration(params: Params, p, dp, ddp, d=None, dd=None) -> np.nda
     if dd is None:
         dd = actuator_velocity(params, p, dp, d)
     c = cos * params.l_a
-    rows = [
-        eq14_row(p[..., i], p[..., j], dp[..., i], dp[..., j], ddp[..., i], ddp[..., j], c[..., i], dd[..., i])
-        for i, j in ((0, 1), (1, 0))
-    ]
-    return np.stack(rows, -1)
+    with np.errstate(over="ignore", invalid="ignore"):
+        rows = [
+            eq14_row(p[..., i], p[..., j], dp[..., i], dp[..., j], ddp[..., i], ddp[..., j], c[..., i], dd[..., i])
+            for i, j in ((0, 1), (1, 0))
+        ]
+    return finite_result(np.stack(rows, -1), "the actuator accelerations")
 
 
 def actuator_forces_from_platform_force(params: Params, p, f, d=None) -> np.ndarray:
@@ -196,11 +200,13 @@ def actuator_forces_from_platform_force(params: Params, p, f, d=None) -> np.ndar
     _check_regular(jac, "direct")
     _check_regular(jac, "inverse")
     jt = np.swapaxes(jac.j, -1, -2)
-    return np.linalg.solve(jt, as_xy(f, "f")[..., None])[..., 0]
+    with np.errstate(over="ignore", invalid="ignore"):
+        return finite_result(np.linalg.solve(jt, as_xy(f, "f")[..., None])[..., 0], "the actuator forces")
 
 
 def platform_force_from_actuator_forces(params: Params, p, tau, d=None) -> np.ndarray:
     """Platform force ``f = J^T τ`` [N] for actuator forces ``τ`` [N], eq. (13)."""
     jac = jacobians(params, p, d)
     _check_regular(jac, "inverse")
-    return np.einsum("...ji,...j->...i", jac.j, as_xy(tau, "tau"))
+    with np.errstate(over="ignore", invalid="ignore"):
+        return finite_result(np.einsum("...ji,...j->...i", jac.j, as_xy(tau, "tau")), "the platform force")

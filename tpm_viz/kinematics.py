@@ -24,6 +24,7 @@ __all__ = [
     "FkSolutions",
     "MechanismPose",
     "as_xy",
+    "finite_result",
     "forward_kinematics",
     "forward_kinematics_both",
     "forward_kinematics_nearest",
@@ -43,6 +44,13 @@ def as_xy(x, name: str = "p") -> np.ndarray:
         raise InputError(f"{name} must have shape (..., 2), got {arr.shape}")
     if not np.all(np.isfinite(arr)):
         raise InputError(f"{name} contains a non-finite value (NaN or inf)")
+    return arr
+
+
+def finite_result(arr: np.ndarray, what: str) -> np.ndarray:
+    """``arr`` unchanged if every entry is finite; otherwise an :class:`InputError` (overflow)."""
+    if not np.all(np.isfinite(arr)):
+        raise InputError(f"{what} overflowed: the inputs are too large for finite results")
     return arr
 
 

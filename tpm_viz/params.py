@@ -16,6 +16,9 @@ from .errors import InvalidParametersError
 
 __all__ = ["PARAM_INFO", "Params"]
 
+_RANGES = {"m": (1e-6, 100.0), "kg": (1e-9, 1e4)}
+"""Supported magnitudes per unit: keeps every derived quantity (l_a², c_i³, ...) finite in float64."""
+
 
 def _f(doc: str, unit: str, ui_unit: str, ui_scale: float, default: float):
     return field(default=default, metadata={"doc": doc, "unit": unit, "ui_unit": ui_unit, "ui_scale": ui_scale})
@@ -59,6 +62,12 @@ class Params:
             if value <= 0.0:
                 raise InvalidParametersError(
                     f"parameter {f.name} must be positive, got {value:g} {f.metadata['unit']}"
+                )
+            low, high = _RANGES[f.metadata["unit"]]
+            if not low <= value <= high:
+                raise InvalidParametersError(
+                    f"parameter {f.name} = {value:g} {f.metadata['unit']} is outside the supported range "
+                    f"{low:g} to {high:g} {f.metadata['unit']}"
                 )
         k = self.a - self.b
         # Eq. (4): d_i = p_i + (a - b) - sqrt(l_a^2 - p_j^2). Over the reachable set
