@@ -136,9 +136,10 @@ class MultibodyModel:
         if not isinstance(params, Params):
             raise InputError(f"MultibodyModel needs a tpm_viz.Params, got {type(params).__name__}")
         self.params = params
-        self.model, self._closures, self._frames = _build(params)
+        self.model, self.constraint_models, self._frames = _build(params)
+        """``pinocchio.Model`` and the three ``RigidConstraintModel`` loop closures (LOCAL_WORLD_ALIGNED)."""
         self.data = self.model.createData()
-        self._cdatas = [c.createData() for c in self._closures]
+        self._cdatas = [c.createData() for c in self.constraint_models]
         self._lock = threading.RLock()
         self.index = {n: self.model.joints[self.model.getJointId(n)].idx_q for n in PART_NAMES}
         """Position of each joint coordinate in ``q`` (and ``v``): Pinocchio's depth-first order."""
@@ -146,7 +147,7 @@ class MultibodyModel:
         self._angle_idx = np.array([self.index[n] for n in PART_NAMES[2:]])  # φ_10, φ_11, φ_20, φ_21, φ_p
         self._s_t = np.zeros((self.model.nv, _DOF))  # Sᵀ: actuator forces -> generalised forces
         self._s_t[self._slider_idx, [0, 1]] = 1.0
-        self._select_platform = np.zeros((len(self._closures) * 3 + _DOF, _DOF))  # [0; I]
+        self._select_platform = np.zeros((len(self.constraint_models) * 3 + _DOF, _DOF))  # [0; I]
         self._select_platform[-_DOF:] = np.eye(_DOF)
         self._q_last: np.ndarray | None = None
 
@@ -160,7 +161,7 @@ class MultibodyModel:
         m, d = self.model, self.data
         pin.computeJointJacobians(m, d, q)  # also runs forwardKinematics(q)
         res, jac = [], []
-        for cm, cd in zip(self._closures, self._cdatas, strict=True):
+        for cm, cd in zip(self.constraint_models, self._cdatas, strict=True):
             cm.calc(m, d, cd)
             res.append(cd.oMc1.translation - cd.oMc2.translation)
             jac.append(pin.getConstraintJacobian(m, d, cm, cd))
@@ -179,7 +180,7 @@ class MultibodyModel:
         gamma = [
             pin.getFrameClassicalAcceleration(m, d, c.joint1_id, c.joint1_placement, lwa).linear
             - pin.getFrameClassicalAcceleration(m, d, c.joint2_id, c.joint2_placement, lwa).linear
-            for c in self._closures
+            for c in self.constraint_models
         ]
         fp = m.frames[self._frames["platform"]]
         acc_p = pin.getFrameClassicalAcceleration(m, d, fp.parentJoint, fp.placement, lwa).linear
@@ -457,13 +458,14 @@ class MultibodyModel:
         q, v = self._as_q(q).copy(), self._as_q(v)
         for _ in range(_NEWTON_MAX_ITER):
             phi, jc = self._closure_terms(q)
-            svd = self._closure_svd(jc)
             if np.max(np.abs(phi)) < _NEWTON_TOL:
                 break
-            q -= svd.solve(phi)
+            # Off the closures the redundant row is not exactly redundant (rank 6, σ_6 ~ the gap):
+            # step on the 5 dominant directions only, the rank the constraints have on the closures.
+            q -= ranked_svd(jc)._replace(rank=self.model.nv - _DOF).solve(phi)
         else:
             raise SingularConfigurationError("the closures cannot be re-assembled (constraint drift too large)")
-        n = svd.null_space
+        n = self._closure_svd(jc).null_space
         return q, n @ (n.T @ v)
 
     @_locked
