@@ -50,7 +50,8 @@ PART_NAMES = ("slider1", "slider2", "link1_0", "link1_1", "link2_0", "link2_1", 
 """Keys of :meth:`MultibodyModel.placements`, also the Pinocchio joint names (and frame names)."""
 
 _DOF = 2
-_NEWTON_TOL = 1e-13  # m, on the closure and platform/actuator residuals
+_NEWTON_TOL = 1e-12  # m: accepted residual of the closure and platform/actuator equations ...
+_NEWTON_FLOOR = 1e-15  # m: ... but Newton polishes down to this or until it stops improving
 _NEWTON_MAX_ITER = 40
 _MAX_ANGLE_STEP = 0.5  # rad, Newton step limit on the revolute coordinates
 _SINGULAR_RTOL = 1e-9
@@ -202,7 +203,7 @@ class MultibodyModel:
 
         Returns ``(q, converged, J_c, J_x)`` with the Jacobians at the returned ``q``.
         """
-        q = q.copy()
+        q, previous = q.copy(), np.inf
         for _ in range(_NEWTON_MAX_ITER):
             phi, jc = self._closure_terms(q)
             if driven == "platform":
@@ -210,8 +211,10 @@ class MultibodyModel:
             else:
                 x, jx = q[self._slider_idx], self._s_t.T
             r = np.concatenate([phi, x - target])
-            if np.max(np.abs(r)) < _NEWTON_TOL:
+            err = np.max(np.abs(r))
+            if err < _NEWTON_FLOOR or (err < _NEWTON_TOL and err > 0.5 * previous):  # at the rounding floor
                 return q, True, jc, jx
+            previous = err
             dq = -ranked_svd(np.vstack([jc, jx])).solve(r)
             big = np.max(np.abs(dq[self._angle_idx]))
             if big > _MAX_ANGLE_STEP:
@@ -455,11 +458,13 @@ class MultibodyModel:
     def project(self, q, v) -> tuple[np.ndarray, np.ndarray]:
         """Constraint stabilisation: the nearest ``q`` on the closures (minimum-norm Newton steps)
         and ``v`` projected on the admissible motions ``N Nᵀ v``."""
-        q, v = self._as_q(q).copy(), self._as_q(v)
+        q, v, previous = self._as_q(q).copy(), self._as_q(v), np.inf
         for _ in range(_NEWTON_MAX_ITER):
             phi, jc = self._closure_terms(q)
-            if np.max(np.abs(phi)) < _NEWTON_TOL:
+            err = np.max(np.abs(phi))
+            if err < _NEWTON_FLOOR or (err < _NEWTON_TOL and err > 0.5 * previous):
                 break
+            previous = err
             # Off the closures the redundant row is not exactly redundant (rank 6, σ_6 ~ the gap):
             # step on the 5 dominant directions only, the rank the constraints have on the closures.
             q -= ranked_svd(jc)._replace(rank=self.model.nv - _DOF).solve(phi)

@@ -1,0 +1,67 @@
+"""PNG figures reproducing the paper's Figs. 4 (line) and 5 (circle): actuator forces vs time.
+
+As in the paper, the closed-form equations are drawn solid and the independent simulation model
+dotted (there ADAMS, here the Pinocchio closed-loop model); a second panel shows their difference.
+Matplotlib is imported lazily and drawn with its Agg canvas (no pyplot, no GUI backend).
+"""
+
+from __future__ import annotations
+
+import pathlib
+
+from .crosscheck import ForceComparison, compare_forces
+from .params import Params
+
+__all__ = ["TITLES", "plot_forces", "write_paper_figures"]
+
+TITLES = {
+    "line": "Fig. 4: line from (-100, -50) to (+100, +50) mm",
+    "circle": "Fig. 5: circle about (0, 0), radius 100 mm",
+}
+FILE_NAMES = {"line": "fig4_line.png", "circle": "fig5_circle.png"}
+
+
+def plot_forces(cmp: ForceComparison, path: str | pathlib.Path, dpi: int = 100) -> pathlib.Path:
+    """Write one force figure (two panels, N vs s) for a :class:`ForceComparison`; returns the path."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(7.0, 6.0), dpi=dpi, layout="constrained")
+    FigureCanvasAgg(fig)
+    top, bottom = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [2.2, 1.0]})
+    colours = ("tab:blue", "tab:red")
+    for i, colour in enumerate(colours):
+        top.plot(cmp.t, cmp.tau_paper[:, i], "-", color=colour, lw=1.6, label=f"τ{i + 1} paper eqs. (29)-(31)")
+        top.plot(cmp.t, cmp.tau_pinocchio[:, i], ":", color="black", lw=2.2, label=f"τ{i + 1} Pinocchio model")
+        bottom.plot(cmp.t, cmp.tau_pinocchio[:, i] - cmp.tau_paper[:, i], "-", color=colour, lw=1.2, label=f"Δτ{i + 1}")
+    top.axhline(0.0, color="0.6", lw=0.6)
+    top.set_ylabel("actuator force [N]")
+    top.legend(loc="best", fontsize=8, ncols=2)
+    top.grid(alpha=0.3)
+    top.set_title(f"{TITLES.get(cmp.kind, cmp.kind)}, T = {cmp.duration:g} s", fontsize=11)
+    bottom.set_ylabel("Pinocchio − paper [N]")
+    bottom.set_xlabel("time [s]")
+    bottom.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
+    bottom.grid(alpha=0.3)
+    bottom.legend(loc="upper right", fontsize=8, ncols=2)
+    bottom.set_title(f"max |Δτ| = {cmp.max_abs_diff:.1e} N, max |Δτ|/(1 N + |τ|) = {cmp.max_rel_diff:.1e}", fontsize=9)
+    bottom.set_xlim(cmp.t[0], cmp.t[-1])
+    path = pathlib.Path(path)
+    fig.savefig(path, format="png", dpi=dpi)
+    return path
+
+
+def write_paper_figures(
+    params: Params,
+    output_dir: str | pathlib.Path,
+    duration_line: float | None = None,
+    duration_circle: float | None = None,
+    samples: int = 201,
+) -> list[pathlib.Path]:
+    """Write ``fig4_line.png`` and ``fig5_circle.png`` into ``output_dir`` (created if needed)."""
+    out = pathlib.Path(output_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for kind, duration in (("line", duration_line), ("circle", duration_circle)):
+        paths.append(plot_forces(compare_forces(params, kind, duration, samples), out / FILE_NAMES[kind]))
+    return paths
