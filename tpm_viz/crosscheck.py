@@ -18,7 +18,7 @@ from .errors import InputError
 from .jacobians import classify
 from .multibody import inverse_dynamics as pinocchio_inverse_dynamics
 from .params import Params
-from .replay import DEFAULT_DT, replay
+from .replay import replay
 from .trajectories import DEFAULT_DURATIONS, paper_trajectory
 
 __all__ = [
@@ -111,7 +111,7 @@ def crosscheck(
     duration_circle: float | None = None,
     n_random: int = 200,
     seed: int = 0,
-    dt: float = DEFAULT_DT,
+    dt: float | None = None,
     tol: Tolerances = Tolerances(),
 ) -> list[CrosscheckRow]:
     """The three comparisons of the module docstring, one :class:`CrosscheckRow` each."""

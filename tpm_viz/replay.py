@@ -28,10 +28,12 @@ from .multibody import model_for
 from .params import Params
 from .trajectories import DEFAULT_DURATIONS, circle_state, line_state
 
-__all__ = ["DEFAULT_DT", "MAX_STEPS", "ReplayResult", "replay"]
+__all__ = ["DEFAULT_DT", "MAX_STEPS", "MIN_STEPS", "ReplayResult", "replay"]
 
 DEFAULT_DT = 1e-3
-"""Default RK4 step [s]."""
+"""Largest default RK4 step [s]."""
+MIN_STEPS = 200
+"""The default step is ``min(DEFAULT_DT, duration / MIN_STEPS)``: short, violent motions get finer steps."""
 MAX_STEPS = 200_000
 """Upper bound on the number of steps (duration / dt) of one replay."""
 
@@ -68,7 +70,9 @@ class ReplayResult:
         return float(np.max(self.constraint_violation))
 
 
-def _steps(duration: float, dt: float) -> int:
+def _steps(duration: float, dt: float | None) -> int:
+    if dt is None:
+        dt = min(DEFAULT_DT, duration / MIN_STEPS)
     try:
         dt = float(dt)
     except (TypeError, ValueError):
@@ -99,14 +103,15 @@ def replay(
     params: Params,
     kind: str,
     duration: float | None = None,
-    dt: float = DEFAULT_DT,
+    dt: float | None = None,
     force_params: Params | None = None,
 ) -> ReplayResult:
     """Drive the Pinocchio model with the paper's actuator forces along ``kind`` (``"line"``/``"circle"``).
 
-    ``duration`` [s] defaults to :data:`tpm_viz.DEFAULT_DURATIONS`; ``dt`` [s] is rounded down so that
-    a whole number of RK4 steps spans the duration. ``force_params`` (default ``params``) are the
-    parameters the closed-form forces are computed with: a mismatch shows as a tracking error.
+    ``duration`` [s] defaults to :data:`tpm_viz.DEFAULT_DURATIONS`; ``dt`` [s] (default
+    ``min(DEFAULT_DT, duration / MIN_STEPS)``) is rounded down so that whole RK4 steps span the
+    duration. ``force_params`` (default ``params``) are the parameters the closed-form forces are
+    computed with: a mismatch shows as a tracking error.
     Raises :mod:`tpm_viz.errors` exceptions for bad input, an unreachable path or a singular
     configuration on it.
     """
