@@ -1,0 +1,73 @@
+"""Parametric parts (tpm_viz.meshes): sizes follow the parameters, poses put the links on their pivots."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tpm_viz import Params, mechanism_pose
+from tpm_viz import meshes as m
+
+P = Params.paper()
+
+
+def _quat_rotate(wxyz: np.ndarray, v: np.ndarray) -> np.ndarray:
+    w, x, y, z = wxyz
+    r = np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+    return r @ v
+
+
+def test_link_length_is_l_a():
+    bounds = m.link(P.replace(l_a=0.3, pivot_spacing=0.05)).bounds
+    assert bounds[1, 0] - bounds[0, 0] == pytest.approx(0.3 + m.LINK_WIDTH)
+
+
+@pytest.mark.parametrize("i", [0, 1])
+def test_rail_spans_the_stroke_and_stops_touch_the_slider_at_its_ends(i):
+    rail = m.rail(P, i).bounds
+    stops = m.end_stops(P, i).bounds
+    assert rail[0, i] < -P.a - m.SLIDER_LENGTH / 2 and rail[1, i] > -P.a + P.stroke + m.SLIDER_LENGTH / 2
+    assert stops[0, i] == pytest.approx(-P.a - m.SLIDER_LENGTH / 2 - 0.012)
+    assert stops[1, i] == pytest.approx(-P.a + P.stroke + m.SLIDER_LENGTH / 2 + 0.012)
+
+
+def test_slider_carries_both_pivots_and_the_platform_covers_its_pins():
+    for i in range(2):
+        lo, hi = m.slider(P, i).bounds
+        for pin in m.slider_pin_offsets(P, i):
+            assert np.all(lo[:2] < pin[:2]) and np.all(pin[:2] < hi[:2])
+    lo, hi = m.platform(P).bounds
+    for pin in m.platform_pin_offsets(P):
+        assert np.all(lo[:2] < pin[:2]) and np.all(pin[:2] < hi[:2])
+
+
+def test_link_instances_run_from_slider_pivot_to_platform_pivot():
+    pose = mechanism_pose(P, np.array([0.06, -0.04]))
+    positions, wxyzs = m.link_instances(pose)
+    ends = pose.links.reshape(4, 2, 2)
+    for k in range(4):
+        tip = positions[k] + _quat_rotate(wxyzs[k], np.array([P.l_a, 0.0, 0.0]))
+        np.testing.assert_allclose(positions[k, :2], ends[k, 0], atol=1e-12)
+        np.testing.assert_allclose(tip[:2], ends[k, 1], atol=1e-12)
+
+
+def test_parts_are_stacked_in_z_without_overlap():
+    assert m.RAIL_Z[1] <= m.SLIDER_Z[0]
+    assert m.SLIDER_Z[1] < min(m.LINK_Z) - m.LINK_THICKNESS / 2
+    assert abs(m.LINK_Z[1] - m.LINK_Z[0]) > m.LINK_THICKNESS
+    assert max(m.LINK_Z) + m.LINK_THICKNESS / 2 < m.PLATFORM_Z[0]
+
+
+def test_segments_helpers():
+    circle = m.circle_segments(0.2, 0.01, n=16)
+    assert circle.shape == (16, 2, 3)
+    np.testing.assert_allclose(np.linalg.norm(circle[:, 0, :2], axis=-1), 0.2)
+    segs = m.polyline_segments([np.zeros((3, 2)), np.zeros((1, 2))], 0.0)
+    assert segs.shape == (2, 2, 3)
+    assert m.polyline_segments([], 0.0).shape == (0, 2, 3)
