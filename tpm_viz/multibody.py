@@ -34,6 +34,7 @@ docstring for why not ``pinocchio.constraintDynamics``.
 from __future__ import annotations
 
 import functools
+import math
 import threading
 
 import numpy as np
@@ -140,7 +141,11 @@ class MultibodyModel:
         self.model, self.constraint_models, self._frames = _build(params)
         """``pinocchio.Model`` and the three ``RigidConstraintModel`` loop closures (LOCAL_WORLD_ALIGNED)."""
         self.data = self.model.createData()
-        self._cdatas = [c.createData() for c in self.constraint_models]
+        self._cmodel_vec = pin.StdVec_RigidConstraintModel()
+        self._cdatas = pin.StdVec_RigidConstraintData()  # holds references: calc() updates these
+        for c in self.constraint_models:
+            self._cmodel_vec.append(c)
+            self._cdatas.append(c.createData())
         self._lock = threading.RLock()
         self.index = {n: self.model.joints[self.model.getJointId(n)].idx_q for n in PART_NAMES}
         """Position of each joint coordinate in ``q`` (and ``v``): Pinocchio's depth-first order."""
@@ -150,23 +155,22 @@ class MultibodyModel:
         self._s_t[self._slider_idx, [0, 1]] = 1.0
         self._select_platform = np.zeros((len(self.constraint_models) * 3 + _DOF, _DOF))  # [0; I]
         self._select_platform[-_DOF:] = np.eye(_DOF)
-        self._q_last: np.ndarray | None = None
+        self._last: tuple[np.ndarray, np.ndarray, np.ndarray | None] | None = None  # warm start (p, q, ∂q/∂p)
 
     # ----------------------------------------------------------------- Pinocchio evaluations
     def _closure_terms(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """World closure residual ``Φ(q)`` (9,) [m] and its Jacobian ``J_c`` (9, 7).
 
         Order matters (pinocchio-notes.md): joint Jacobians and placements at ``q`` first, then
-        ``calc`` of each constraint, then ``getConstraintJacobian``.
+        ``calc`` of each constraint, then the constraint Jacobian (all three in one call).
         """
         m, d = self.model, self.data
         pin.computeJointJacobians(m, d, q)  # also runs forwardKinematics(q)
-        res, jac = [], []
-        for cm, cd in zip(self.constraint_models, self._cdatas, strict=True):
+        res = np.empty(3 * len(self._cdatas))
+        for k, (cm, cd) in enumerate(zip(self.constraint_models, self._cdatas, strict=True)):
             cm.calc(m, d, cd)
-            res.append(cd.oMc1.translation - cd.oMc2.translation)
-            jac.append(pin.getConstraintJacobian(m, d, cm, cd))
-        return np.concatenate(res), np.vstack(jac)
+            res[3 * k : 3 * k + 3] = cd.oMc1.translation - cd.oMc2.translation
+        return res, pin.getConstraintsJacobian(m, d, self._cmodel_vec, self._cdatas)
 
     def _platform_jacobian(self) -> np.ndarray:
         """In-plane translational Jacobian ``J_P`` (2, 7) of P (after :meth:`_closure_terms`)."""
@@ -201,39 +205,43 @@ class MultibodyModel:
     def _newton(self, q: np.ndarray, target: np.ndarray, driven: str):
         """Gauss-Newton on ``[Φ(q); x(q) - target] = 0``, ``x`` = platform P or actuators d.
 
-        Returns ``(q, converged, J_c, J_x)`` with the Jacobians at the returned ``q``.
+        ``[J_c; J_x]`` has full column rank away from singularities, so the normal equations give the
+        step. Returns ``(q, converged, J_c, J_x)`` with the Jacobians at the returned ``q``.
         """
-        q, previous = q.copy(), np.inf
+        q, previous, nc = q.copy(), np.inf, 3 * len(self._cdatas)
+        a, r = np.empty((nc + _DOF, self.model.nv)), np.empty(nc + _DOF)
         for _ in range(_NEWTON_MAX_ITER):
-            phi, jc = self._closure_terms(q)
+            r[:nc], a[:nc] = self._closure_terms(q)
             if driven == "platform":
-                x, jx = self._platform_position_now(), self._platform_jacobian()
+                r[nc:], a[nc:] = self._platform_position_now() - target, self._platform_jacobian()
             else:
-                x, jx = q[self._slider_idx], self._s_t.T
-            r = np.concatenate([phi, x - target])
-            err = np.max(np.abs(r))
+                r[nc:], a[nc:] = q[self._slider_idx] - target, self._s_t.T
+            err = abs(r).max()
             if err < _NEWTON_FLOOR or (err < _NEWTON_TOL and err > 0.5 * previous):  # at the rounding floor
-                return q, True, jc, jx
+                return q, True, a[:nc].copy(), a[nc:].copy()
             previous = err
-            dq = -ranked_svd(np.vstack([jc, jx])).solve(r)
-            big = np.max(np.abs(dq[self._angle_idx]))
+            try:
+                dq = -np.linalg.solve(a.T @ a, a.T @ r)
+            except np.linalg.LinAlgError:
+                break
+            big = abs(dq[self._angle_idx]).max()
             if big > _MAX_ANGLE_STEP:
                 dq *= _MAX_ANGLE_STEP / big
             q += dq
-        return q, False, jc, jx
+        return q, False, a[:nc].copy(), a[nc:].copy()
 
     def _platform_position_now(self) -> np.ndarray:
         return pin.updateFramePlacement(self.model, self.data, self._frames["platform"]).translation[:2].copy()
 
     def _is_parallelogram(self, q: np.ndarray) -> bool:
         """Both links of each leg parallel and the platform translating (``φ_p = -φ_10``)."""
-        f10, f11, f20, f21, fp = q[self._angle_idx]
-        wrap = np.angle(np.exp(1j * np.array([f11 - f10, f21 - f20, fp + f10])))
-        return bool(np.all(np.abs(wrap) < 1e-6))
+        f10, f11, f20, f21, fp = q[self._angle_idx].tolist()
+        return all(abs(math.remainder(x, 2 * math.pi)) < 1e-6 for x in (f11 - f10, f21 - f20, fp + f10))
 
     def _wrap(self, q: np.ndarray) -> np.ndarray:
+        """``q`` with every angle in ``[-π, π]``."""
         q = q.copy()
-        q[self._angle_idx] = np.angle(np.exp(1j * q[self._angle_idx]))
+        q[self._angle_idx] = [math.remainder(x, 2 * math.pi) for x in q[self._angle_idx].tolist()]
         return q
 
     def _pack(self, d, phi1: float, phi2: float) -> np.ndarray:
@@ -248,12 +256,14 @@ class MultibodyModel:
         return float(q[self.index["link1_0"]]), float(q[self.index["link2_0"]])
 
     def _guess_from_platform(self, p: np.ndarray, d: np.ndarray | None) -> np.ndarray:
-        """Starting point: links along their rails (θ = 0, the working mode), or pointing at the
-        platform pivots from given actuator positions ``d`` (which selects the branch)."""
-        k = self.params.a - self.params.b
-        if d is None:
-            return self._pack(p + k - self.params.l_a, 0.0, 0.0)
-        return self._guess_from_both(p, d)
+        """Starting point: the working mode with small-angle leg angles ``θ_i ≈ p_j / l_a`` (a guess
+        only), or links pointing at the platform pivots from given actuator positions ``d``."""
+        if d is not None:
+            return self._guess_from_both(p, d)
+        la, k = self.params.l_a, self.params.a - self.params.b
+        theta = (float(p[1]) / la, float(p[0]) / la)
+        d = (p[0] + k - la * math.cos(theta[0]), p[1] + k - la * math.cos(theta[1]))
+        return self._pack(d, theta[0], -theta[1])
 
     def _guess_from_both(self, p: np.ndarray, d: np.ndarray) -> np.ndarray:
         """Links pointing from the slider joints ``A_i`` towards the platform pivots ``B_i``."""
@@ -275,21 +285,22 @@ class MultibodyModel:
     def _configure(self, p: np.ndarray, d: np.ndarray | None):
         """``(q, J_c, J_P)`` at the closed-loop configuration of platform position ``p``."""
         la = self.params.l_a
-        if np.any(np.abs(p) >= la):
+        if max(abs(p[0]), abs(p[1])) >= la:
             raise UnreachablePoseError(
                 f"platform position ({p[0] * 1e3:.1f}, {p[1] * 1e3:.1f}) mm is unreachable: "
                 f"each |p_j| must be below l_a = {la * 1e3:.1f} mm"
             )
-        starts = [self._guess_from_platform(p, d)]
-        if d is None and self._q_last is not None:
-            starts.insert(0, self._q_last)
-        for q0 in starts:
-            q, ok, jc, jp = self._newton(q0, p, "platform")
-            working = np.all(np.cos(self._link_angles(q)) > 0)  # c_i = l_a cos θ_i > 0 (eq. 4)
+        starts = [lambda: self._guess_from_platform(p, d)]
+        if d is None and self._last is not None:  # continuation from the last pose, tangent predictor
+            p_last, q_last, dq_dp = self._last
+            starts.insert(0, lambda: q_last if dq_dp is None else q_last + dq_dp @ (p - p_last))
+        for start in starts:
+            q, ok, jc, jp = self._newton(start(), p, "platform")
+            working = min(math.cos(x) for x in self._link_angles(q)) > 0  # c_i = l_a cos θ_i > 0 (eq. 4)
             if ok and self._is_parallelogram(q) and (d is not None or working):
                 q = self._wrap(q)
                 if d is None:
-                    self._q_last = q
+                    self._last = (p.copy(), q, None)
                 return q, jc, jp
         raise SingularConfigurationError(
             f"no closed-loop configuration found at ({p[0] * 1e3:.1f}, {p[1] * 1e3:.1f}) mm "
@@ -375,8 +386,9 @@ class MultibodyModel:
         if svd.rank < self.model.nv:
             raise SingularConfigurationError("singular configuration: cos θ1 cos θ2 = 0 (eq. 11)")
         n = svd.solve(self._select_platform)
-        if np.max(np.abs(jc @ n)) > _SINGULAR_RTOL * np.max(np.abs(n)):
+        if np.abs(jc @ n).max() > _SINGULAR_RTOL * np.abs(n).max():
             raise SingularConfigurationError("singular configuration: the closures allow a platform-free motion")
+        self._last = (p.copy(), q, n)
         v = n @ dp
         gamma, jp_dot_v = self._drifts(q, v)
         a = svd.solve(np.concatenate([-gamma, ddp - jp_dot_v]))
@@ -388,11 +400,13 @@ class MultibodyModel:
         ``Nᵀ Sᵀ`` is the paper's ``Jᵀ`` (eq. 10, ``ḋ = J ṗ``): singular at ``cos(θ1 + θ2) = 0`` (eq. 12).
         """
         rhs = pin.rnea(self.model, self.data, q, v, a) - jp.T @ f_ext
-        nst = n[self._slider_idx].T  # Nᵀ Sᵀ
+        (g11, g12), (g21, g22) = n[self._slider_idx].T.tolist()  # Nᵀ Sᵀ (2 x 2)
+        det = g11 * g22 - g12 * g21
         # |det| / (product of row norms) = |sin| of the angle between the rows; 0 when singular.
-        if abs(np.linalg.det(nst)) < _SINGULAR_RTOL * np.prod(np.linalg.norm(nst, axis=1)):
+        if abs(det) < _SINGULAR_RTOL * math.hypot(g11, g12) * math.hypot(g21, g22):
             raise SingularConfigurationError("singular configuration: cos(θ1 + θ2) = 0 (eq. 12)")
-        return np.linalg.solve(nst, n.T @ rhs), rhs
+        b1, b2 = (n.T @ rhs).tolist()
+        return np.array([g22 * b1 - g12 * b2, g11 * b2 - g21 * b1]) / det, rhs
 
     @_locked
     def constrained_motion(self, p, dp, ddp) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -413,6 +427,8 @@ class MultibodyModel:
             p, dp, ddp, f = np.broadcast_arrays(p, dp, ddp, f)
         except ValueError:
             raise InputError("p, dp, ddp and f_ext have incompatible shapes") from None
+        if p.shape == (2,):
+            return self._tau(*self._motion(p, dp, ddp), f)[0]
         shape = p.shape
         flat = [x.reshape(-1, 2) for x in (p, dp, ddp, f)]
         tau = np.empty((flat[0].shape[0], 2))
