@@ -3,7 +3,9 @@
 This is the only module of tpm-viz that imports :mod:`pinocchio`. The model is built from a
 :class:`~tpm_viz.Params` (no model file), zero gravity (the paper's ``U = 0``), SI units.
 
-Tree (``nq = nv = 7``; ``q = (d_1, d_2, φ_10, φ_11, φ_20, φ_21, φ_p)``)::
+Tree, in the depth-first order Pinocchio needs (``crba`` silently assumes every subtree is
+contiguous in ``v``), so ``q = (d_1, φ_10, φ_p, φ_11, d_2, φ_20, φ_21)`` (see
+:attr:`MultibodyModel.index`)::
 
     universe ─PX─ slider1 (origin A_1 = (d_1 - a) e_1) ─RZ─ link1_0 (pivot A_1) ─RZ─ platform (pivot B_1)
                                                       └RZ─ link1_1 (pivot A_1 + s e_2)
@@ -20,15 +22,18 @@ rotates, so its rotational inertia does not enter), each link a uniform slender 
 
 Over-constraint. The 9 closure rows have rank 5: the 3 out-of-plane rows vanish identically and
 one in-plane row is redundant (both parallelograms fix the platform's orientation, the paper's
-"overlapped rotational constraints"). Every solve therefore goes through an SVD of the stacked
-constraint Jacobian ``J_c`` that reveals its rank (:mod:`tpm_viz.rank`) and its null space ``N``
-(the 2 admissible motions). Inverse dynamics solves ``rnea(q, v, a) - J_Pᵀ f_ext = Sᵀ τ + J_cᵀ λ``
-in the least-squares sense by projecting on ``N``: ``Nᵀ Sᵀ τ = Nᵀ (rnea - J_Pᵀ f_ext)``. Only
-``J_cᵀ λ`` is defined (the redundant part of ``λ`` is not), and since ``N`` is the same for every
-maximal independent subset of rows, ``τ`` does not depend on which redundant row one would keep.
-Forward dynamics (:meth:`MultibodyModel.forward_dynamics`) is our own KKT solve on the same null
-space (Gauss's principle) with Pinocchio's ``crba``, ``nle`` and constraint Jacobian; see its
-docstring for why not ``pinocchio.constraintDynamics``.
+"overlapped rotational constraints"). Nothing here picks rows; the solves use SVDs that reveal
+the rank (:mod:`tpm_viz.rank`). Inverse dynamics: the prescribed platform motion gives
+``A = [J_c; J_P]`` (rank 7 checked), ``v``, ``a`` and ``N = A⁺ [0; I]``, whose columns span the
+null space of ``J_c`` (the 2 admissible motions, checked). Then
+``rnea(q, v, a) - J_Pᵀ f_ext = Sᵀ τ + J_cᵀ λ`` is solved in the least-squares sense by projecting on
+``N``: ``Nᵀ Sᵀ τ = Nᵀ (rnea - J_Pᵀ f_ext)`` (``Nᵀ Sᵀ`` is the paper's ``Jᵀ``). Only ``J_cᵀ λ`` is
+defined, not the redundant part of ``λ``; since the null space is the same for every maximal
+independent subset of rows, ``τ`` does not depend on which redundant row one would keep (the tests
+solve the square system for every such subset). Forward dynamics
+(:meth:`MultibodyModel.forward_dynamics`) is our own KKT solve on the null space from the SVD of
+``J_c`` (Gauss's principle) with Pinocchio's ``crba``, ``nle`` and constraint Jacobian; its docstring
+says why not ``pinocchio.constraintDynamics``.
 """
 
 from __future__ import annotations
@@ -467,7 +472,7 @@ class MultibodyModel:
         mass = pin.crba(m, d, q)
         mass = np.triu(mass) + np.triu(mass, 1).T  # C++ crba fills the upper triangle only
         a_c = -svd.solve(gamma)
-        rhs = self._s_t @ np.asarray(tau, dtype=float) - pin.nle(m, d, q, v) - mass @ a_c
+        rhs = self._s_t @ self._one(tau, "tau") - pin.nle(m, d, q, v) - mass @ a_c
         return a_c + n @ np.linalg.solve(n.T @ mass @ n, n.T @ rhs)
 
     @_locked
