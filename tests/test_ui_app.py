@@ -1,0 +1,293 @@
+"""Wiring of the app, without a browser: a protocol-level client sends what a browser would send, and the tests
+check that each control changes the right state and the right scene and panel handles.
+"""
+
+from __future__ import annotations
+
+import io
+import re
+import socket
+import threading
+from contextlib import redirect_stderr, redirect_stdout
+
+import numpy as np
+import pytest
+from conftest import wait_for
+
+from tpm_viz import Params, forward_kinematics_both, inverse_kinematics
+from tpm_viz.trajectories import line_state
+from tpm_viz.ui.app import is_loopback, main
+from tpm_viz.ui.scene import COLORS
+
+P = Params.paper()
+
+
+def _state(view):
+    """The view's state, read under the hub's lock: once a new state is visible, its render is complete."""
+    with view.hub.lock:
+        return view.session.state
+
+
+def _dashboard(view) -> str:
+    return view.panel.dashboard.content
+
+
+def _q(view, name: str) -> str:
+    match = re.search(rf'data-q="{name}"[^>]*>([^<]*)<', _dashboard(view))
+    assert match, f"no {name} in the dashboard"
+    return match.group(1)
+
+
+def test_main_prints_one_line_with_the_real_port_and_moves_on_when_busy():
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        out = io.StringIO()
+        with redirect_stdout(out):
+            app = main(host="127.0.0.1", port=port, block=False)
+        try:
+            lines = out.getvalue().splitlines()
+            assert lines == [f"tpm-viz serving at http://127.0.0.1:{app.port}"]
+            assert app.port != port
+        finally:
+            app.stop()
+
+
+def test_loopback_detection_and_warning(monkeypatch):
+    assert is_loopback("127.0.0.1") and is_loopback("localhost") and is_loopback("::1")
+    assert not is_loopback("0.0.0.0") and not is_loopback("192.168.1.10")
+    import tpm_viz.ui.app as app_module
+
+    class Fake:
+        def __init__(self, server):
+            self.port = 1234
+
+    monkeypatch.setattr(app_module, "build_server", lambda host, port: None)
+    monkeypatch.setattr(app_module, "TpmApp", Fake)
+    err, out = io.StringIO(), io.StringIO()
+    with redirect_stderr(err), redirect_stdout(out):
+        main(host="0.0.0.0", port=8080, block=False)
+    assert "warning" in err.getvalue() and "0.0.0.0" in err.getvalue()
+    assert out.getvalue().count("\n") == 1
+
+
+def test_share_url_tunnel_is_disabled(app, connect):
+    client, view = connect()
+    assert app.server.request_share_url() is None
+    client.send(type="ShareUrlRequest")
+    client.set_value(view.panel.d[0], 150.0)  # a later message: the request above was handled by then
+    wait_for(lambda: abs(_state(view).pose.d[0] - 0.15) < 1e-9, what="d1 after the share request")
+    assert app.server._share_tunnel is None
+
+
+def test_first_render_shows_the_home_pose(connect):
+    _client, view = connect()
+    assert _q(view, "p1") == "0.0" and _q(view, "d1") == "130.0" and _q(view, "det_jx") == "1.0000"
+    np.testing.assert_allclose(view.scene.sliders[0].position, (-P.a + 0.13, 0.0, 0.0))
+    assert "nan" not in _dashboard(view).lower() and "inf" not in _dashboard(view).lower()
+
+
+def test_actuator_slider_drives_forward_kinematics(connect):
+    client, view = connect()
+    client.set_value(view.panel.d[0], 250.0)
+    wait_for(lambda: abs(_state(view).pose.d[0] - 0.25) < 1e-12, what="d1 = 250 mm")
+    p = forward_kinematics_both(P, (0.25, 0.13)).plus
+    np.testing.assert_allclose(_state(view).pose.p, p)
+    np.testing.assert_allclose(view.scene.sliders[0].position, (0.25 - P.a, 0.0, 0.0))
+    np.testing.assert_allclose(view.scene.platform.position[:2], p)
+    assert _q(view, "d1") == "250.0" and _q(view, "p1") == f"{p[0] * 1e3:.1f}"
+    assert view.panel.p.value == pytest.approx(tuple(np.round(p * 1e3, 2)))
+
+
+def test_actuator_slider_out_of_range_is_clamped_with_a_reason(connect):
+    client, view = connect()
+    client.set_value(view.panel.d[1], 7000.0)  # the browser does not range-check
+    wait_for(lambda: _state(view).note, what="a clamp note")
+    assert _state(view).pose.d[1] == pytest.approx(P.stroke)
+    assert "actuator 2" in _q(view, "banner") or "actuator 2" in _dashboard(view)
+    assert view.panel.d[1].value == pytest.approx(300.0)
+
+
+def test_gizmo_drag_moves_every_part_and_clamps_at_the_stroke(connect):
+    client, view = connect()
+    owner = str(view.client.client_id)
+    client.drag(view.scene.gizmo, owner, [(0.02, 0.01, 0.09)], end=False)
+    wait_for(lambda: abs(_state(view).pose.p[0] - 0.02) < 1e-12, what="the drag update")
+    np.testing.assert_allclose(_state(view).pose.d, inverse_kinematics(P, (0.02, 0.01)))
+    np.testing.assert_allclose(view.scene.platform.position[:2], (0.02, 0.01))
+    client.drag(view.scene.gizmo, owner, [(0.5, 0.0, 0.09)])
+    wait_for(lambda: np.allclose(view.scene.gizmo.position[:2], _state(view).pose.p), what="gizmo written back")
+    assert _state(view).pose.d[0] == pytest.approx(P.stroke, abs=1e-5)
+    assert "stopped" in _state(view).note
+
+
+def test_typed_platform_position(connect):
+    client, view = connect()
+    client.set_value(view.panel.p, (40.0, -30.0))
+    wait_for(lambda: np.allclose(_state(view).pose.p, (0.04, -0.03)), what="p = (40, -30) mm")
+    assert _q(view, "p2") == "-30.0"
+
+
+def test_parameters_apply_rebuilds_and_a_bad_value_is_refused_for_its_tab_only(connect):
+    client, view = connect()
+    _other_client, other = connect()
+    old_links = view.scene.links
+    client.set_value(view.panel.params["l_a"], 280.0)
+    client.set_value(view.panel.params["stroke"], 320.0)
+    wait_for(lambda: view.panel.params["stroke"].value == 320.0, what="the input value")
+    client.click(view.panel.apply)
+    wait_for(lambda: _state(view).params.l_a == pytest.approx(0.28), what="l_a = 280 mm")
+    assert _state(view).params.stroke == pytest.approx(0.32)
+    assert view.scene.links is not old_links  # geometry re-added once
+    assert view.panel.d[0].max == pytest.approx(320.0)
+    assert _state(other).params.l_a == pytest.approx(0.28)  # shared by default
+    assert other.panel.params["l_a"].value == pytest.approx(280.0)
+
+    good = _state(view)
+    client.set_value(view.panel.params["b"], -5.0)
+    wait_for(lambda: view.panel.params["b"].value == -5.0, what="the bad input")
+    client.click(view.panel.apply)
+    wait_for(lambda: "Refused" in view.panel.message.content, what="the refusal")
+    assert "b must be positive" in view.panel.message.content
+    assert other.panel.message.content == ""
+    assert _state(view) is good
+    assert view.panel.params["b"].value == pytest.approx(92.0)  # reverted to the last good value
+    client.set_value(view.panel.d[0], 200.0)  # the app keeps working
+    wait_for(lambda: abs(_state(view).pose.d[0] - 0.2) < 1e-12, what="d1 after a refusal")
+    assert view.panel.message.content == ""
+
+
+def test_paper_values_button(connect):
+    client, view = connect()
+    client.set_value(view.panel.params["m_p"], 5.0)
+    wait_for(lambda: view.panel.params["m_p"].value == 5.0, what="m_p input")
+    client.click(view.panel.apply)
+    wait_for(lambda: _state(view).params.m_p == 5.0, what="m_p = 5 kg")
+    client.click(view.panel.paper)
+    wait_for(lambda: _state(view).params == P, what="paper values")
+
+
+@pytest.mark.parametrize(
+    ("kind", "check"),
+    [
+        ("inverse", lambda v: COLORS["inverse"] in [tuple(c) for c in v.scene.links.batched_colors]),
+        ("direct", lambda v: tuple(v.scene.platform_body.color) == COLORS["direct"]),
+        ("stroke", lambda v: COLORS["stroke"] in [tuple(b.color) for b in v.scene.slider_bodies]),
+    ],
+)
+def test_demo_buttons_warn_and_recolour(connect, kind, check):
+    client, view = connect()
+    client.click(view.panel.demo[kind])
+    wait_for(lambda: kind in {a.kind for a in view.session.readout.alerts}, what=f"a {kind} alert")
+    assert f'data-level="{kind}"' in _dashboard(view) or kind == "stroke"
+    assert check(view)
+
+
+def test_switch_assembly_mode_and_the_ghost(connect):
+    client, view = connect()
+    client.set_value(view.panel.d[0], 200.0)
+    wait_for(lambda: abs(_state(view).pose.d[0] - 0.2) < 1e-12, what="d1")
+    client.set_value(view.panel.d[1], 250.0)
+    wait_for(lambda: abs(_state(view).pose.d[1] - 0.25) < 1e-12, what="d2")
+    ghost = np.array(view.scene.ghost.position[:2])
+    assert view.scene.ghost.visible
+    client.click(view.panel.switch_mode)
+    wait_for(lambda: view.session.readout.mode == -1, what="the other mode")
+    np.testing.assert_allclose(_state(view).pose.p, ghost)
+    assert "−" in _q(view, "mode")
+
+
+def test_static_and_dynamic_loads_show_forces_and_the_reference(connect):
+    client, view = connect()
+    client.set_value(view.panel.f_ext, (0.0, -20.0))
+    wait_for(lambda: _state(view).load.f_ext == (0.0, -20.0), what="f_ext")
+    assert _q(view, "tau2") == "20.00"  # at home J = I: τ = -f_ext
+    assert _q(view, "tau2_ref") == "20.00"
+    assert view.scene.forces[1].visible
+    client.set_value(view.panel.load_mode, "dynamic")
+    wait_for(lambda: _state(view).load.mode == "dynamic", what="dynamic mode")
+    client.set_value(view.panel.ddp, (10.0, 0.0))
+    wait_for(lambda: _state(view).load.ddp == (10.0, 0.0), what="ddp")
+    tau1 = float(_q(view, "tau1"))
+    assert tau1 > 0 and float(_q(view, "tau1_ref")) == pytest.approx(tau1, abs=0.01)
+    assert abs(float(_q(view, "tau1_diff"))) < 1e-6
+
+
+def test_trajectory_sample_drives_pose_and_motion(connect):
+    client, view = connect()
+    client.set_value(view.panel.trajectory, "line")
+    wait_for(lambda: _state(view).trajectory.kind == "line", what="line selected")
+    client.set_value(view.panel.time, 0.05)
+    wait_for(lambda: _state(view).trajectory.t == pytest.approx(0.05), what="t = 0.05 s")
+    p, _dp, ddp = line_state(0.05, 0.2)
+    np.testing.assert_allclose(_state(view).pose.p, p)
+    assert _state(view).load.mode == "dynamic"
+    np.testing.assert_allclose(_state(view).load.ddp, ddp)
+
+
+def test_view_toggles_are_per_tab(connect):
+    client, view = connect()
+    _other_client, other = connect()
+    client.set_value(view.panel.show_toggles["labels"], False)
+    wait_for(lambda: not view.scene.labels[0].visible, what="labels hidden")
+    assert other.scene.labels[0].visible
+
+
+def test_classroom_shared_then_own_copy_then_back(connect):
+    c1, v1 = connect()
+    c2, v2 = connect()
+    c1.set_value(v1.panel.d[0], 180.0)
+    wait_for(lambda: abs(_state(v2).pose.d[0] - 0.18) < 1e-12, what="shared change reaches tab 2")
+    np.testing.assert_allclose(v2.scene.sliders[0].position, v1.scene.sliders[0].position)
+    assert v2.panel.d[0].value == pytest.approx(180.0)
+
+    c2.set_value(v2.panel.own_copy, True)
+    wait_for(lambda: not v2.session.shared, what="own copy")
+    c2.set_value(v2.panel.d[0], 100.0)
+    wait_for(lambda: abs(_state(v2).pose.d[0] - 0.1) < 1e-12, what="private change")
+    assert _state(v1).pose.d[0] == pytest.approx(0.18)  # the shared mechanism did not move
+    c1.set_value(v1.panel.d[1], 200.0)
+    wait_for(lambda: abs(_state(v1).pose.d[1] - 0.2) < 1e-12, what="shared change")
+    assert _state(v2).pose.d[1] == pytest.approx(0.13)  # the private copy did not follow
+
+    c2.set_value(v2.panel.own_copy, False)
+    wait_for(lambda: v2.session.shared, what="back to shared")
+    assert _state(v2) is _state(v1)
+    assert v2.panel.d[1].value == pytest.approx(200.0)
+    assert "on the shared mechanism" in v1.panel.class_info.content
+
+
+def test_simultaneous_drags_are_serialised_and_never_corrupt_state(app, connect):
+    clients = [connect() for _ in range(3)]
+    errors: list[BaseException] = []
+
+    def drag(client, view, seed):
+        rng = np.random.default_rng(seed)
+        try:
+            owner = str(view.client.client_id)
+            points = [(*rng.uniform(-0.4, 0.4, 2), 0.09) for _ in range(40)]
+            client.drag(view.scene.gizmo, owner, points)
+        except BaseException as exc:  # pragma: no cover - reported below
+            errors.append(exc)
+
+    threads = [threading.Thread(target=drag, args=(c, v, k)) for k, (c, v) in enumerate(clients)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors
+    view = clients[0][1]
+    wait_for(
+        lambda: all(np.allclose(v.scene.gizmo.position[:2], _state(v).pose.p) for _, v in clients),
+        what="all gizmos settled",
+    )
+    state = _state(view)
+    from tpm_viz.interaction import OK, check
+
+    assert check(state.params, state.pose) == OK
+    np.testing.assert_allclose(state.pose.d, inverse_kinematics(P, state.pose.p))
+    for _, v in clients:
+        assert _state(v) is state
+        np.testing.assert_allclose(v.scene.platform.position[:2], state.pose.p)
+    assert "nan" not in _dashboard(view).lower()

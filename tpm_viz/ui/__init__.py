@@ -1,0 +1,9 @@
+"""The browser app (viser). The only package of tpm-viz that imports viser; nothing in the library imports it.
+
+- :mod:`.scene`: the 3D mechanism of one tab, handles built once, then moved;
+- :mod:`.panels`: the control panel of one tab, handles built once, then written;
+- :mod:`.text`: formatting of the readouts (HTML), no maths;
+- :mod:`.session`: shared state, private copies and the lock that serialises changes;
+- :mod:`.client`: one tab's callbacks (widget -> pure library function -> commit);
+- :mod:`.app`: the server and ``main(host, port)``.
+"""

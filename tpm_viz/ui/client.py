@@ -1,0 +1,253 @@
+"""One browser tab: its scene and panel, and the callbacks that turn its inputs into state changes.
+
+Every callback has the same shape: under the hub's lock, read the widget's *current* value, validate it, call a
+pure library function (:mod:`tpm_viz.interaction`, :mod:`tpm_viz.poses`, ``Params.replace``, trajectories),
+and commit the new state, which redraws every view of the session. Events that the server caused itself (a
+value written by :meth:`Panel.show`, which viser echoes synchronously with ``client=None``) are ignored.
+A refused input is reported to this tab only; the last good state stays.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+import viser
+
+from ..errors import TpmVizError
+from ..interaction import Move, drag_to, drive_to, place, switch_mode
+from ..params import PARAM_INFO, Params
+from ..poses import DEMO_KINDS, demo_pose, home_pose, settle
+from ..readouts import LOAD_MODES, Load, Readout
+from ..trajectories import circle_state, line_state
+from .panels import Panel
+from .scene import MechanismScene, camera_pose
+from .session import TRAJECTORY_KINDS, AppState, Hub, Session, TrajectorySample, read_number, read_vec2
+
+__all__ = ["ClientView"]
+
+MAX_FORCE = 1e5  # N, bound on typed forces
+MAX_SPEED = 100.0  # m/s
+MAX_ACCEL = 1e5  # m/s²
+
+
+def _callback(method):
+    """Run a handler under the hub's lock; ignore server-side echoes; report refused input to this tab."""
+
+    @functools.wraps(method)
+    def wrapper(self: ClientView, event, *args) -> None:
+        if getattr(event, "client", None) is None:
+            return
+        with self.hub.lock:
+            if self.closed:
+                return
+            try:
+                method(self, event, *args)
+            except TpmVizError as exc:
+                self.refuse(str(exc))
+
+    return wrapper
+
+
+class ClientView:
+    """The scene, panel and callbacks of one connected browser tab."""
+
+    def __init__(self, client: viser.ClientHandle, hub: Hub) -> None:
+        self.client = client
+        self.hub = hub
+        self.closed = False
+        self._last_drag: tuple[float, float] | None = None
+        with hub.lock:
+            state = hub.shared.state
+            self.scene = MechanismScene(client.scene, state.params)
+            self.panel = Panel(client.gui, state)
+            self._wire()
+            self.frame_camera(state.params)
+            self.session: Session = hub.join(self, private=False)
+
+    # -- drawing -------------------------------------------------------------------------------------------
+    def render(self, state: AppState, readout: Readout, *, dragging: bool = False) -> None:
+        """Draw ``state`` in this tab (called by the hub under its lock) and flush at once."""
+        if self.closed:
+            return
+        with self.client.atomic():
+            self.scene.update(state, readout, dragging=dragging)
+            self.panel.show(state, readout)
+        self.client.flush()
+
+    def refuse(self, text: str) -> None:
+        """Tell this tab (only) that its input was refused; the mechanism keeps its last good state."""
+        self.panel.tell(f"Refused: {text}")
+        self.client.add_notification("Input refused", text, color="red", auto_close_seconds=8.0)
+        self.client.flush()
+
+    def frame_camera(self, params: Params) -> None:
+        """Point this tab's camera at the whole mechanism."""
+        position, look_at = camera_pose(params)
+        self.client.camera.position = position
+        self.client.camera.look_at = look_at
+
+    def close(self) -> None:
+        """The tab went away: stop drawing and leave the session."""
+        with self.hub.lock:
+            self.closed = True
+            self.hub.leave(self, self.session)
+
+    def set_class_info(self, text: str) -> None:
+        """The classroom line of the *Class & view* tab."""
+        self.panel.class_info.content = text
+
+    # -- commits -------------------------------------------------------------------------------------------
+    def _commit(self, state: AppState, dragging: bool = False) -> None:
+        self.panel.tell("")
+        self.hub.commit(self.session, state, origin=self, dragging=dragging)
+
+    def _move(self, move: Move, **changes) -> None:
+        state = self.session.state
+        changes.setdefault("trajectory", TrajectorySample("none", state.trajectory.duration, 0.0))
+        self._commit(state.replace(pose=move.pose, note=move.reason, **changes))
+
+    # -- wiring --------------------------------------------------------------------------------------------
+    def _wire(self) -> None:
+        panel, scene = self.panel, self.scene
+        scene.gizmo.on_update(self._on_drag)
+        panel.p.on_update(self._on_p)
+        for i, slider in enumerate(panel.d):
+            slider.on_update(lambda event, i=i: self._on_d(event, i))
+        panel.switch_mode.on_click(self._on_switch_mode)
+        panel.home.on_click(self._on_home)
+        for kind in DEMO_KINDS:
+            panel.demo[kind].on_click(lambda event, kind=kind: self._on_demo(event, kind))
+        for handle in (panel.load_mode, panel.f_ext, panel.dp, panel.ddp):
+            handle.on_update(self._on_load)
+        for handle in (panel.trajectory, panel.duration, panel.time):
+            handle.on_update(self._on_trajectory)
+        panel.apply.on_click(self._on_apply)
+        panel.paper.on_click(self._on_paper)
+        panel.own_copy.on_update(self._on_own_copy)
+        for what, handle in panel.show_toggles.items():
+            handle.on_update(lambda event, what=what: self._on_show(event, what))
+        panel.frame_camera.on_click(self._on_frame)
+
+    @_callback
+    def _on_drag(self, event) -> None:
+        p_req = read_vec2(np.asarray(self.scene.gizmo.position)[:2], "platform position")
+        key = (float(p_req[0]), float(p_req[1]))
+        end = event.phase == "end"
+        if key == self._last_drag and not end:
+            return  # a late event carrying the value already applied (latest value wins)
+        self._last_drag = None if end else key
+        state = self.session.state
+        move = drag_to(state.params, state.pose, p_req)
+        self.panel.tell("")
+        self.hub.commit(
+            self.session,
+            state.replace(
+                pose=move.pose, note=move.reason, trajectory=TrajectorySample("none", state.trajectory.duration)
+            ),
+            origin=self,
+            dragging=not end,
+        )
+
+    @_callback
+    def _on_p(self, event) -> None:
+        p_req = read_vec2(self.panel.p.value, "platform position p", scale=1e-3, bound=10.0)
+        state = self.session.state
+        self._move(drag_to(state.params, state.pose, p_req))
+
+    @_callback
+    def _on_d(self, event, i: int) -> None:
+        state = self.session.state
+        d_req = np.array(state.pose.d, dtype=float)
+        d_req[i] = read_number(self.panel.d[i].value, f"d{i + 1}", scale=1e-3, lo=-10.0, hi=10.0)
+        self._move(drive_to(state.params, state.pose, d_req))
+
+    @_callback
+    def _on_switch_mode(self, event) -> None:
+        state = self.session.state
+        self._move(switch_mode(state.params, state.pose))
+
+    @_callback
+    def _on_home(self, event) -> None:
+        state = self.session.state
+        self._move(Move(home_pose(state.params)))
+
+    @_callback
+    def _on_demo(self, event, kind: str) -> None:
+        state = self.session.state
+        self._move(demo_pose(state.params, kind, near=state.pose.p))
+
+    @_callback
+    def _on_load(self, event) -> None:
+        panel = self.panel
+        mode = panel.load_mode.value if panel.load_mode.value in LOAD_MODES else "static"
+        load = Load(
+            mode=mode,
+            f_ext=tuple(read_vec2(panel.f_ext.value, "f_ext", bound=MAX_FORCE)),
+            dp=tuple(read_vec2(panel.dp.value, "platform velocity", bound=MAX_SPEED)),
+            ddp=tuple(read_vec2(panel.ddp.value, "platform acceleration", bound=MAX_ACCEL)),
+        )
+        state = self.session.state
+        if load != state.load:
+            self._commit(state.replace(load=load, note=""))
+
+    @_callback
+    def _on_trajectory(self, event) -> None:
+        panel = self.panel
+        kind = panel.trajectory.value if panel.trajectory.value in TRAJECTORY_KINDS else "none"
+        duration = read_number(panel.duration.value, "duration T", lo=0.01, hi=100.0)
+        t = read_number(panel.time.value, "time t", lo=0.0, hi=duration)
+        state = self.session.state
+        sample = TrajectorySample(kind, duration, t)
+        if kind == "none":
+            self._commit(state.replace(trajectory=sample, note=""))
+            return
+        p, dp, ddp = (line_state if kind == "line" else circle_state)(t, duration)
+        move = place(state.params, state.pose, p)
+        load = Load("dynamic", dp=tuple(dp), ddp=tuple(ddp)) if not move.clamped else state.load
+        self._commit(state.replace(pose=move.pose, load=load, trajectory=sample, note=move.reason))
+
+    @_callback
+    def _on_apply(self, event) -> None:
+        state = self.session.state
+        raw = self.panel.read_params()
+        try:
+            changes = {
+                name: read_number(value, name, scale=1.0 / PARAM_INFO[name]["ui_scale"]) for name, value in raw.items()
+            }
+            params = state.params.replace(**changes)
+            move = settle(params, state.pose)
+        except TpmVizError:
+            self.panel.show_params(state.params)  # revert the inputs to the last good mechanism
+            raise
+        self._commit(state.replace(params=params, pose=move.pose, note=move.reason))
+
+    @_callback
+    def _on_paper(self, event) -> None:
+        state = self.session.state
+        params = Params.paper()
+        move = settle(params, state.pose)
+        self._commit(state.replace(params=params, pose=move.pose, note=move.reason))
+
+    @_callback
+    def _on_own_copy(self, event) -> None:
+        private = bool(self.panel.own_copy.value)
+        if private == (not self.session.shared):
+            return
+        old = self.session
+        self.hub.leave(self, old)
+        self.session = self.hub.join(self, private=private, session=old)
+
+    def _on_show(self, event, what: str) -> None:
+        if getattr(event, "client", None) is None:
+            return
+        with self.hub.lock:
+            self.scene.set_visible(what, bool(self.panel.show_toggles[what].value))
+            if self.session.readout is not None:
+                self.render(self.session.state, self.session.readout)
+
+    def _on_frame(self, event) -> None:
+        if getattr(event, "client", None) is None:
+            return
+        self.frame_camera(self.session.state.params)
+        self.client.flush()

@@ -1,0 +1,131 @@
+"""The control panel of one browser tab: GUI handles built once, values written by :meth:`Panel.show`.
+
+No maths here: the numbers come from a :class:`~tpm_viz.readouts.Readout`, formatted by :mod:`.text`.
+Units in labels: mm, N, kg, s, degrees (SI inside; the scale factors come from ``PARAM_INFO``).
+"""
+
+from __future__ import annotations
+
+import viser
+
+from ..params import PARAM_INFO, Params
+from ..poses import DEMO_KINDS
+from ..readouts import LOAD_MODES, Readout
+from .session import TRAJECTORY_KINDS, AppState
+from .text import dashboard_html
+
+__all__ = ["PARAM_LABELS", "Panel"]
+
+PARAM_LABELS = {
+    "a": "a, total size (mm)",
+    "b": "b, platform offset (mm)",
+    "l_a": "l_a, link length (mm)",
+    "pivot_spacing": "pivot spacing (mm)",
+    "stroke": "stroke Δd (mm)",
+    "m_a": "m_a, slider (kg)",
+    "m_b": "m_b, links of a leg (kg)",
+    "m_p": "m_p, platform (kg)",
+}
+"""Panel label of each parameter, with its UI unit."""
+
+DEMO_LABELS = {
+    "inverse": "Near an inverse singularity",
+    "direct": "Near the direct singularity",
+    "stroke": "At a stroke end",
+}
+
+SHOW_LABELS = {
+    "labels": "Labels O, A_i, B_i, P",
+    "loci": "Singularity loci and stroke limits (floor)",
+    "circles": "Constraint circles and the other assembly mode",
+    "forces": "Force arrows",
+}
+
+
+def _ui(name: str, value_si: float) -> float:
+    return round(value_si * PARAM_INFO[name]["ui_scale"], 6)
+
+
+class Panel:
+    """GUI handles of one tab (``client.gui``); callbacks are attached by the client view."""
+
+    def __init__(self, gui: viser.GuiApi, state: AppState) -> None:
+        self._gui = gui
+        self._shown_params: Params | None = None
+        self._shown_load = None
+        self._shown_trajectory = None
+        stroke_mm = state.params.stroke * 1e3
+        self.dashboard = gui.add_html("")
+        self.message = gui.add_markdown("")
+        tabs = gui.add_tab_group()
+        with tabs.add_tab("Move", viser.Icon.ARROWS_MOVE):
+            self.p = gui.add_vector2("Platform p (mm)", (0.0, 0.0), step=0.1, hint="Or drag the gizmo in 3D")
+            self.d = [
+                gui.add_slider(f"Actuator d{i + 1} (mm)", 0.0, stroke_mm, 0.1, 0.0, hint="Forward kinematics")
+                for i in range(2)
+            ]
+            self.switch_mode = gui.add_button("Switch assembly mode", icon=viser.Icon.SWITCH_HORIZONTAL)
+            self.home = gui.add_button("Home (p = 0)", icon=viser.Icon.HOME)
+            self.demo = {k: gui.add_button(DEMO_LABELS[k], color="gray") for k in DEMO_KINDS}
+        with tabs.add_tab("Forces", viser.Icon.ARROW_BAR_RIGHT):
+            self.load_mode = gui.add_dropdown("Load", LOAD_MODES, initial_value="static")
+            self.f_ext = gui.add_vector2("External load on platform f_ext (N)", (0.0, 0.0), step=1.0)
+            self.dp = gui.add_vector2("Platform velocity ṗ (m/s)", (0.0, 0.0), step=0.01)
+            self.ddp = gui.add_vector2("Platform acceleration p̈ (m/s²)", (0.0, 0.0), step=0.1)
+            self.trajectory = gui.add_dropdown("Trajectory sample (Figs. 4-5)", TRAJECTORY_KINDS, initial_value="none")
+            self.duration = gui.add_number("Duration T (s)", 0.2, min=0.01, max=100.0, step=0.01)
+            self.time = gui.add_slider("Time t (s)", 0.0, 0.2, 0.001, 0.0)
+        with tabs.add_tab("Parameters", viser.Icon.ADJUSTMENTS):
+            self.params = {
+                name: gui.add_number(PARAM_LABELS[name], _ui(name, getattr(state.params, name)), step=0.01)
+                for name in PARAM_LABELS
+            }
+            self.apply = gui.add_button("Apply parameters", icon=viser.Icon.CHECK)
+            self.paper = gui.add_button("Paper values (Tables 1-2)", color="gray")
+        with tabs.add_tab("Class & view", viser.Icon.USERS):
+            self.own_copy = gui.add_checkbox(
+                "Work on my own copy", False, hint="Off: everyone shares the lecturer's mechanism"
+            )
+            self.class_info = gui.add_markdown("")
+            self.show_toggles = {k: gui.add_checkbox(label, True) for k, label in SHOW_LABELS.items()}
+            self.frame_camera = gui.add_button("Frame the mechanism", icon=viser.Icon.FOCUS_CENTERED)
+
+    def show(self, state: AppState, readout: Readout) -> None:
+        """Write every value of ``state`` and ``readout`` into the widgets (viser skips unchanged ones)."""
+        self.dashboard.content = dashboard_html(state, readout)
+        self.p.value = (round(float(readout.p[0]) * 1e3, 2), round(float(readout.p[1]) * 1e3, 2))
+        stroke_mm = state.params.stroke * 1e3
+        for i, slider in enumerate(self.d):
+            if slider.max != stroke_mm:
+                slider.max = stroke_mm
+            slider.value = min(max(round(float(readout.d[i]) * 1e3, 2), 0.0), stroke_mm)
+        if state.load != self._shown_load:
+            self._shown_load = load = state.load
+            self.load_mode.value = load.mode
+            self.f_ext.value = load.f_ext
+            self.dp.value = tuple(round(v, 6) for v in load.dp)
+            self.ddp.value = tuple(round(v, 6) for v in load.ddp)
+        if state.trajectory != self._shown_trajectory:
+            self._shown_trajectory = traj = state.trajectory
+            self.trajectory.value = traj.kind
+            self.duration.value = traj.duration
+            if self.time.max != traj.duration:
+                self.time.max = traj.duration
+                self.time.step = traj.duration / 200.0
+            self.time.value = min(traj.t, traj.duration)
+        if state.params != self._shown_params:
+            self.show_params(state.params)
+
+    def show_params(self, params: Params) -> None:
+        """Write the parameter inputs (also to revert a refused edit)."""
+        self._shown_params = params
+        for name, handle in self.params.items():
+            handle.value = _ui(name, getattr(params, name))
+
+    def read_params(self) -> dict[str, object]:
+        """The raw values of the parameter inputs, in UI units (validated by the caller)."""
+        return {name: handle.value for name, handle in self.params.items()}
+
+    def tell(self, text: str) -> None:
+        """Show a message to this tab only (empty text clears it)."""
+        self.message.content = f"**{text}**" if text else ""

@@ -1,0 +1,309 @@
+"""The 3D mechanism of one browser tab: scene handles built once, then only moved and recoloured.
+
+:class:`MechanismScene` adds every node when it is created and re-adds geometry only in :meth:`rebuild` (a
+parameter change). :meth:`update` assigns poses and props, and only those that changed since the last call, so
+a drag sends a handful of small messages. Sliders and the platform are frames: their pins, labels, constraint
+circles and force arrows are children and follow without messages of their own.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import viser
+
+from .. import meshes
+from ..kinematics import mechanism_pose
+from ..params import Params
+from ..readouts import Readout
+from ..workspace import direct_singularity_locus, inverse_singularity_loci, stroke_limit_loci
+from .session import AppState
+
+__all__ = ["COLORS", "FORCE_SCALE", "MechanismScene"]
+
+COLORS = {
+    "base": (226, 232, 240),
+    "rail": (148, 163, 184),
+    "stop": (71, 85, 105),
+    "slider": (51, 65, 85),
+    "leg1": (13, 148, 136),
+    "leg2": (109, 40, 217),
+    "pin": (30, 41, 59),
+    "platform": (100, 116, 139),
+    "marker": (250, 204, 21),
+    "inverse": (245, 158, 11),
+    "direct": (220, 38, 38),
+    "stroke": (219, 39, 119),
+    "tau_pos": (22, 163, 74),
+    "tau_neg": (220, 38, 38),
+    "load": (71, 85, 105),
+    "circle": (59, 130, 246),
+    "locus_direct": (220, 38, 38),
+    "locus_inverse": (245, 158, 11),
+    "locus_stroke": (219, 39, 119),
+}
+"""RGB colours of the parts, the warning colours (inverse, direct, stroke) and the force arrows."""
+
+FORCE_SCALE = 1e-3
+"""Length of a force arrow per newton [m/N] (1 mm per N), clipped at :data:`FORCE_MAX`."""
+FORCE_MAX = 0.3  # m
+ARROW_Z = meshes.SLIDER_Z[1] + 0.012  # m
+LOCI_Z = 0.0008  # m
+GIZMO_Z = meshes.PLATFORM_Z[1] + 0.02  # m
+
+
+def _mesh(scene: viser.SceneApi, name: str, mesh, color, **kwargs):
+    return scene.add_mesh_simple(
+        name,
+        mesh.vertices,
+        mesh.faces,
+        color=color,
+        flat_shading=True,
+        cast_shadow=False,
+        receive_shadow=False,
+        **kwargs,
+    )
+
+
+class MechanismScene:
+    """Scene nodes of one mechanism in one scene API (a client's ``client.scene``)."""
+
+    def __init__(self, scene: viser.SceneApi, params: Params) -> None:
+        self._scene = scene
+        self._sent: dict[str, object] = {}
+        self.params: Params | None = None
+        self.show = {"labels": True, "loci": True, "circles": True, "forces": True}
+        self.slider_bodies: list = [None, None]
+        self.circles: list = [None, None]
+        self.loci: list = []
+        add_frame = scene.add_frame
+        self.sliders = [add_frame(f"/tpm/slider{i + 1}", show_axes=False) for i in range(2)]
+        self.platform = add_frame("/tpm/platform", show_axes=False)
+        self.ghost = add_frame("/tpm/ghost", show_axes=False)
+        self.labels = [scene.add_label("/tpm/label_O", "O", position=(0.0, 0.0, 0.002), anchor="top-left")]
+        for i in range(2):
+            self.labels.append(scene.add_label(f"/tpm/slider{i + 1}/label", f"A{'₁₂'[i]}", anchor="bottom-right"))
+            self.labels.append(scene.add_label(f"/tpm/platform/label_B{i + 1}", f"B{'₁₂'[i]}", anchor="bottom-right"))
+        self.label_p = scene.add_label("/tpm/platform/label_P", "P", anchor="bottom-left")
+        self.labels.append(self.label_p)
+        self.ghost_label = scene.add_label("/tpm/ghost/label", "P′ (other assembly mode)", anchor="center-center")
+        self.labels.append(self.ghost_label)
+        self.forces = [
+            scene.add_arrows(
+                f"/tpm/slider{i + 1}/force",
+                np.zeros((1, 2, 3)),
+                COLORS["tau_pos"],
+                shaft_radius=0.005,
+                head_radius=0.013,
+                head_length=0.025,
+                visible=False,
+            )
+            for i in range(2)
+        ]
+        self.load_arrow = scene.add_arrows(
+            "/tpm/platform/load",
+            np.zeros((1, 2, 3)),
+            COLORS["load"],
+            shaft_radius=0.004,
+            head_radius=0.011,
+            head_length=0.022,
+            visible=False,
+        )
+        self.gizmo = scene.add_transform_controls(
+            "/gizmo",
+            scale=0.16,
+            active_axes=(True, True, False),
+            disable_rotations=True,
+            depth_test=False,
+            position=(0.0, 0.0, GIZMO_Z),
+        )
+        self.rebuild(params)
+
+    def rebuild(self, params: Params) -> None:
+        """(Re)add every node whose geometry depends on the parameters."""
+        s = self._scene
+        self.params = params
+        self._sent.clear()
+        lo, hi = meshes.base_extent(params)
+        _mesh(s, "/tpm/base", meshes.base_plate(params), COLORS["base"])
+        size = hi - lo
+        s.add_grid(
+            "/tpm/grid",
+            size,
+            size,
+            plane="xy",
+            cell_size=0.02,
+            section_size=0.1,
+            cell_color=(203, 213, 225),
+            section_color=(148, 163, 184),
+            position=((lo + hi) / 2, (lo + hi) / 2, 0.0005),
+            shadow_opacity=0.0,
+        )
+        for i in range(2):
+            _mesh(s, f"/tpm/rail{i + 1}", meshes.rail(params, i), COLORS["rail"])
+            _mesh(s, f"/tpm/stops{i + 1}", meshes.end_stops(params, i), COLORS["stop"])
+            self.slider_bodies[i] = _mesh(s, f"/tpm/slider{i + 1}/body", meshes.slider(params, i), COLORS["slider"])
+            offsets = meshes.slider_pin_offsets(params, i)
+            self._pins(f"/tpm/slider{i + 1}/pins", offsets)
+            centre = np.zeros(3)
+            centre[i] = params.b  # C_i = A_i + b e_i
+            self.circles[i] = s.add_line_segments(
+                f"/tpm/slider{i + 1}/circle",
+                meshes.circle_segments(params.l_a, LOCI_Z + 0.001) + centre,
+                COLORS["circle"],
+                thickness=2.0,
+                thickness_units="screen",
+                visible=self.show["circles"],
+            )
+            self.labels[1 + 2 * i].position = (0.0, 0.0, meshes.SLIDER_Z[1])
+            b_label = meshes.platform_pin_offsets(params)[2 * i] + (0.0, 0.0, meshes.PLATFORM_Z[1])
+            self.labels[2 + 2 * i].position = tuple(b_label)
+        link = meshes.link(params)
+        self.links = s.add_batched_meshes_simple(
+            "/tpm/links",
+            link.vertices,
+            link.faces,
+            batched_wxyzs=np.tile([1.0, 0.0, 0.0, 0.0], (4, 1)),
+            batched_positions=np.zeros((4, 3)),
+            batched_colors=self._leg_colors((False, False)),
+            flat_shading=True,
+            cast_shadow=False,
+            receive_shadow=False,
+        )
+        self.platform_body = _mesh(s, "/tpm/platform/body", meshes.platform(params), COLORS["platform"])
+        _mesh(s, "/tpm/platform/marker", meshes.tool_marker(), COLORS["marker"])
+        self._pins("/tpm/platform/pins", meshes.platform_pin_offsets(params))
+        self.label_p.position = (0.0, 0.0, meshes.PLATFORM_Z[1] + 0.01)
+        _mesh(s, "/tpm/ghost/body", meshes.platform(params), COLORS["circle"], opacity=0.22)
+        self.ghost_label.position = (0.0, 0.0, meshes.PLATFORM_Z[1])
+        self._loci(params)
+
+    def _pins(self, name: str, offsets: np.ndarray) -> None:
+        pin = meshes.pin()
+        self._scene.add_batched_meshes_simple(
+            name,
+            pin.vertices,
+            pin.faces,
+            batched_wxyzs=np.tile([1.0, 0.0, 0.0, 0.0], (len(offsets), 1)),
+            batched_positions=offsets,
+            batched_colors=COLORS["pin"],
+            cast_shadow=False,
+            receive_shadow=False,
+        )
+
+    def _loci(self, params: Params) -> None:
+        s = self._scene
+        sets = {
+            "direct": direct_singularity_locus(params),
+            "inverse": inverse_singularity_loci(params),
+            "stroke": stroke_limit_loci(params),
+        }
+        self.loci = []
+        for kind, curves in sets.items():
+            segs = meshes.polyline_segments(curves, LOCI_Z)
+            if len(segs) == 0:
+                continue
+            self.loci.append(
+                s.add_line_segments(
+                    f"/tpm/loci/{kind}",
+                    segs,
+                    COLORS[f"locus_{kind}"],
+                    thickness=2.5,
+                    thickness_units="screen",
+                    visible=self.show["loci"],
+                )
+            )
+
+    @staticmethod
+    def _leg_colors(near_inverse) -> np.ndarray:
+        legs = [COLORS["inverse"] if near_inverse[i] else COLORS[f"leg{i + 1}"] for i in range(2)]
+        return np.array([legs[0], legs[0], legs[1], legs[1]], dtype=np.uint8)
+
+    def _set(self, key: str, handle, attr: str, value) -> None:
+        """Assign ``handle.attr = value`` unless that exact value was the last one sent."""
+        last = self._sent.get(key)
+        if last is not None and np.array_equal(np.asarray(last), np.asarray(value)):
+            return
+        setattr(handle, attr, value)
+        self._sent[key] = value
+
+    def set_visible(self, what: str, visible: bool) -> None:
+        """Show or hide a family of nodes: ``labels``, ``loci``, ``circles`` or ``forces``."""
+        self.show[what] = bool(visible)
+        if what == "labels":
+            for label in self.labels:
+                label.visible = visible
+        elif what == "loci":
+            for locus in self.loci:
+                locus.visible = visible
+        elif what == "circles":
+            for circle in self.circles:
+                circle.visible = visible
+        for key in [k for k in self._sent if k.endswith("_vis") or k.startswith("force_vis")]:
+            del self._sent[key]  # re-evaluated at the next update
+
+    def update(self, state: AppState, readout: Readout, dragging: bool = False) -> None:
+        """Move every part to ``readout``'s pose and recolour it from its alerts."""
+        params = state.params
+        if params != self.params:
+            self.rebuild(params)
+        mp = mechanism_pose(params, readout.p, readout.d)
+        for i in range(2):
+            a = np.array([mp.A[i, 0], mp.A[i, 1], 0.0])
+            self._set(f"slider{i}", self.sliders[i], "position", a)
+            color = COLORS["stroke"] if readout.stroke_end[i] else COLORS["slider"]
+            self._set(f"slider_color{i}", self.slider_bodies[i], "color", color)
+        p3 = np.array([readout.p[0], readout.p[1], 0.0])
+        self._set("platform", self.platform, "position", p3)
+        self._set(
+            "platform_color",
+            self.platform_body,
+            "color",
+            COLORS["direct"] if readout.near_direct else COLORS["platform"],
+        )
+        positions, wxyzs = meshes.link_instances(mp)
+        self._set("links_pos", self.links, "batched_positions", positions.astype(np.float32))
+        self._set("links_rot", self.links, "batched_wxyzs", wxyzs.astype(np.float32))
+        self._set("links_color", self.links, "batched_colors", self._leg_colors(readout.near_inverse))
+        ghost_visible = self.show["circles"] and readout.other_p is not None
+        if readout.other_p is not None:
+            self._set("ghost", self.ghost, "position", np.array([readout.other_p[0], readout.other_p[1], 0.0]))
+        self._set("ghost_vis", self.ghost, "visible", ghost_visible)
+        self._update_forces(state, readout)
+        if not dragging:
+            self._set("gizmo", self.gizmo, "position", np.array([readout.p[0], readout.p[1], GIZMO_Z]))
+        else:
+            self._sent.pop("gizmo", None)
+
+    def _update_forces(self, state: AppState, readout: Readout) -> None:
+        tau = readout.forces.tau
+        for i in range(2):
+            value = None if tau is None else float(tau[i])
+            visible = self.show["forces"] and value is not None and abs(value) * FORCE_SCALE > 1e-3
+            self._set(f"force_vis{i}", self.forces[i], "visible", visible)
+            if not visible:
+                continue
+            length = min(abs(value) * FORCE_SCALE, FORCE_MAX) * np.sign(value)
+            tip = np.zeros(3)
+            tip[i] = length
+            pts = np.array([[[0.0, 0.0, ARROW_Z], [tip[0], tip[1], ARROW_Z]]], dtype=np.float32)
+            self._set(f"force{i}", self.forces[i], "points", pts)
+            color = np.array([COLORS["tau_pos"] if value >= 0 else COLORS["tau_neg"]], dtype=np.uint8)
+            self._set(f"force_color{i}", self.forces[i], "colors", color)
+        f = np.array(state.load.f_ext) if state.load.mode == "static" else np.zeros(2)
+        norm = float(np.linalg.norm(f))
+        visible = self.show["forces"] and norm * FORCE_SCALE > 1e-3
+        self._set("load_vis", self.load_arrow, "visible", visible)
+        if visible:
+            vec = f / norm * min(norm * FORCE_SCALE, FORCE_MAX)
+            z = meshes.PLATFORM_Z[1] + 0.006
+            pts = np.array([[[0.0, 0.0, z], [vec[0], vec[1], z]]], dtype=np.float32)
+            self._set("load", self.load_arrow, "points", pts)
+
+
+def camera_pose(params: Params) -> tuple[np.ndarray, np.ndarray]:
+    """Camera position and look-at point [m] that frame the base plate from the front, above."""
+    lo, hi = meshes.base_extent(params)
+    size = hi - lo
+    centre = np.array([(lo + hi) / 2, (lo + hi) / 2, 0.0])
+    look_at = centre + np.array([0.14, 0.04, 0.0]) * size
+    return look_at + np.array([0.0, -0.62, 0.82]) * size, look_at

@@ -1,0 +1,161 @@
+"""Classroom state: one shared mechanism, private copies, one lock that serialises every change.
+
+No viser here. A :class:`Session` holds one :class:`AppState` and the views (browser tabs) that show it; the
+:class:`Hub` owns the shared session, hands out private copies, and runs every change under a single re-entrant
+lock, so callbacks that arrive concurrently from viser's thread pool apply one after the other. Callbacks read
+the *current* value of their widget inside the lock, so an older event that runs late applies the latest value
+(latest value wins) instead of undoing a newer one.
+
+Incoming widget values are untrusted (the browser does not range-check them): :func:`read_vec2` and
+:func:`read_number` validate them and raise :class:`~tpm_viz.InputError` with a one-line message.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from ..errors import InputError
+from ..interaction import Pose
+from ..params import Params
+from ..poses import home_pose
+from ..readouts import Load, Readout, Reference, evaluate
+
+__all__ = ["TRAJECTORY_KINDS", "AppState", "Hub", "Session", "View", "read_number", "read_vec2"]
+
+TRAJECTORY_KINDS = ("none", "line", "circle")
+"""Trajectory sample that drives the platform: none, the paper's line (Fig. 4) or circle (Fig. 5)."""
+
+
+@dataclass(frozen=True)
+class TrajectorySample:
+    """Which trajectory sample drives the platform: ``kind``, duration ``T`` [s] and time ``t`` [s]."""
+
+    kind: str = "none"
+    duration: float = 0.2
+    t: float = 0.0
+
+
+@dataclass(frozen=True)
+class AppState:
+    """Everything a view draws (SI units). Replaced, never mutated."""
+
+    params: Params
+    pose: Pose
+    load: Load = field(default_factory=Load)
+    trajectory: TrajectorySample = field(default_factory=TrajectorySample)
+    note: str = ""
+    """Why the last move stopped short (shown to every viewer of the session), or empty."""
+    version: int = 0
+
+    @classmethod
+    def initial(cls, params: Params | None = None) -> AppState:
+        """The paper's prototype at its home pose (``p = 0``), static mode, no load."""
+        params = Params.paper() if params is None else params
+        return cls(params=params, pose=home_pose(params))
+
+    def replace(self, **changes) -> AppState:
+        """A copy with some fields changed and the version bumped."""
+        return dataclasses.replace(self, version=self.version + 1, **changes)
+
+
+class View(Protocol):
+    """What a session needs from a browser tab."""
+
+    def render(self, state: AppState, readout: Readout, *, dragging: bool) -> None:
+        """Draw ``state``; ``dragging`` is True while this tab's own gizmo is being dragged."""
+
+
+class Session:
+    """One mechanism state and the views that show it (mutated only under the hub's lock)."""
+
+    def __init__(self, state: AppState, shared: bool) -> None:
+        self.state = state
+        self.shared = shared
+        self.views: list[View] = []
+        self.readout: Readout | None = None
+
+
+class Hub:
+    """The shared session and the private copies; :meth:`commit` is the only way state changes."""
+
+    def __init__(self, state: AppState, reference: Reference | None = None) -> None:
+        self.lock = threading.RLock()
+        self.shared = Session(state, shared=True)
+        self.reference = reference
+        self.on_membership: Callable[[], None] | None = None
+
+    def evaluate(self, state: AppState) -> Readout:
+        """All displayed numbers for ``state`` (closed form and reference forces)."""
+        return evaluate(state.params, state.pose, state.load, self.reference)
+
+    def join(self, view: View, private: bool, session: Session | None = None) -> Session:
+        """Attach ``view`` to the shared session, or to a new private copy of ``session``'s state; draws it."""
+        with self.lock:
+            source = session if session is not None else self.shared
+            target = Session(source.state, shared=False) if private else self.shared
+            target.views.append(view)
+            self._draw(target, [view], origin=None, dragging=False)
+        self._membership_changed()
+        return target
+
+    def leave(self, view: View, session: Session) -> None:
+        """Detach ``view`` from ``session`` (a tab closed or switched)."""
+        with self.lock:
+            if view in session.views:
+                session.views.remove(view)
+        self._membership_changed()
+
+    def commit(self, session: Session, state: AppState, origin: View | None = None, dragging: bool = False) -> None:
+        """Make ``state`` current in ``session`` and draw it in every view, ``origin`` first."""
+        with self.lock:
+            session.state = state
+            session.readout = None
+            self._draw(session, list(session.views), origin, dragging)
+
+    def _draw(self, session: Session, views: list[View], origin: View | None, dragging: bool) -> None:
+        if session.readout is None:
+            session.readout = self.evaluate(session.state)
+        if origin in views:
+            views.remove(origin)
+            views.insert(0, origin)
+        for view in views:
+            view.render(session.state, session.readout, dragging=dragging and view is origin)
+
+    def shared_viewers(self) -> int:
+        """How many tabs show the shared mechanism."""
+        return len(self.shared.views)
+
+    def _membership_changed(self) -> None:
+        if self.on_membership is not None:
+            self.on_membership()
+
+
+def read_number(value, name: str, scale: float = 1.0, lo: float = -math.inf, hi: float = math.inf) -> float:
+    """A finite number from a widget, times ``scale`` (UI unit -> SI), clipped to ``[lo, hi]`` (SI)."""
+    if isinstance(value, bool):
+        raise InputError(f"{name} must be a number, got {value!r}")
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(x):
+        raise InputError(f"{name} must be finite, got {value!r}")
+    return float(np.clip(x * scale, lo, hi))
+
+
+def read_vec2(value, name: str, scale: float = 1.0, bound: float = math.inf) -> np.ndarray:
+    """Two finite numbers from a widget, times ``scale`` (UI unit -> SI), each clipped to ``[-bound, bound]``."""
+    try:
+        items = list(value)
+    except TypeError:
+        raise InputError(f"{name} must be two numbers, got {value!r}") from None
+    if len(items) != 2:
+        raise InputError(f"{name} must be two numbers, got {value!r}")
+    return np.array([read_number(v, name, scale, -bound, bound) for v in items])

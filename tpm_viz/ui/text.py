@@ -1,0 +1,157 @@
+"""Text and HTML of the panel, from a :class:`~tpm_viz.readouts.Readout`: formatting only, no maths.
+
+UI units: mm, N, degrees (the readout is in SI). Every number goes through :func:`num`, which prints a dash for
+``None``, NaN or infinity, so that no ``nan`` or ``inf`` ever reaches the page. Values carry ``data-q`` attributes
+(used by the browser tests) and every label names its unit.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+
+import numpy as np
+
+from ..readouts import Readout
+from .session import AppState
+
+__all__ = ["COLORS_CSS", "banner_level", "dashboard_html", "force_scale", "num"]
+
+DASH = "—"
+
+COLORS_CSS = {
+    "ok": ("#ecfdf5", "#065f46", "#10b981"),
+    "stroke": ("#fdf2f8", "#9d174d", "#db2777"),
+    "inverse": ("#fffbeb", "#92400e", "#f59e0b"),
+    "direct": ("#fef2f2", "#991b1b", "#dc2626"),
+}
+"""Banner background, text and border colours per level."""
+
+TAU_POS, TAU_NEG = "#16a34a", "#dc2626"
+
+
+def num(x, fmt: str = ".1f", scale: float = 1.0) -> str:
+    """``x * scale`` formatted with ``fmt``; a dash for None, NaN or infinity."""
+    if x is None:
+        return DASH
+    try:
+        v = float(x) * scale
+    except (TypeError, ValueError):
+        return DASH
+    if not math.isfinite(v):
+        return DASH
+    text = format(v, fmt)
+    return text[1:] if text.startswith("-") and float(text) == 0.0 else text  # no "-0.0"
+
+
+def banner_level(readout: Readout) -> str:
+    """The most severe alert kind (``"direct"`` > ``"inverse"`` > ``"stroke"``), or ``"ok"``."""
+    kinds = {a.kind for a in readout.alerts}
+    for kind in ("direct", "inverse", "stroke"):
+        if kind in kinds:
+            return kind
+    return "ok"
+
+
+def force_scale(values) -> float:
+    """Full scale [N] of the force bars: the next of 1-2-5 x 10^k at or above the largest ``|τ|`` (min 10 N)."""
+    finite = [abs(float(v)) for v in values if v is not None and math.isfinite(float(v))]
+    top = max([10.0, *finite])
+    k = 10 ** math.floor(math.log10(top))
+    for m in (1, 2, 5, 10):
+        if m * k >= top:
+            return float(m * k)
+    return float(10 * k)  # pragma: no cover
+
+
+def _q(name: str, text: str) -> str:
+    return f'<span data-q="{name}">{html.escape(text)}</span>'
+
+
+def _banner(state: AppState, readout: Readout) -> str:
+    level = banner_level(readout)
+    bg, fg, border = COLORS_CSS[level]
+    lines = [html.escape(a.text) for a in readout.alerts] or ["Regular pose: clear of singularities and stroke ends"]
+    note = f'<div style="margin-top:3px;font-style:italic">{html.escape(state.note)}</div>' if state.note else ""
+    return (
+        f'<div data-q="banner" data-level="{level}" style="background:{bg};color:{fg};border-left:4px solid {border};'
+        f'padding:6px 8px;border-radius:4px;font-size:0.85em;line-height:1.35">'
+        f"<b>{'<br>'.join(lines)}</b>{note}</div>"
+    )
+
+
+def _row(label: str, values: str, unit: str) -> str:
+    return (
+        f'<tr><td style="padding:1px 6px 1px 0;color:#475569">{label}</td>'
+        f'<td style="padding:1px 4px;text-align:right;font-variant-numeric:tabular-nums">{values}</td>'
+        f'<td style="padding:1px 0;color:#64748b">{unit}</td></tr>'
+    )
+
+
+def _kinematics(readout: Readout) -> str:
+    p, d, th = readout.p, readout.d, np.degrees(readout.theta)
+    mode = "+ (det J_x > 0)" if readout.mode > 0 else "− (det J_x < 0)"
+    rows = [
+        _row("platform p", f"({_q('p1', num(p[0], '.1f', 1e3))}, {_q('p2', num(p[1], '.1f', 1e3))})", "mm"),
+        _row("actuators d₁, d₂", f"{_q('d1', num(d[0], '.1f', 1e3))}, {_q('d2', num(d[1], '.1f', 1e3))}", "mm"),
+        _row("leg angles θ₁, θ₂", f"{_q('theta1', num(th[0], '.2f'))}, {_q('theta2', num(th[1], '.2f'))}", "deg"),
+        _row("det J_x = cos(θ₁+θ₂)", _q("det_jx", num(readout.det_jx, ".4f")), "eq. 12"),
+        _row("det J_q = cos θ₁ cos θ₂", _q("det_jq", num(readout.det_jq, ".4f")), "eq. 11"),
+        _row("condition number of J", _q("cond", num(readout.cond, ".2f")), "eq. 10"),
+        _row("assembly mode", _q("mode", mode), ""),
+    ]
+    return f'<table style="font-size:0.85em;border-collapse:collapse;margin-top:6px">{"".join(rows)}</table>'
+
+
+def _bar(value, scale: float) -> str:
+    if value is None or not math.isfinite(float(value)):
+        return '<div style="height:10px"></div>'
+    frac = min(abs(float(value)) / scale, 1.0) * 50.0
+    left = 50.0 if value >= 0 else 50.0 - frac
+    color = TAU_POS if value >= 0 else TAU_NEG
+    return (
+        '<div style="position:relative;height:10px;background:#f1f5f9;border-radius:2px">'
+        '<div style="position:absolute;left:50%;top:0;bottom:0;width:1px;background:#94a3b8"></div>'
+        f'<div style="position:absolute;left:{left:.2f}%;width:{frac:.2f}%;top:1px;bottom:1px;'
+        f'background:{color};border-radius:2px"></div></div>'
+    )
+
+
+def _forces(state: AppState, readout: Readout) -> str:
+    f = readout.forces
+    load = state.load
+    if load.mode == "static":
+        head = (
+            f"Static: external load on platform f_ext = ({num(load.f_ext[0], '.1f')}, {num(load.f_ext[1], '.1f')}) N; "
+            f"{html.escape(f.equation)}"
+        )
+    else:
+        head = (
+            f"Dynamic: ṗ = ({num(load.dp[0], '.3f')}, {num(load.dp[1], '.3f')}) m/s, "
+            f"p̈ = ({num(load.ddp[0], '.2f')}, {num(load.ddp[1], '.2f')}) m/s²; {html.escape(f.equation)}"
+        )
+    tau = [None, None] if f.tau is None else list(f.tau)
+    ref = [None, None] if f.tau_ref is None else list(f.tau_ref)
+    diff = [None, None] if f.diff is None else list(f.diff)
+    scale = force_scale(tau + ref)
+    rows = []
+    for i in range(2):
+        rows.append(
+            f'<div style="display:grid;grid-template-columns:1.6em 1fr 4.6em;gap:4px;align-items:center">'
+            f"<b>τ{'₁₂'[i]}</b>{_bar(tau[i], scale)}"
+            f'<span style="text-align:right">{_q(f"tau{i + 1}", num(tau[i], ".2f"))} N</span></div>'
+            f'<div style="font-size:0.9em;color:#475569;margin:0 0 3px 1.9em">Pinocchio '
+            f"{_q(f'tau{i + 1}_ref', num(ref[i], '.2f'))} N, difference "
+            f"{_q(f'tau{i + 1}_diff', num(diff[i], '.1e'))} N</div>"
+        )
+    note = f'<div style="color:#92400e">{html.escape(f.note)}</div>' if f.note else ""
+    return (
+        f'<div style="font-size:0.85em;margin-top:6px"><div style="color:#334155;margin-bottom:3px">'
+        f"<b>Actuator forces</b> (paper's closed form; bars full scale ±{num(scale, '.0f')} N)<br>{head}</div>"
+        f"{''.join(rows)}{note}</div>"
+    )
+
+
+def dashboard_html(state: AppState, readout: Readout) -> str:
+    """The always-visible top of the panel: banner, kinematic readouts, force bars."""
+    return f"<div>{_banner(state, readout)}{_kinematics(readout)}{_forces(state, readout)}</div>"
