@@ -47,6 +47,12 @@ def as_xy(x, name: str = "p") -> np.ndarray:
     return arr
 
 
+def _mm(x: float) -> str:
+    """A length [m] as millimetres for a message (no overflow warning for absurd values)."""
+    mm = float(x) * 1e3  # Python floats overflow to inf silently
+    return f"{mm:.1f}" if abs(mm) < 1e9 else f"{mm:.3g}"
+
+
 def finite_result(arr: np.ndarray, what: str) -> np.ndarray:
     """``arr`` unchanged if every entry is finite; otherwise an :class:`InputError` (overflow)."""
     if not np.all(np.isfinite(arr)):
@@ -85,7 +91,7 @@ def inverse_kinematics(params: Params, p) -> np.ndarray:
     if not np.all(ok):
         bad = p[~ok][0] if p.ndim > 1 else p
         raise UnreachablePoseError(
-            f"platform position ({bad[0] * 1e3:.1f}, {bad[1] * 1e3:.1f}) mm is unreachable: "
+            f"platform position ({_mm(bad[0])}, {_mm(bad[1])}) mm is unreachable: "
             f"each |p_j| must be below l_a = {params.l_a * 1e3:.1f} mm"
         )
     return _ik_unchecked(params, p)
@@ -132,6 +138,11 @@ def forward_kinematics_both(params: Params, d) -> FkSolutions:
     leg 2 to the circle about ``C_2 = (0, d_2 - a + b)``.
     """
     d = as_xy(d, "d")
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        return _fk_both(params, d)
+
+
+def _fk_both(params: Params, d: np.ndarray) -> FkSolutions:
     k = params.a - params.b
     c1 = np.stack([d[..., 0] - k, np.zeros_like(d[..., 0])], axis=-1)
     c2 = np.stack([np.zeros_like(d[..., 1]), d[..., 1] - k], axis=-1)
@@ -141,7 +152,7 @@ def forward_kinematics_both(params: Params, d) -> FkSolutions:
     with np.errstate(invalid="ignore", divide="ignore"):
         h = np.sqrt(np.maximum(params.l_a**2 - half**2, 0.0))  # tangency within rounding: h = 0
         u = delta / dist[..., None]
-    exists = (half <= params.l_a * (1 + 1e-12)) & (dist > 1e-12 * params.l_a)
+    exists = (half <= params.l_a * (1 + 1e-12)) & (dist > 1e-12 * params.l_a) & np.isfinite(dist)
     h = np.where(exists, h, np.nan)
     mid = (c1 + c2) / 2.0
     normal = np.stack([-u[..., 1], u[..., 0]], axis=-1)  # u rotated by +90 deg
@@ -166,13 +177,13 @@ def _raise_if_missing(params: Params, d: np.ndarray, sol: FkSolutions) -> None:
         return
     bad = np.asarray(d)[~sol.exists][0] if np.ndim(sol.exists) else np.asarray(d)
     k = params.a - params.b
-    if np.hypot(bad[0] - k, bad[1] - k) <= 1e-12 * params.l_a:
+    if abs(float(bad[0]) - k) + abs(float(bad[1]) - k) <= 1e-12 * params.l_a:
         raise SingularConfigurationError(
             f"d1 = d2 = a - b = {k * 1e3:.1f} mm: the two leg circles coincide, the platform position "
             "is undetermined (direct singularity, eq. 12)"
         )
     raise UnreachablePoseError(
-        f"actuators at ({bad[0] * 1e3:.1f}, {bad[1] * 1e3:.1f}) mm cannot be assembled: "
+        f"actuators at ({_mm(bad[0])}, {_mm(bad[1])}) mm cannot be assembled: "
         "the leg circles are more than 2 l_a apart"
     )
 
@@ -197,8 +208,9 @@ def forward_kinematics_nearest(params: Params, d, p_prev) -> tuple[np.ndarray, i
     sol = forward_kinematics_both(params, d)
     _raise_if_missing(params, d, sol)
     p_prev = as_xy(p_prev, "p_prev")
-    if np.linalg.norm(sol.plus - p_prev) <= np.linalg.norm(sol.minus - p_prev):
-        return sol.plus, 1
+    with np.errstate(over="ignore"):  # an absurd previous pose: both distances inf, keep "plus"
+        if np.sum((sol.plus - p_prev) ** 2) <= np.sum((sol.minus - p_prev) ** 2):
+            return sol.plus, 1
     return sol.minus, -1
 
 
