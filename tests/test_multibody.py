@@ -248,6 +248,25 @@ def test_projection_restores_the_closures_and_admissible_velocity():
 
 
 # ----------------------------------------------------------------------------- errors
+ANY = st.floats(allow_nan=True, allow_infinity=True) | st.floats(-0.3, 0.3) | st.sampled_from([1e300, -0.26, 0.2599])
+
+
+@settings(max_examples=300, deadline=None, derandomize=True)
+@given(p=st.tuples(ANY, ANY), dp=st.tuples(ANY, ANY), ddp=st.tuples(ANY, ANY), mode=st.sampled_from([1, -1]))
+def test_arbitrary_numbers_give_finite_results_or_one_line_errors(p, dp, ddp, mode):
+    for call in (
+        lambda: MB.inverse_dynamics(p, dp, ddp, f_ext=ddp),
+        lambda: MB.configuration(p),
+        lambda: MB.configuration_from_actuators(dp, mode),
+    ):
+        try:
+            out = call()
+        except tv.TpmVizError as exc:
+            assert str(exc) and "\n" not in str(exc)
+        else:
+            assert np.all(np.isfinite(out))
+
+
 @pytest.mark.parametrize(
     ("call", "error"),
     [

@@ -289,10 +289,10 @@ class MultibodyModel:
 
     def _configure(self, p: np.ndarray, d: np.ndarray | None):
         """``(q, J_c, J_P)`` at the closed-loop configuration of platform position ``p``."""
-        la = self.params.l_a
-        if max(abs(p[0]), abs(p[1])) >= la:
+        la, (p1, p2) = self.params.l_a, p.tolist()
+        if max(abs(p1), abs(p2)) >= la:
             raise UnreachablePoseError(
-                f"platform position ({p[0] * 1e3:.1f}, {p[1] * 1e3:.1f}) mm is unreachable: "
+                f"platform position ({p1 * 1e3:.1f}, {p2 * 1e3:.1f}) mm is unreachable: "
                 f"each |p_j| must be below l_a = {la * 1e3:.1f} mm"
             )
         starts = [lambda: self._guess_from_platform(p, d)]
@@ -308,7 +308,7 @@ class MultibodyModel:
                     self._last = (p.copy(), q, None)
                 return q, jc, jp
         raise SingularConfigurationError(
-            f"no closed-loop configuration found at ({p[0] * 1e3:.1f}, {p[1] * 1e3:.1f}) mm "
+            f"no closed-loop configuration found at ({p1 * 1e3:.1f}, {p2 * 1e3:.1f}) mm "
             "(too close to cos θ_i = 0, eq. 11)"
         )
 
@@ -321,8 +321,8 @@ class MultibodyModel:
         d = self._one(d, "d")
         k, la = self.params.a - self.params.b, self.params.l_a
         c1, c2 = np.array([d[0] - k, 0.0]), np.array([0.0, d[1] - k])  # leg circle centres
-        gap = np.linalg.norm(c2 - c1)
-        if gap >= 2 * la or gap == 0:
+        gap = math.hypot(float(d[0] - k), float(d[1] - k))  # |C_2 - C_1|, no overflow for huge d
+        if not gap < 2 * la or gap == 0:
             raise UnreachablePoseError(
                 "actuator positions cannot be assembled: the leg circles are more than 2 l_a apart"
             )
@@ -432,14 +432,14 @@ class MultibodyModel:
             p, dp, ddp, f = np.broadcast_arrays(p, dp, ddp, f)
         except ValueError:
             raise InputError("p, dp, ddp and f_ext have incompatible shapes") from None
-        if p.shape == (2,):
-            return self._tau(*self._motion(p, dp, ddp), f)[0]
-        shape = p.shape
         flat = [x.reshape(-1, 2) for x in (p, dp, ddp, f)]
         tau = np.empty((flat[0].shape[0], 2))
-        for k, (pk, dpk, ddpk, fk) in enumerate(zip(*flat, strict=True)):
-            tau[k] = self._tau(*self._motion(pk, dpk, ddpk), fk)[0]
-        return tau.reshape(shape)
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # huge inputs: checked below
+            for k, (pk, dpk, ddpk, fk) in enumerate(zip(*flat, strict=True)):
+                tau[k] = self._tau(*self._motion(pk, dpk, ddpk), fk)[0]
+        if not np.all(np.isfinite(tau)):
+            raise InputError("the actuator forces overflowed: the inputs are too large for finite results")
+        return tau.reshape(p.shape)
 
     @_locked
     def generalized_forces(self, p, dp, ddp, f_ext=None) -> dict[str, np.ndarray]:
