@@ -8,6 +8,7 @@ import io
 import re
 import socket
 import threading
+import time
 from contextlib import redirect_stderr, redirect_stdout
 
 import numpy as np
@@ -28,8 +29,27 @@ def _state(view):
         return view.session.state
 
 
+def _readout(view):
+    with view.hub.lock:
+        return view.session.readout
+
+
+def _settle(view, quiet: float = 0.3) -> None:
+    """Wait until the view's state has not changed for ``quiet`` seconds (pending events all applied)."""
+    last = [_state(view).version, time.monotonic()]
+
+    def still() -> bool:
+        version = _state(view).version
+        if version != last[0]:
+            last[:] = [version, time.monotonic()]
+        return time.monotonic() - last[1] > quiet
+
+    wait_for(still, what="the state to settle")
+
+
 def _dashboard(view) -> str:
-    return view.panel.dashboard.content
+    with view.hub.lock:
+        return view.panel.dashboard.content
 
 
 def _q(view, name: str) -> str:
@@ -117,6 +137,7 @@ def test_gizmo_drag_moves_every_part_and_clamps_at_the_stroke(connect):
     np.testing.assert_allclose(_state(view).pose.d, inverse_kinematics(P, (0.02, 0.01)))
     np.testing.assert_allclose(view.scene.platform.position[:2], (0.02, 0.01))
     client.drag(view.scene.gizmo, owner, [(0.5, 0.0, 0.09)])
+    wait_for(lambda: "stopped" in _state(view).note, what="the clamp")
     wait_for(lambda: np.allclose(view.scene.gizmo.position[:2], _state(view).pose.p), what="gizmo written back")
     assert _state(view).pose.d[0] == pytest.approx(P.stroke, abs=1e-5)
     assert "stopped" in _state(view).note
@@ -179,7 +200,7 @@ def test_paper_values_button(connect):
 def test_demo_buttons_warn_and_recolour(connect, kind, check):
     client, view = connect()
     client.click(view.panel.demo[kind])
-    wait_for(lambda: kind in {a.kind for a in view.session.readout.alerts}, what=f"a {kind} alert")
+    wait_for(lambda: kind in {a.kind for a in _readout(view).alerts}, what=f"a {kind} alert")
     assert f'data-level="{kind}"' in _dashboard(view) or kind == "stroke"
     assert check(view)
 
@@ -193,7 +214,7 @@ def test_switch_assembly_mode_and_the_ghost(connect):
     ghost = np.array(view.scene.ghost.position[:2])
     assert view.scene.ghost.visible
     client.click(view.panel.switch_mode)
-    wait_for(lambda: view.session.readout.mode == -1, what="the other mode")
+    wait_for(lambda: _readout(view).mode == -1, what="the other mode")
     np.testing.assert_allclose(_state(view).pose.p, ghost)
     assert "−" in _q(view, "mode")
 
@@ -244,6 +265,8 @@ def test_classroom_shared_then_own_copy_then_back(connect):
 
     c2.set_value(v2.panel.own_copy, True)
     wait_for(lambda: not v2.session.shared, what="own copy")
+    wait_for(lambda: "You see your own copy" in v2.panel.class_info.content, what="the classroom line")
+    assert "1 on the shared mechanism" in v1.panel.class_info.content
     c2.set_value(v2.panel.d[0], 100.0)
     wait_for(lambda: abs(_state(v2).pose.d[0] - 0.1) < 1e-12, what="private change")
     assert _state(v1).pose.d[0] == pytest.approx(0.18)  # the shared mechanism did not move
@@ -255,7 +278,7 @@ def test_classroom_shared_then_own_copy_then_back(connect):
     wait_for(lambda: v2.session.shared, what="back to shared")
     assert _state(v2) is _state(v1)
     assert v2.panel.d[1].value == pytest.approx(200.0)
-    assert "on the shared mechanism" in v1.panel.class_info.content
+    assert "2 on the shared mechanism" in v1.panel.class_info.content
 
 
 def test_simultaneous_drags_are_serialised_and_never_corrupt_state(app, connect):
@@ -278,10 +301,7 @@ def test_simultaneous_drags_are_serialised_and_never_corrupt_state(app, connect)
         t.join()
     assert not errors
     view = clients[0][1]
-    wait_for(
-        lambda: all(np.allclose(v.scene.gizmo.position[:2], _state(v).pose.p) for _, v in clients),
-        what="all gizmos settled",
-    )
+    _settle(view)
     state = _state(view)
     from tpm_viz.interaction import OK, check
 

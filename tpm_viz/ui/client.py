@@ -9,7 +9,9 @@ A refused input is reported to this tab only; the last good state stays.
 
 from __future__ import annotations
 
+import asyncio
 import functools
+import traceback
 
 import numpy as np
 import viser
@@ -29,6 +31,12 @@ __all__ = ["ClientView"]
 MAX_FORCE = 1e5  # N, bound on typed forces
 MAX_SPEED = 100.0  # m/s
 MAX_ACCEL = 1e5  # m/s²
+
+
+def _report(future) -> None:
+    """Print the traceback of a failed background drain (it would be lost otherwise)."""
+    if not future.cancelled() and future.exception() is not None:
+        traceback.print_exception(future.exception())
 
 
 def _callback(method):
@@ -56,7 +64,7 @@ class ClientView:
         self.client = client
         self.hub = hub
         self.closed = False
-        self._last_drag: tuple[float, float] | None = None
+        self._pending_drags: list[tuple[str, np.ndarray]] = []
         with hub.lock:
             state = hub.shared.state
             self.scene = MechanismScene(client.scene, state.params)
@@ -129,34 +137,42 @@ class ClientView:
             handle.on_update(lambda event, what=what: self._on_show(event, what))
         panel.frame_camera.on_click(self._on_frame)
 
-    @_callback
-    def _on_drag(self, event) -> None:
-        p_req = read_vec2(np.asarray(self.scene.gizmo.position)[:2], "platform position")
-        key = (float(p_req[0]), float(p_req[1]))
-        end = event.phase == "end"
-        if key == self._last_drag and not end:
-            return  # a late event carrying the value already applied (latest value wins)
-        self._last_drag = None if end else key
-        state = self.session.state
-        move = drag_to(state.params, state.pose, p_req)
-        self.panel.tell("")
-        self.hub.commit(
-            self.session,
-            state.replace(
-                pose=move.pose, note=move.reason, trajectory=TrajectorySample("none", state.trajectory.duration)
-            ),
-            origin=self,
-            dragging=not end,
-        )
+    async def _on_drag(self, event) -> None:
+        """Gizmo events, in arrival order on the event loop: keep a snapshot, hand the work to the pool."""
+        self._pending_drags.append((event.phase, np.array(event.target.position, dtype=float)))
+        asyncio.get_running_loop().run_in_executor(None, self._drain_drags).add_done_callback(_report)
+
+    def _drain_drags(self) -> None:
+        """Apply the latest pending gizmo position (latest value wins); ``end`` writes the gizmo back."""
+        with self.hub.lock:
+            if self.closed or not self._pending_drags:
+                return
+            phase, position = self._pending_drags[-1]
+            self._pending_drags.clear()
+            try:
+                p_req = read_vec2(position[:2], "platform position")
+            except TpmVizError as exc:
+                self.refuse(str(exc))
+                return
+            state = self.session.state
+            move = drag_to(state.params, state.pose, p_req)
+            self.panel.tell("")
+            sample = TrajectorySample("none", state.trajectory.duration)
+            changed = state.replace(pose=move.pose, note=move.reason, trajectory=sample)
+            self.hub.commit(self.session, changed, origin=self, dragging=phase != "end")
 
     @_callback
     def _on_p(self, event) -> None:
+        if self.panel.is_echo(self.panel.p):
+            return
         p_req = read_vec2(self.panel.p.value, "platform position p", scale=1e-3, bound=10.0)
         state = self.session.state
         self._move(drag_to(state.params, state.pose, p_req))
 
     @_callback
     def _on_d(self, event, i: int) -> None:
+        if self.panel.is_echo(self.panel.d[i]):
+            return
         state = self.session.state
         d_req = np.array(state.pose.d, dtype=float)
         d_req[i] = read_number(self.panel.d[i].value, f"d{i + 1}", scale=1e-3, lo=-10.0, hi=10.0)
@@ -180,6 +196,8 @@ class ClientView:
     @_callback
     def _on_load(self, event) -> None:
         panel = self.panel
+        if panel.is_echo(panel.load_mode, panel.f_ext, panel.dp, panel.ddp):
+            return
         mode = panel.load_mode.value if panel.load_mode.value in LOAD_MODES else "static"
         load = Load(
             mode=mode,
@@ -194,6 +212,8 @@ class ClientView:
     @_callback
     def _on_trajectory(self, event) -> None:
         panel = self.panel
+        if panel.is_echo(panel.trajectory, panel.duration, panel.time):
+            return
         kind = panel.trajectory.value if panel.trajectory.value in TRAJECTORY_KINDS else "none"
         duration = read_number(panel.duration.value, "duration T", lo=0.01, hi=100.0)
         t = read_number(panel.time.value, "time t", lo=0.0, hi=duration)
@@ -237,6 +257,7 @@ class ClientView:
         old = self.session
         self.hub.leave(self, old)
         self.session = self.hub.join(self, private=private, session=old)
+        self.hub.membership_changed()
 
     def _on_show(self, event, what: str) -> None:
         if getattr(event, "client", None) is None:

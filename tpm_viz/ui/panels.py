@@ -16,6 +16,8 @@ from .text import dashboard_html
 
 __all__ = ["PARAM_LABELS", "Panel"]
 
+_UNSET = object()
+
 PARAM_LABELS = {
     "a": "a, total size (mm)",
     "b": "b, platform offset (mm)",
@@ -53,6 +55,7 @@ class Panel:
         self._gui = gui
         self._shown_params: Params | None = None
         self._shown_load = None
+        self._written: dict[int, object] = {}
         self._shown_trajectory = None
         stroke_mm = state.params.stroke * 1e3
         self.dashboard = gui.add_html("")
@@ -93,28 +96,38 @@ class Panel:
     def show(self, state: AppState, readout: Readout) -> None:
         """Write every value of ``state`` and ``readout`` into the widgets (viser skips unchanged ones)."""
         self.dashboard.content = dashboard_html(state, readout)
-        self.p.value = (round(float(readout.p[0]) * 1e3, 2), round(float(readout.p[1]) * 1e3, 2))
+        self._put(self.p, (round(float(readout.p[0]) * 1e3, 2), round(float(readout.p[1]) * 1e3, 2)))
         stroke_mm = state.params.stroke * 1e3
         for i, slider in enumerate(self.d):
             if slider.max != stroke_mm:
                 slider.max = stroke_mm
-            slider.value = min(max(round(float(readout.d[i]) * 1e3, 2), 0.0), stroke_mm)
+            self._put(slider, min(max(round(float(readout.d[i]) * 1e3, 2), 0.0), stroke_mm))
         if state.load != self._shown_load:
             self._shown_load = load = state.load
-            self.load_mode.value = load.mode
-            self.f_ext.value = load.f_ext
-            self.dp.value = tuple(round(v, 6) for v in load.dp)
-            self.ddp.value = tuple(round(v, 6) for v in load.ddp)
+            self._put(self.load_mode, load.mode)
+            self._put(self.f_ext, load.f_ext)
+            self._put(self.dp, tuple(round(v, 6) for v in load.dp))
+            self._put(self.ddp, tuple(round(v, 6) for v in load.ddp))
         if state.trajectory != self._shown_trajectory:
             self._shown_trajectory = traj = state.trajectory
-            self.trajectory.value = traj.kind
-            self.duration.value = traj.duration
+            self._put(self.trajectory, traj.kind)
+            self._put(self.duration, traj.duration)
             if self.time.max != traj.duration:
                 self.time.max = traj.duration
                 self.time.step = traj.duration / 200.0
-            self.time.value = min(traj.t, traj.duration)
+            self._put(self.time, min(traj.t, traj.duration))
         if state.params != self._shown_params:
             self.show_params(state.params)
+
+    def _put(self, handle, value) -> None:
+        """Write a widget value and remember it (see :meth:`is_echo`)."""
+        handle.value = value
+        self._written[id(handle)] = handle.value
+
+    def is_echo(self, *handles) -> bool:
+        """Whether these widgets still hold the values the server wrote last: then a callback that reads them
+        is a late duplicate of an event already applied, not new user input (viser only reports changes)."""
+        return all(self._written.get(id(h), _UNSET) == h.value for h in handles)
 
     def show_params(self, params: Params) -> None:
         """Write the parameter inputs (also to revert a refused edit)."""

@@ -96,13 +96,14 @@ class Hub:
         return evaluate(state.params, state.pose, state.load, self.reference)
 
     def join(self, view: View, private: bool, session: Session | None = None) -> Session:
-        """Attach ``view`` to the shared session, or to a new private copy of ``session``'s state; draws it."""
+        """Attach ``view`` to the shared session, or to a new private copy of ``session``'s state; draws it.
+
+        The caller stores the returned session in the view, then calls :meth:`membership_changed`."""
         with self.lock:
             source = session if session is not None else self.shared
             target = Session(source.state, shared=False) if private else self.shared
             target.views.append(view)
             self._draw(target, [view], origin=None, dragging=False)
-        self._membership_changed()
         return target
 
     def leave(self, view: View, session: Session) -> None:
@@ -110,7 +111,7 @@ class Hub:
         with self.lock:
             if view in session.views:
                 session.views.remove(view)
-        self._membership_changed()
+        self.membership_changed()
 
     def commit(self, session: Session, state: AppState, origin: View | None = None, dragging: bool = False) -> None:
         """Make ``state`` current in ``session`` and draw it in every view, ``origin`` first."""
@@ -132,7 +133,8 @@ class Hub:
         """How many tabs show the shared mechanism."""
         return len(self.shared.views)
 
-    def _membership_changed(self) -> None:
+    def membership_changed(self) -> None:
+        """Tell the app that tabs joined, left or switched sessions (it updates the classroom line)."""
         if self.on_membership is not None:
             self.on_membership()
 
