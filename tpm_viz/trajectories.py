@@ -76,11 +76,16 @@ def _check_samples(samples: int) -> int:
 
 
 def _cubic_law(t, duration: float):
-    """``s, ṡ, s̈`` of ``s(τ) = 3τ² - 2τ³`` at times ``t`` (clamped to ``[0, T]``)."""
-    tau = np.clip(np.asarray(t, dtype=float) / duration, 0.0, 1.0)
+    """``s, ṡ, s̈`` of ``s(τ) = 3τ² - 2τ³`` at times ``t``; at rest before 0 and after ``T``.
+
+    On the closed interval ``[0, T]`` these are the polynomial's values, so ``s̈(0) = 6/T²`` and
+    ``s̈(T) = -6/T²``: the acceleration (and the actuator force) jumps at the start and the end.
+    """
+    raw = np.asarray(t, dtype=float) / duration
+    tau = np.clip(raw, 0.0, 1.0)
     s = 3 * tau**2 - 2 * tau**3
     ds = (6 * tau - 6 * tau**2) / duration
-    dds = np.where((tau > 0) & (tau < 1), (6 - 12 * tau) / duration**2, 0.0)
+    dds = np.where((raw >= 0) & (raw <= 1), (6 - 12 * tau) / duration**2, 0.0)
     return s, ds, dds
 
 
