@@ -311,3 +311,27 @@ def test_simultaneous_drags_are_serialised_and_never_corrupt_state(app, connect)
         assert _state(v) is state
         np.testing.assert_allclose(v.scene.platform.position[:2], state.pose.p)
     assert "nan" not in _dashboard(view).lower()
+
+
+def test_play_steps_through_the_trajectory_and_any_input_stops_it(connect, monkeypatch):
+    import tpm_viz.ui.client as client_module
+
+    monkeypatch.setattr(client_module, "PLAY_SECONDS", 0.5)
+    client, view = connect()
+    client.set_value(view.panel.trajectory, "circle")
+    wait_for(lambda: _state(view).trajectory.kind == "circle", what="circle selected")
+    client.set_value(view.panel.duration, 0.5)
+    wait_for(lambda: _state(view).trajectory.duration == 0.5, what="T = 0.5 s")
+    client.click(view.panel.play)
+    wait_for(lambda: _state(view).trajectory.t == pytest.approx(0.5), what="the end of the trajectory")
+    np.testing.assert_allclose(_state(view).pose.p, (0.1, 0.0), atol=1e-12)  # one full turn
+    assert view.panel.time.value == pytest.approx(0.5)
+
+    monkeypatch.setattr(client_module, "PLAY_SECONDS", 30.0)
+    client.click(view.panel.play)
+    wait_for(lambda: 0 < _state(view).trajectory.t < 0.5, what="playing")
+    client.click(view.panel.home)
+    wait_for(lambda: _state(view).trajectory.kind == "none", what="home")
+    version = _state(view).version
+    time.sleep(0.6)  # more than two frames of the player
+    assert _state(view).version == version  # stopped

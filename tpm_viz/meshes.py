@@ -30,6 +30,7 @@ __all__ = [
     "platform_pin_offsets",
     "polyline_segments",
     "rail",
+    "region_mesh",
     "slider",
     "slider_pin_offsets",
     "tool_marker",
@@ -191,3 +192,27 @@ def polyline_segments(curves, z: float) -> np.ndarray:
         return np.zeros((0, 2, 3))
     xy = np.concatenate(segs)
     return np.concatenate([xy, np.full((*xy.shape[:2], 1), z)], axis=-1)
+
+
+def region_mesh(mask: np.ndarray, xs: np.ndarray, ys: np.ndarray, z: float) -> trimesh.Trimesh | None:
+    """A flat mesh at height ``z`` covering the grid cells where ``mask`` is true (e.g. the workspace).
+
+    ``mask`` has shape ``(ny, nx)`` on the grid points ``xs`` (nx,), ``ys`` (ny,) [m]; each point owns the
+    cell around it (half a spacing each way). Returns None if the mask is empty.
+    """
+    mask = np.asarray(mask, dtype=bool)
+    if not mask.any():
+        return None
+    hx, hy = (xs[1] - xs[0]) / 2, (ys[1] - ys[0]) / 2
+    gx = np.concatenate([xs - hx, [xs[-1] + hx]])
+    gy = np.concatenate([ys - hy, [ys[-1] + hy]])
+    vx, vy = np.meshgrid(gx, gy)  # (ny + 1, nx + 1) cell corners
+    vertices = np.column_stack([vx.ravel(), vy.ravel(), np.full(vx.size, z)])
+    j, i = np.nonzero(mask)  # row (y) and column (x) of each cell
+    stride = len(gx)
+    v00 = j * stride + i
+    v10, v01, v11 = v00 + 1, v00 + stride, v00 + stride + 1
+    faces = np.concatenate([np.column_stack([v00, v10, v11]), np.column_stack([v00, v11, v01])])
+    mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+    mesh.remove_unreferenced_vertices()
+    return mesh

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import asyncio
 import functools
+import threading
+import time
 import traceback
 
 import numpy as np
@@ -20,17 +22,31 @@ from ..errors import TpmVizError
 from ..interaction import Move, drag_to, drive_to, place, switch_mode
 from ..params import PARAM_INFO, Params
 from ..poses import DEMO_KINDS, demo_pose, home_pose, settle
-from ..readouts import LOAD_MODES, Load, Readout
+from ..readouts import LOAD_MODES, Load
 from ..trajectories import circle_state, line_state
+from .frame import Frame
 from .panels import Panel
 from .scene import MechanismScene, camera_pose
 from .session import TRAJECTORY_KINDS, AppState, Hub, Session, TrajectorySample, read_number, read_vec2
 
 __all__ = ["ClientView"]
 
+PLAY_SECONDS = 4.0  # s, wall-clock length of a played trajectory (slow motion)
+PLAY_FRAMES = 100
 MAX_FORCE = 1e5  # N, bound on typed forces
 MAX_SPEED = 100.0  # m/s
 MAX_ACCEL = 1e5  # m/s²
+
+
+def _sampled(state: AppState, sample: TrajectorySample) -> AppState:
+    """``state`` driven by a trajectory sample: the pose at ``p(t)`` (working mode) and ``ṗ(t), p̈(t)`` as a
+    dynamic load; unchanged pose and load, with the reason, if ``p(t)`` is not valid for these parameters."""
+    if sample.kind == "none":
+        return state.replace(trajectory=sample, note="")
+    p, dp, ddp = (line_state if sample.kind == "line" else circle_state)(sample.t, sample.duration)
+    move = place(state.params, state.pose, p)
+    load = state.load if move.clamped else Load("dynamic", dp=tuple(dp), ddp=tuple(ddp))
+    return state.replace(pose=move.pose, load=load, trajectory=sample, note=move.reason)
 
 
 def _report(future) -> None:
@@ -74,13 +90,13 @@ class ClientView:
             self.session: Session = hub.join(self, private=False)
 
     # -- drawing -------------------------------------------------------------------------------------------
-    def render(self, state: AppState, readout: Readout, *, dragging: bool = False) -> None:
-        """Draw ``state`` in this tab (called by the hub under its lock) and flush at once."""
+    def render(self, frame: Frame, *, dragging: bool = False) -> None:
+        """Draw ``frame`` in this tab (called by the hub under its lock) and flush at once."""
         if self.closed:
             return
         with self.client.atomic():
-            self.scene.update(state, readout, dragging=dragging)
-            self.panel.show(state, readout)
+            self.scene.update(frame, dragging=dragging)
+            self.panel.show(frame)
         self.client.flush()
 
     def refuse(self, text: str) -> None:
@@ -108,6 +124,7 @@ class ClientView:
     # -- commits -------------------------------------------------------------------------------------------
     def _commit(self, state: AppState, dragging: bool = False) -> None:
         self.panel.tell("")
+        self.session.play_token += 1  # any input stops a playing trajectory
         self.hub.commit(self.session, state, origin=self, dragging=dragging)
 
     def _move(self, move: Move, **changes) -> None:
@@ -130,6 +147,7 @@ class ClientView:
             handle.on_update(self._on_load)
         for handle in (panel.trajectory, panel.duration, panel.time):
             handle.on_update(self._on_trajectory)
+        panel.play.on_click(self._on_play)
         panel.apply.on_click(self._on_apply)
         panel.paper.on_click(self._on_paper)
         panel.own_copy.on_update(self._on_own_copy)
@@ -159,7 +177,7 @@ class ClientView:
             self.panel.tell("")
             sample = TrajectorySample("none", state.trajectory.duration)
             changed = state.replace(pose=move.pose, note=move.reason, trajectory=sample)
-            self.hub.commit(self.session, changed, origin=self, dragging=phase != "end")
+            self._commit(changed, dragging=phase != "end")
 
     @_callback
     def _on_p(self, event) -> None:
@@ -217,15 +235,32 @@ class ClientView:
         kind = panel.trajectory.value if panel.trajectory.value in TRAJECTORY_KINDS else "none"
         duration = read_number(panel.duration.value, "duration T", lo=0.01, hi=100.0)
         t = read_number(panel.time.value, "time t", lo=0.0, hi=duration)
-        state = self.session.state
-        sample = TrajectorySample(kind, duration, t)
-        if kind == "none":
-            self._commit(state.replace(trajectory=sample, note=""))
-            return
-        p, dp, ddp = (line_state if kind == "line" else circle_state)(t, duration)
-        move = place(state.params, state.pose, p)
-        load = Load("dynamic", dp=tuple(dp), ddp=tuple(ddp)) if not move.clamped else state.load
-        self._commit(state.replace(pose=move.pose, load=load, trajectory=sample, note=move.reason))
+        self._commit(_sampled(self.session.state, TrajectorySample(kind, duration, t)))
+
+    @_callback
+    def _on_play(self, event) -> None:
+        """Play the selected trajectory (the line if none) in slow motion, in a background thread."""
+        session = self.session
+        traj = session.state.trajectory
+        kind = traj.kind if traj.kind != "none" else "line"
+        duration = traj.duration
+        session.play_token += 1
+        threading.Thread(
+            target=self._play, args=(session, kind, duration, session.play_token), name="tpm-viz-play", daemon=True
+        ).start()
+
+    def _play(self, session: Session, kind: str, duration: float, token: int) -> None:
+        """Step through ``PLAY_FRAMES`` samples over ``PLAY_SECONDS``; any other input stops it."""
+        for k in range(PLAY_FRAMES + 1):
+            if k:
+                time.sleep(PLAY_SECONDS / PLAY_FRAMES)
+            with self.hub.lock:
+                if session.play_token != token or not session.views:
+                    return
+                state = _sampled(session.state, TrajectorySample(kind, duration, duration * k / PLAY_FRAMES))
+                self.hub.commit(session, state)
+                if state.note:
+                    return
 
     @_callback
     def _on_apply(self, event) -> None:
@@ -264,8 +299,8 @@ class ClientView:
             return
         with self.hub.lock:
             self.scene.set_visible(what, bool(self.panel.show_toggles[what].value))
-            if self.session.readout is not None:
-                self.render(self.session.state, self.session.readout)
+            if self.session.frame is not None:
+                self.render(self.session.frame)
 
     def _on_frame(self, event) -> None:
         if getattr(event, "client", None) is None:

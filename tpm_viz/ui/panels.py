@@ -10,9 +10,10 @@ import viser
 
 from ..params import PARAM_INFO, Params
 from ..poses import DEMO_KINDS
-from ..readouts import LOAD_MODES, Readout
+from ..readouts import LOAD_MODES
+from .frame import Frame
 from .session import TRAJECTORY_KINDS, AppState
-from .text import dashboard_html
+from .text import legend_html
 
 __all__ = ["PARAM_LABELS", "Panel"]
 
@@ -38,8 +39,8 @@ DEMO_LABELS = {
 
 SHOW_LABELS = {
     "labels": "Labels O, A_i, B_i, P",
-    "loci": "Singularity loci and stroke limits (floor)",
-    "circles": "Constraint circles and the other assembly mode",
+    "loci": "Workspace and singularities",
+    "circles": "Circles, other mode",
     "forces": "Force arrows",
 }
 
@@ -78,6 +79,7 @@ class Panel:
             self.trajectory = gui.add_dropdown("Trajectory sample (Figs. 4-5)", TRAJECTORY_KINDS, initial_value="none")
             self.duration = gui.add_number("Duration T (s)", 0.2, min=0.01, max=100.0, step=0.01)
             self.time = gui.add_slider("Time t (s)", 0.0, 0.2, 0.001, 0.0)
+            self.play = gui.add_button("Play the trajectory (slow motion)", icon=viser.Icon.PLAYER_PLAY)
         with tabs.add_tab("Parameters", viser.Icon.ADJUSTMENTS):
             self.params = {
                 name: gui.add_number(PARAM_LABELS[name], _ui(name, getattr(state.params, name)), step=0.01)
@@ -91,11 +93,13 @@ class Panel:
             )
             self.class_info = gui.add_markdown("")
             self.show_toggles = {k: gui.add_checkbox(label, True) for k, label in SHOW_LABELS.items()}
+            gui.add_html(legend_html())
             self.frame_camera = gui.add_button("Frame the mechanism", icon=viser.Icon.FOCUS_CENTERED)
 
-    def show(self, state: AppState, readout: Readout) -> None:
-        """Write every value of ``state`` and ``readout`` into the widgets (viser skips unchanged ones)."""
-        self.dashboard.content = dashboard_html(state, readout)
+    def show(self, frame: Frame) -> None:
+        """Write every value of the frame's state and readout into the widgets (viser skips unchanged ones)."""
+        state, readout = frame.state, frame.readout
+        self.dashboard.content = frame.dashboard
         self._put(self.p, (round(float(readout.p[0]) * 1e3, 2), round(float(readout.p[1]) * 1e3, 2)))
         stroke_mm = state.params.stroke * 1e3
         for i, slider in enumerate(self.d):

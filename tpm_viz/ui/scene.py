@@ -12,10 +12,10 @@ import numpy as np
 import viser
 
 from .. import meshes
-from ..kinematics import mechanism_pose
 from ..params import Params
 from ..readouts import Readout
-from ..workspace import direct_singularity_locus, inverse_singularity_loci, stroke_limit_loci
+from ..workspace import direct_singularity_locus, inverse_singularity_loci, workspace_map
+from .frame import Frame
 from .session import AppState
 
 __all__ = ["COLORS", "FORCE_SCALE", "MechanismScene"]
@@ -39,14 +39,14 @@ COLORS = {
     "circle": (59, 130, 246),
     "locus_direct": (220, 38, 38),
     "locus_inverse": (245, 158, 11),
-    "locus_stroke": (219, 39, 119),
+    "workspace": (34, 197, 94),
 }
 """RGB colours of the parts, the warning colours (inverse, direct, stroke) and the force arrows."""
 
-FORCE_SCALE = 1e-3
-"""Length of a force arrow per newton [m/N] (1 mm per N), clipped at :data:`FORCE_MAX`."""
+FORCE_SCALE = 1.5e-3
+"""Length of a force arrow per newton [m/N] (1.5 mm per N), clipped at :data:`FORCE_MAX`."""
 FORCE_MAX = 0.3  # m
-ARROW_Z = meshes.SLIDER_Z[1] + 0.012  # m
+ARROW_Z = meshes.PIN_Z[1] + 0.02  # m, above every part so that no part hides an arrow
 LOCI_Z = 0.0008  # m
 GIZMO_Z = meshes.PLATFORM_Z[1] + 0.02  # m
 
@@ -92,9 +92,9 @@ class MechanismScene:
                 f"/tpm/slider{i + 1}/force",
                 np.zeros((1, 2, 3)),
                 COLORS["tau_pos"],
-                shaft_radius=0.005,
-                head_radius=0.013,
-                head_length=0.025,
+                shaft_radius=0.007,
+                head_radius=0.018,
+                head_length=0.035,
                 visible=False,
             )
             for i in range(2)
@@ -191,27 +191,29 @@ class MechanismScene:
         )
 
     def _loci(self, params: Params) -> None:
+        """The floor overlay: the workspace inside the stroke (eq. 4), the inverse singularity square (eq. 11)
+        and the direct singularity arcs (eq. 12), all in the working mode."""
         s = self._scene
-        sets = {
-            "direct": direct_singularity_locus(params),
-            "inverse": inverse_singularity_loci(params),
-            "stroke": stroke_limit_loci(params),
-        }
+        ws = workspace_map(params, n=100)
+        region = meshes.region_mesh(ws.in_stroke, ws.xs, ws.ys, LOCI_Z / 2)
         self.loci = []
-        for kind, curves in sets.items():
-            segs = meshes.polyline_segments(curves, LOCI_Z)
-            if len(segs) == 0:
-                continue
+        if region is not None:
+            self.loci.append(_mesh(s, "/tpm/loci/workspace", region, COLORS["workspace"], opacity=0.45, side="double"))
+        for kind, curves in (
+            ("inverse", inverse_singularity_loci(params)),
+            ("direct", direct_singularity_locus(params)),
+        ):
             self.loci.append(
                 s.add_line_segments(
                     f"/tpm/loci/{kind}",
-                    segs,
+                    meshes.polyline_segments(curves, LOCI_Z),
                     COLORS[f"locus_{kind}"],
                     thickness=2.5,
                     thickness_units="screen",
-                    visible=self.show["loci"],
                 )
             )
+        for handle in self.loci:
+            handle.visible = self.show["loci"]
 
     @staticmethod
     def _leg_colors(near_inverse) -> np.ndarray:
@@ -241,12 +243,13 @@ class MechanismScene:
         for key in [k for k in self._sent if k.endswith("_vis") or k.startswith("force_vis")]:
             del self._sent[key]  # re-evaluated at the next update
 
-    def update(self, state: AppState, readout: Readout, dragging: bool = False) -> None:
-        """Move every part to ``readout``'s pose and recolour it from its alerts."""
+    def update(self, frame: Frame, dragging: bool = False) -> None:
+        """Move every part to the frame's pose and recolour it from its alerts."""
+        state, readout = frame.state, frame.readout
         params = state.params
         if params != self.params:
             self.rebuild(params)
-        mp = mechanism_pose(params, readout.p, readout.d)
+        mp = frame.mechanism
         for i in range(2):
             a = np.array([mp.A[i, 0], mp.A[i, 1], 0.0])
             self._set(f"slider{i}", self.sliders[i], "position", a)
@@ -260,9 +263,9 @@ class MechanismScene:
             "color",
             COLORS["direct"] if readout.near_direct else COLORS["platform"],
         )
-        positions, wxyzs = meshes.link_instances(mp)
-        self._set("links_pos", self.links, "batched_positions", positions.astype(np.float32))
-        self._set("links_rot", self.links, "batched_wxyzs", wxyzs.astype(np.float32))
+        positions, wxyzs = frame.links
+        self._set("links_pos", self.links, "batched_positions", positions)
+        self._set("links_rot", self.links, "batched_wxyzs", wxyzs)
         self._set("links_color", self.links, "batched_colors", self._leg_colors(readout.near_inverse))
         ghost_visible = self.show["circles"] and readout.other_p is not None
         if readout.other_p is not None:
@@ -305,5 +308,5 @@ def camera_pose(params: Params) -> tuple[np.ndarray, np.ndarray]:
     lo, hi = meshes.base_extent(params)
     size = hi - lo
     centre = np.array([(lo + hi) / 2, (lo + hi) / 2, 0.0])
-    look_at = centre + np.array([0.14, 0.04, 0.0]) * size
-    return look_at + np.array([0.0, -0.62, 0.82]) * size, look_at
+    look_at = centre + np.array([0.2, -0.1, 0.0]) * size
+    return look_at + np.array([0.0, -0.36, 0.7]) * size, look_at

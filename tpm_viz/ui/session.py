@@ -68,8 +68,9 @@ class AppState:
 class View(Protocol):
     """What a session needs from a browser tab."""
 
-    def render(self, state: AppState, readout: Readout, *, dragging: bool) -> None:
-        """Draw ``state``; ``dragging`` is True while this tab's own gizmo is being dragged."""
+    def render(self, frame, *, dragging: bool) -> None:
+        """Draw ``frame`` (a :class:`~tpm_viz.ui.frame.Frame`); ``dragging`` is True while this tab's own gizmo
+        is being dragged."""
 
 
 class Session:
@@ -79,7 +80,13 @@ class Session:
         self.state = state
         self.shared = shared
         self.views: list[View] = []
-        self.readout: Readout | None = None
+        self.frame = None  # the Frame last drawn (tpm_viz.ui.frame), None until the first draw
+        self.play_token = 0  # a playing trajectory stops when this changes
+
+    @property
+    def readout(self) -> Readout | None:
+        """The readout of the state last drawn."""
+        return None if self.frame is None else self.frame.readout
 
 
 class Hub:
@@ -117,17 +124,19 @@ class Hub:
         """Make ``state`` current in ``session`` and draw it in every view, ``origin`` first."""
         with self.lock:
             session.state = state
-            session.readout = None
+            session.frame = None
             self._draw(session, list(session.views), origin, dragging)
 
     def _draw(self, session: Session, views: list[View], origin: View | None, dragging: bool) -> None:
-        if session.readout is None:
-            session.readout = self.evaluate(session.state)
+        if session.frame is None:
+            from .frame import Frame  # viser-free, but keeps this module free of trimesh
+
+            session.frame = Frame(session.state, self.evaluate(session.state))
         if origin in views:
             views.remove(origin)
             views.insert(0, origin)
         for view in views:
-            view.render(session.state, session.readout, dragging=dragging and view is origin)
+            view.render(session.frame, dragging=dragging and view is origin)
 
     def shared_viewers(self) -> int:
         """How many tabs show the shared mechanism."""

@@ -15,7 +15,7 @@ import numpy as np
 from ..readouts import Readout
 from .session import AppState
 
-__all__ = ["COLORS_CSS", "banner_level", "dashboard_html", "force_scale", "num"]
+__all__ = ["COLORS_CSS", "banner_level", "dashboard_html", "force_scale", "legend_html", "num"]
 
 DASH = "—"
 
@@ -150,6 +150,27 @@ def _forces(state: AppState, readout: Readout) -> str:
         f"<b>Actuator forces</b> (paper's closed form; bars full scale ±{num(scale, '.0f')} N)<br>{head}</div>"
         f"{''.join(rows)}{note}</div>"
     )
+
+
+LEGEND = (
+    ("#22c55e", "workspace: poses inside the stroke (eq. 4, working mode)"),
+    ("#f59e0b", "inverse singularity |p_j| = l_a, cos θ_i = 0 (eq. 11); a leg turns amber near it"),
+    ("#dc2626", "direct singularity cos(θ₁+θ₂) = 0 (eq. 12); the platform turns red near it"),
+    ("#db2777", "a slider at its stroke end turns pink"),
+    ("#3b82f6", "leg constraint circles (radius l_a) and P′, the other assembly mode"),
+    (TAU_POS, "force arrow τ_i > 0 (along +e_i)"),
+    (TAU_NEG, "force arrow τ_i < 0"),
+)
+
+
+def legend_html() -> str:
+    """The colour legend of the 3D view."""
+    rows = "".join(
+        f'<div style="display:flex;gap:6px;align-items:baseline"><span style="flex:none;width:10px;height:10px;'
+        f'background:{color};border-radius:2px;display:inline-block"></span><span>{html.escape(text)}</span></div>'
+        for color, text in LEGEND
+    )
+    return f'<div style="font-size:0.8em;color:#334155;line-height:1.4;padding:2px 0">{rows}</div>'
 
 
 def dashboard_html(state: AppState, readout: Readout) -> str:

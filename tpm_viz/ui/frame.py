@@ -1,0 +1,43 @@
+"""One committed state as every view draws it, with the drawing data computed once for all views.
+
+A shared mechanism may be on many tabs: the readout (all the numbers), the joint positions, the link transforms
+and the dashboard HTML are the same for all of them, so they are computed at most once per commit.
+"""
+
+from __future__ import annotations
+
+from functools import cached_property
+
+import numpy as np
+
+from .. import meshes
+from ..kinematics import MechanismPose, mechanism_pose
+from ..readouts import Readout
+from .session import AppState
+from .text import dashboard_html
+
+__all__ = ["Frame"]
+
+
+class Frame:
+    """``state`` and its ``readout``; derived drawing data are cached properties."""
+
+    def __init__(self, state: AppState, readout: Readout) -> None:
+        self.state = state
+        self.readout = readout
+
+    @cached_property
+    def mechanism(self) -> MechanismPose:
+        """Every joint of the pose [m] (``A_i``, ``B_i``, the four links)."""
+        return mechanism_pose(self.state.params, self.readout.p, self.readout.d)
+
+    @cached_property
+    def links(self) -> tuple[np.ndarray, np.ndarray]:
+        """World positions (4, 3) and orientations (4, 4) of the links, as float32 for the batched mesh."""
+        positions, wxyzs = meshes.link_instances(self.mechanism)
+        return positions.astype(np.float32), wxyzs.astype(np.float32)
+
+    @cached_property
+    def dashboard(self) -> str:
+        """The HTML of the always-visible top of the panel."""
+        return dashboard_html(self.state, self.readout)
