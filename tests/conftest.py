@@ -171,8 +171,10 @@ def connect(app):
         return client, view
 
     yield _connect
-    for client in opened:
+    for client in opened:  # one at a time: each tab's departure is processed before the next one leaves
+        count = len(app.views)
         client.close()
+        wait_for(lambda count=count: len(app.views) < count, what="the app to drop the closed tab")
 
 
 @pytest.fixture

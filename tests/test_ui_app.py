@@ -335,3 +335,17 @@ def test_play_steps_through_the_trajectory_and_any_input_stops_it(connect, monke
     version = _state(view).version
     time.sleep(0.6)  # more than two frames of the player
     assert _state(view).version == version  # stopped
+
+
+def test_equations_tab_follows_the_state_but_not_every_drag_frame(connect):
+    client, view = connect()
+    client.set_value(view.panel.f_ext, (0.0, -20.0))
+    wait_for(lambda: _state(view).load.f_ext == (0.0, -20.0), what="f_ext")
+    assert "(a) Inverse kinematics" in view.panel.equations.content and "Errata" in view.panel.equations.content
+    before = view.panel.equations.content
+    owner = str(view.client.client_id)
+    client.drag(view.scene.gizmo, owner, [(0.03, 0.0, 0.09)], end=False)
+    wait_for(lambda: abs(_state(view).pose.p[0] - 0.03) < 1e-12, what="the drag")
+    assert view.panel.equations.content == before  # not recomputed for intermediate drag frames
+    client.drag(view.scene.gizmo, owner, [(0.03, 0.0, 0.09)])
+    wait_for(lambda: view.panel.equations.content != before, what="refresh at the end of the drag")

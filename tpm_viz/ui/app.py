@@ -105,8 +105,9 @@ class TpmApp:
             view.close()
 
     def _class_info(self) -> None:
+        connected = set(self.server.get_clients())
         with self._views_lock:
-            views = [v for v in self.views.values() if not v.closed]
+            views = [v for cid, v in self.views.items() if not v.closed and cid in connected]
         shared = self.hub.shared_viewers()
         for view in views:
             where = "your own copy" if not view.session.shared else "the shared mechanism"

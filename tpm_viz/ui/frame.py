@@ -6,11 +6,16 @@ and the dashboard HTML are the same for all of them, so they are computed at mos
 
 from __future__ import annotations
 
+import html
 from functools import cached_property
 
 import numpy as np
 
 from .. import meshes
+from ..dynamics import inverse_dynamics_detail
+from ..equations import ERRATA_HTML, procedure_html
+from ..errors import TpmVizError
+from ..jacobians import jacobians
 from ..kinematics import MechanismPose, mechanism_pose
 from ..readouts import Readout
 from .session import AppState
@@ -22,9 +27,11 @@ __all__ = ["Frame"]
 class Frame:
     """``state`` and its ``readout``; derived drawing data are cached properties."""
 
-    def __init__(self, state: AppState, readout: Readout) -> None:
+    def __init__(self, state: AppState, readout: Readout, in_drag: bool = False) -> None:
         self.state = state
         self.readout = readout
+        self.in_drag = in_drag
+        """True for the intermediate frames of a gizmo drag (views may skip costly, non-essential parts)."""
 
     @cached_property
     def mechanism(self) -> MechanismPose:
@@ -36,6 +43,19 @@ class Frame:
         """World positions (4, 3) and orientations (4, 4) of the links, as float32 for the batched mesh."""
         positions, wxyzs = meshes.link_instances(self.mechanism)
         return positions.astype(np.float32), wxyzs.astype(np.float32)
+
+    @cached_property
+    def equations(self) -> str:
+        """The paper's procedure (a)-(e) with this state's numbers (MathML), and the errata."""
+        state = self.state
+        dp, ddp, f_ext = state.load.motion()
+        try:
+            res = inverse_dynamics_detail(state.params, state.pose.p, dp, ddp, f_ext, d=state.pose.d)
+            jac = jacobians(state.params, state.pose.p, state.pose.d)
+            body = procedure_html(state.params, res, jac, f_ext)
+        except TpmVizError as exc:
+            body = f"<p>{html.escape(str(exc))}</p>"
+        return body + ERRATA_HTML
 
     @cached_property
     def dashboard(self) -> str:

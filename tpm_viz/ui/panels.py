@@ -62,7 +62,7 @@ class Panel:
         self.dashboard = gui.add_html("")
         self.message = gui.add_markdown("")
         tabs = gui.add_tab_group()
-        with tabs.add_tab("Move", viser.Icon.ARROWS_MOVE):
+        with tabs.add_tab("Move"):
             self.p = gui.add_vector2("Platform p (mm)", (0.0, 0.0), step=0.1, hint="Or drag the gizmo in 3D")
             self.d = [
                 gui.add_slider(f"Actuator d{i + 1} (mm)", 0.0, stroke_mm, 0.1, 0.0, hint="Forward kinematics")
@@ -71,7 +71,7 @@ class Panel:
             self.switch_mode = gui.add_button("Switch assembly mode", icon=viser.Icon.SWITCH_HORIZONTAL)
             self.home = gui.add_button("Home (p = 0)", icon=viser.Icon.HOME)
             self.demo = {k: gui.add_button(DEMO_LABELS[k], color="gray") for k in DEMO_KINDS}
-        with tabs.add_tab("Forces", viser.Icon.ARROW_BAR_RIGHT):
+        with tabs.add_tab("Forces"):
             self.load_mode = gui.add_dropdown("Load", LOAD_MODES, initial_value="static")
             self.f_ext = gui.add_vector2("External load on platform f_ext (N)", (0.0, 0.0), step=1.0)
             self.dp = gui.add_vector2("Platform velocity ṗ (m/s)", (0.0, 0.0), step=0.01)
@@ -80,14 +80,19 @@ class Panel:
             self.duration = gui.add_number("Duration T (s)", 0.2, min=0.01, max=100.0, step=0.01)
             self.time = gui.add_slider("Time t (s)", 0.0, 0.2, 0.001, 0.0)
             self.play = gui.add_button("Play the trajectory (slow motion)", icon=viser.Icon.PLAYER_PLAY)
-        with tabs.add_tab("Parameters", viser.Icon.ADJUSTMENTS):
+        with tabs.add_tab("Parameters"):
             self.params = {
                 name: gui.add_number(PARAM_LABELS[name], _ui(name, getattr(state.params, name)), step=0.01)
                 for name in PARAM_LABELS
             }
             self.apply = gui.add_button("Apply parameters", icon=viser.Icon.CHECK)
             self.paper = gui.add_button("Paper values (Tables 1-2)", color="gray")
-        with tabs.add_tab("Class & view", viser.Icon.USERS):
+        with tabs.add_tab("Equations"):
+            gui.add_markdown(
+                "The paper's procedure (a)-(e) with the current numbers (refreshed when you release the platform)."
+            )
+            self.equations = gui.add_html("")
+        with tabs.add_tab("Class & view"):
             self.own_copy = gui.add_checkbox(
                 "Work on my own copy", False, hint="Off: everyone shares the lecturer's mechanism"
             )
@@ -100,6 +105,8 @@ class Panel:
         """Write every value of the frame's state and readout into the widgets (viser skips unchanged ones)."""
         state, readout = frame.state, frame.readout
         self.dashboard.content = frame.dashboard
+        if not frame.in_drag or not self.equations.content:
+            self.equations.content = frame.equations
         self._put(self.p, (round(float(readout.p[0]) * 1e3, 2), round(float(readout.p[1]) * 1e3, 2)))
         stroke_mm = state.params.stroke * 1e3
         for i, slider in enumerate(self.d):

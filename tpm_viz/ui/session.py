@@ -131,7 +131,7 @@ class Hub:
         if session.frame is None:
             from .frame import Frame  # viser-free, but keeps this module free of trimesh
 
-            session.frame = Frame(session.state, self.evaluate(session.state))
+            session.frame = Frame(session.state, self.evaluate(session.state), in_drag=dragging)
         if origin in views:
             views.remove(origin)
             views.insert(0, origin)
