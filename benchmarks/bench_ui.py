@@ -94,10 +94,30 @@ def bench_browser(samples: int) -> None:
     import viser.transforms as tf
     from playwright.sync_api import sync_playwright
 
+    from tpm_viz.ui import client as client_module
+
+    received: list[float] = []
+    flushed: list[float] = []
+    original_on_drag, original_drain = client_module.ClientView._on_drag, client_module.ClientView._drain_drags
+
+    async def on_drag(self, event):  # timestamp each gizmo message as the server receives it
+        received.append(time.perf_counter())
+        await original_on_drag(self, event)
+
+    def drain(self):
+        start = received[-1] if received else time.perf_counter()
+        original_drain(self)
+        flushed.append(time.perf_counter() - start)
+
+    client_module.ClientView._on_drag, client_module.ClientView._drain_drags = on_drag, drain
     app = TpmApp(build_server("127.0.0.1", 0))
     with tempfile.TemporaryDirectory() as profile, sync_playwright() as pw:
         ctx = pw.chromium.launch_persistent_context(
-            profile, executable_path=CHROMIUM, args=CHROMIUM_ARGS, headless=True, viewport={"width": 1400, "height": 860}
+            profile,
+            executable_path=CHROMIUM,
+            args=CHROMIUM_ARGS,
+            headless=True,
+            viewport={"width": 1400, "height": 860},
         )
         page = ctx.new_page()
         page.add_init_script(WORKER_LOG_JS)
@@ -115,7 +135,11 @@ def bench_browser(samples: int) -> None:
         xc = rot.T @ (point - np.asarray(cam.position))
         focal = (cam.image_height / 2) / np.tan(cam.fov / 2)
         x0, y0 = cam.image_width / 2 + focal * xc[0] / xc[2], cam.image_height / 2 + focal * xc[1] / xc[2]
-        page.evaluate("() => { window.__viserLog.length = 0; }")
+        page.evaluate(
+            "() => { window.__viserLog.length = 0; window.__frames = [];"
+            " const f = (t) => { window.__frames.push(t); requestAnimationFrame(f); }; requestAnimationFrame(f); }"
+        )
+        flushed.clear()
         page.mouse.move(x0, y0)
         page.mouse.down()
         for k in range(samples):
@@ -126,12 +150,17 @@ def bench_browser(samples: int) -> None:
         time.sleep(0.5)
         pairs = page.evaluate(_LATENCY_JS, "/tpm/platform")
         _stats("gizmo drag: update sent -> platform moved", [(b - a) / 1e3 for a, b in pairs])
+        _stats("  of which server: message received -> flushed", flushed)
+        frames = np.diff(page.evaluate("() => window.__frames")) / 1e3
+        _stats("  page frame interval during the drag", frames)
 
         # (b) Typed actuator position d1 (the number field beside the slider).
         page.evaluate("() => { window.__viserLog.length = 0; }")
-        field = page.locator(f'label[for="{view.panel.d[0]._impl.uuid}"]').locator(
-            "xpath=ancestor::div[contains(@class,'mantine-Flex-root')][1]"
-        ).locator("input.mantine-NumberInput-input")
+        field = (
+            page.locator(f'label[for="{view.panel.d[0]._impl.uuid}"]')
+            .locator("xpath=ancestor::div[contains(@class,'mantine-Flex-root')][1]")
+            .locator("input.mantine-NumberInput-input")
+        )
         for k in range(max(samples // 4, 10)):
             field.fill(f"{120 + 40 * (k % 2)}")
             field.press("Tab")
@@ -141,6 +170,7 @@ def bench_browser(samples: int) -> None:
         _stats("typed d1: update sent -> slider moved", [(b - a) / 1e3 for a, b in pairs])
         ctx.close()
     app.stop()
+    client_module.ClientView._on_drag, client_module.ClientView._drain_drags = original_on_drag, original_drain
 
 
 def bench_startup(runs: int) -> None:
