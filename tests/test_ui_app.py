@@ -349,3 +349,14 @@ def test_equations_tab_follows_the_state_but_not_every_drag_frame(connect):
     assert view.panel.equations.content == before  # not recomputed for intermediate drag frames
     client.drag(view.scene.gizmo, owner, [(0.03, 0.0, 0.09)])
     wait_for(lambda: view.panel.equations.content != before, what="refresh at the end of the drag")
+
+
+def test_camera_reframes_after_a_large_geometry_change(connect):
+    client, view = connect()
+    before = np.array(view.client.camera.position)
+    client.set_value(view.panel.params["l_a"], 500.0)
+    client.set_value(view.panel.params["a"], 900.0)
+    wait_for(lambda: view.panel.params["a"].value == 900.0, what="the input")
+    client.click(view.panel.apply)
+    wait_for(lambda: _state(view).params.a == pytest.approx(0.9), what="a = 900 mm")
+    wait_for(lambda: not np.allclose(view.client.camera.position, before), what="the camera to move")

@@ -18,6 +18,7 @@ import traceback
 import numpy as np
 import viser
 
+from .. import meshes
 from ..errors import TpmVizError
 from ..interaction import Move, drag_to, drive_to, place, switch_mode
 from ..params import PARAM_INFO, Params
@@ -47,6 +48,12 @@ def _sampled(state: AppState, sample: TrajectorySample) -> AppState:
     move = place(state.params, state.pose, p)
     load = state.load if move.clamped else Load("dynamic", dp=tuple(dp), ddp=tuple(ddp))
     return state.replace(pose=move.pose, load=load, trajectory=sample, note=move.reason)
+
+
+def _size(params: Params) -> float:
+    """Side of the base plate [m]: what the camera frames."""
+    lo, hi = meshes.base_extent(params)
+    return hi - lo
 
 
 def _report(future) -> None:
@@ -97,6 +104,9 @@ class ClientView:
         with self.client.atomic():
             self.scene.update(frame, dragging=dragging)
             self.panel.show(frame)
+            size = _size(frame.state.params)
+            if not 0.8 < size / self._framed_size < 1.25:  # the mechanism grew or shrank a lot: reframe
+                self.frame_camera(frame.state.params)
         self.client.flush()
 
     def refuse(self, text: str) -> None:
@@ -107,6 +117,7 @@ class ClientView:
 
     def frame_camera(self, params: Params) -> None:
         """Point this tab's camera at the whole mechanism."""
+        self._framed_size = _size(params)
         position, look_at = camera_pose(params)
         self.client.camera.position = position
         self.client.camera.look_at = look_at
