@@ -4,6 +4,7 @@
 - :mod:`.panels`: the control panel of one tab, handles built once, then written;
 - :mod:`.text`: formatting of the readouts (HTML), no maths;
 - :mod:`.session`: shared state, private copies and the lock that serialises changes;
+- :mod:`.frame`: one committed state and its drawing data, computed once for all tabs;
 - :mod:`.client`: one tab's callbacks (widget -> pure library function -> commit);
 - :mod:`.app`: the server and ``main(host, port)``.
 """
