@@ -195,13 +195,16 @@ def actuator_forces_from_platform_force(params: Params, p, f, d=None) -> np.ndar
     ``f`` is the force the platform exerts on its surroundings (eq. 13: ``f = J^T τ``). To
     hold an external load ``f_ext`` applied *to* the platform at rest, pass ``f = -f_ext``
     (this is what :func:`tpm_viz.inverse_dynamics` does with zero velocity and acceleration).
+    Computed as ``τ = J_q J_x^{-T} f`` (``J_q`` is diagonal), which stays finite at an inverse
+    singularity (eq. 11: the leg carries the load with no actuator force along it); raises only
+    at the direct singularity (eq. 12).
     """
     jac = jacobians(params, p, d)
     _check_regular(jac, "direct")
-    _check_regular(jac, "inverse")
-    jt = np.swapaxes(jac.j, -1, -2)
+    jxt = np.swapaxes(jac.jx, -1, -2)
     with np.errstate(over="ignore", invalid="ignore"):
-        return finite_result(np.linalg.solve(jt, as_xy(f, "f")[..., None])[..., 0], "the actuator forces")
+        g = np.linalg.solve(jxt, as_xy(f, "f")[..., None])[..., 0]
+        return finite_result(np.einsum("...ij,...j->...i", jac.jq, g), "the actuator forces")
 
 
 def platform_force_from_actuator_forces(params: Params, p, tau, d=None) -> np.ndarray:
