@@ -117,15 +117,18 @@ def test_classify_each_kind():
 
 
 def test_statics_stay_finite_at_an_inverse_singularity():
-    """Approaching cos θ1 = 0 (p2 -> l_a) the forces for a fixed platform force converge (τ = J_q J_x^{-T} f)."""
-    f = np.array([3.0, -40.0])
-    taus = [actuator_forces_from_platform_force(P, [0.05, P.l_a * (1 - eps)], f) for eps in (1e-4, 1e-6, 1e-8, 1e-10)]
-    assert np.all(np.isfinite(taus))
-    assert taus[-1] == pytest.approx(taus[-2], rel=1e-4, abs=1e-6)
-    # By hand at the limit: s1 = e_2, J_x = [[0, 1], [sin θ2, cos θ2]], J_q = diag(0, cos θ2), so
-    # τ = J_q J_x^{-T} f = (0, f_1 / tan θ2) with tan θ2 = p1 / sqrt(l_a² - p1²).
-    tan2 = 0.05 / np.sqrt(P.l_a**2 - 0.05**2)
-    assert taus[-1] == pytest.approx([0.0, f[0] / tan2], abs=2e-3)
+    """At cos θ1 = 0 (p2 = l_a) τ = J_q J_x^{-T} f is finite, and poses approaching it converge (like sqrt(ε)).
+
+    By hand at the limit: s1 = e_2, J_x = [[0, 1], [sin θ2, cos θ2]], J_q = diag(0, cos θ2), so
+    τ = (0, f_1 / tan θ2) with tan θ2 = p1 / sqrt(l_a² - p1²).
+    """
+    f, p1 = np.array([3.0, -40.0]), 0.05
+    by_hand = np.array([0.0, f[0] * np.sqrt(P.l_a**2 - p1**2) / p1])
+    d_at = np.array([p1 + P.a - P.b, P.l_a + P.a - P.b - np.sqrt(P.l_a**2 - p1**2)])  # c_1 = 0, eq. (4) for leg 2
+    assert actuator_forces_from_platform_force(P, [p1, P.l_a], f, d=d_at) == pytest.approx(by_hand, abs=1e-9)
+    for eps, tol in ((1e-8, 0.1), (1e-12, 1e-3)):
+        tau = actuator_forces_from_platform_force(P, [p1, P.l_a * (1 - eps)], f)
+        assert tau == pytest.approx(by_hand, abs=tol)
 
 
 def test_singular_configurations_raise():
