@@ -87,6 +87,26 @@ def test_configuration_matches_closed_form_inverse_kinematics(params, u, w):
     assert model.constraint_violation(q) < 1e-12
 
 
+@pytest.mark.parametrize("seed", range(5))
+def test_newton_converges_from_a_perturbed_start(seed, monkeypatch):
+    """The cold guess is exact (sin θ_1 = p_2 / l_a); Newton on Pinocchio's closure residual must also find the
+    configuration from a start off by up to 0.2 rad and 20 mm, so the solver (not the guess) carries the check."""
+    rng = np.random.default_rng(seed)
+    model = MultibodyModel(P)
+    p = rng.uniform(-0.15, 0.15, 2)
+    exact = model._guess_from_platform
+    monkeypatch.setattr(model, "_guess_from_platform", lambda p_, d_: exact(p_, d_) + _perturbation(model, rng))
+    q = model.configuration(p)
+    assert q[[model.index["slider1"], model.index["slider2"]]] == pytest.approx(tv.inverse_kinematics(P, p), abs=1e-12)
+    assert model.constraint_violation(q) < 1e-12
+
+
+def _perturbation(model, rng) -> np.ndarray:
+    dq = rng.uniform(-0.2, 0.2, model.model.nv)
+    dq[[model.index["slider1"], model.index["slider2"]]] = rng.uniform(-0.02, 0.02, 2)
+    return dq
+
+
 def test_configuration_on_the_other_branch_follows_the_given_actuators():
     p = np.array([0.03, -0.05])
     k, la = P.a - P.b, P.l_a

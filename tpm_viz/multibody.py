@@ -261,12 +261,13 @@ class MultibodyModel:
         return float(q[self.index["link1_0"]]), float(q[self.index["link2_0"]])
 
     def _guess_from_platform(self, p: np.ndarray, d: np.ndarray | None) -> np.ndarray:
-        """Starting point: the working mode with small-angle leg angles ``θ_i ≈ p_j / l_a`` (a guess
-        only), or links pointing at the platform pivots from given actuator positions ``d``."""
+        """Starting point: the working mode with leg angles ``sin θ_1 = p_2 / l_a``, ``sin θ_2 = p_1 / l_a``
+        (conventions.md), or links pointing at the platform pivots from given actuator positions ``d``.
+        Only a guess: Newton accepts it only once Pinocchio's own closure residual is at the rounding floor."""
         if d is not None:
             return self._guess_from_both(p, d)
         la, k = self.params.l_a, self.params.a - self.params.b
-        theta = (float(p[1]) / la, float(p[0]) / la)
+        theta = (math.asin(float(p[1]) / la), math.asin(float(p[0]) / la))
         d = (p[0] + k - la * math.cos(theta[0]), p[1] + k - la * math.cos(theta[1]))
         return self._pack(d, theta[0], -theta[1])
 
@@ -296,9 +297,9 @@ class MultibodyModel:
                 f"each |p_j| must be below l_a = {la * 1e3:.1f} mm"
             )
         starts = [lambda: self._guess_from_platform(p, d)]
-        if d is None and self._last is not None:  # continuation from the last pose, tangent predictor
+        if d is None and self._last is not None:  # fallback: continuation from the last pose, tangent predictor
             p_last, q_last, dq_dp = self._last
-            starts.insert(0, lambda: q_last if dq_dp is None else q_last + dq_dp @ (p - p_last))
+            starts.append(lambda: q_last if dq_dp is None else q_last + dq_dp @ (p - p_last))
         for start in starts:
             q, ok, jc, jp = self._newton(start(), p, "platform")
             working = min(math.cos(x) for x in self._link_angles(q)) > 0  # c_i = l_a cos θ_i > 0 (eq. 4)
