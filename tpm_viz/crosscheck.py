@@ -19,7 +19,7 @@ from .jacobians import classify
 from .multibody import inverse_dynamics as pinocchio_inverse_dynamics
 from .params import Params
 from .replay import replay
-from .trajectories import DEFAULT_DURATIONS, paper_trajectory
+from .trajectories import paper_duration, paper_trajectory
 
 __all__ = [
     "CrosscheckRow",
@@ -117,7 +117,7 @@ def crosscheck(
     """The three comparisons of the module docstring, one :class:`CrosscheckRow` each."""
     rows = []
     for kind, duration in (("line", duration_line), ("circle", duration_circle)):
-        duration = DEFAULT_DURATIONS[kind] if duration is None else duration
+        duration = paper_duration(kind, duration)
         cmp = compare_forces(params, kind, duration)
         rep = replay(params, kind, duration, dt)
         ok = (

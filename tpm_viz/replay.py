@@ -26,7 +26,7 @@ from .dynamics import inverse_dynamics
 from .errors import InputError
 from .multibody import model_for
 from .params import Params
-from .trajectories import DEFAULT_DURATIONS, circle_state, line_state
+from .trajectories import circle_state, line_state, paper_duration, positive_seconds
 
 __all__ = ["DEFAULT_DT", "MAX_STEPS", "MIN_STEPS", "ReplayResult", "replay"]
 
@@ -71,32 +71,11 @@ class ReplayResult:
 
 
 def _steps(duration: float, dt: float | None) -> int:
-    if dt is None:
-        dt = min(DEFAULT_DT, duration / MIN_STEPS)
-    try:
-        dt = float(dt)
-    except (TypeError, ValueError):
-        raise InputError(f"time step must be a number of seconds, got {dt!r}") from None
-    if not math.isfinite(dt) or dt <= 0:
-        raise InputError(f"time step must be a positive, finite number of seconds, got {dt:g}")
+    dt = min(DEFAULT_DT, duration / MIN_STEPS) if dt is None else positive_seconds(dt, "time step")
     steps = max(1, math.ceil(duration / dt - 1e-9))
     if steps > MAX_STEPS:
         raise InputError(f"duration / dt = {steps} steps exceeds the limit of {MAX_STEPS}")
     return steps
-
-
-def _duration(kind: str, duration) -> float:
-    if kind not in DEFAULT_DURATIONS:
-        raise InputError(f"trajectory kind must be 'line' or 'circle', got {kind!r}")
-    if duration is None:
-        return DEFAULT_DURATIONS[kind]
-    try:
-        duration = float(duration)
-    except (TypeError, ValueError):
-        raise InputError(f"duration must be a number of seconds, got {duration!r}") from None
-    if not math.isfinite(duration) or duration <= 0:
-        raise InputError(f"duration must be a positive, finite number of seconds, got {duration:g}")
-    return duration
 
 
 def replay(
@@ -117,7 +96,7 @@ def replay(
     """
     if not isinstance(params, Params) or not isinstance(force_params, Params | None):
         raise InputError("replay needs tpm_viz.Params parameter sets")
-    duration = _duration(kind, duration)
+    duration = paper_duration(kind, duration)
     steps = _steps(duration, dt)
     h = duration / steps
     state = line_state if kind == "line" else circle_state

@@ -28,8 +28,10 @@ __all__ = [
     "Trajectory",
     "circle_state",
     "line_state",
+    "paper_duration",
     "paper_trajectory",
     "parse_trajectory_csv",
+    "positive_seconds",
     "trajectory_from_samples",
 ]
 
@@ -59,14 +61,24 @@ class Trajectory:
         return float(self.t[-1] - self.t[0])
 
 
-def _check_duration(duration: float) -> float:
+def positive_seconds(value, what: str = "duration") -> float:
+    """``value`` as a positive, finite number of seconds, or a one-line :class:`InputError` naming ``what``."""
     try:
-        duration = float(duration)
+        value = float(value)
     except (TypeError, ValueError):
-        raise InputError(f"duration must be a number of seconds, got {duration!r}") from None
-    if not math.isfinite(duration) or duration <= 0:
-        raise InputError(f"duration must be a positive, finite number of seconds, got {duration:g}")
-    return duration
+        raise InputError(f"{what} must be a number of seconds, got {value!r}") from None
+    if not math.isfinite(value) or value <= 0:
+        raise InputError(f"{what} must be a positive, finite number of seconds, got {value:g}")
+    return value
+
+
+def paper_duration(kind: str, duration: float | None = None) -> float:
+    """The validated duration [s] of the paper's ``kind`` trajectory (its default when ``duration`` is None)."""
+    if kind not in DEFAULT_DURATIONS:
+        raise InputError(f"trajectory kind must be 'line' or 'circle', got {kind!r}")
+    return DEFAULT_DURATIONS[kind] if duration is None else positive_seconds(duration)
+
+
 
 
 def _check_samples(samples: int) -> int:
@@ -91,7 +103,7 @@ def _cubic_law(t, duration: float):
 
 def line_state(t, duration: float = DEFAULT_DURATIONS["line"], start=LINE_START, end=LINE_END):
     """``(p, ṗ, p̈)`` on the straight line at times ``t`` [s]; each of shape ``t.shape + (2,)``."""
-    duration = _check_duration(duration)
+    duration = positive_seconds(duration)
     s, ds, dds = _cubic_law(t, duration)
     start, delta = np.asarray(start, float), np.asarray(end, float) - np.asarray(start, float)
     return start + s[..., None] * delta, ds[..., None] * delta, dds[..., None] * delta
@@ -99,7 +111,7 @@ def line_state(t, duration: float = DEFAULT_DURATIONS["line"], start=LINE_START,
 
 def circle_state(t, duration: float = DEFAULT_DURATIONS["circle"], centre=CIRCLE_CENTRE, radius=CIRCLE_RADIUS):
     """``(p, ṗ, p̈)`` on the circle at times ``t`` [s] (polar angle ``φ = 2π s(t/T)``)."""
-    duration = _check_duration(duration)
+    duration = positive_seconds(duration)
     s, ds, dds = _cubic_law(t, duration)
     phi, dphi, ddphi = 2 * np.pi * s, 2 * np.pi * ds, 2 * np.pi * dds
     radial = np.stack([np.cos(phi), np.sin(phi)], -1)
@@ -112,9 +124,7 @@ def circle_state(t, duration: float = DEFAULT_DURATIONS["circle"], centre=CIRCLE
 
 def paper_trajectory(kind: str, duration: float | None = None, samples: int = 201) -> Trajectory:
     """The paper's ``"line"`` (Fig. 4) or ``"circle"`` (Fig. 5) sampled at ``samples`` times."""
-    if kind not in DEFAULT_DURATIONS:
-        raise InputError(f"trajectory kind must be 'line' or 'circle', got {kind!r}")
-    duration = _check_duration(DEFAULT_DURATIONS[kind] if duration is None else duration)
+    duration = paper_duration(kind, duration)
     t = np.linspace(0.0, duration, _check_samples(samples))
     state = line_state if kind == "line" else circle_state
     p, dp, ddp = state(t, duration)
