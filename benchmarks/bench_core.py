@@ -7,28 +7,10 @@ a 200 x 200 singularity map < 50 ms.
 
 from __future__ import annotations
 
-import statistics
-import time
-
 import numpy as np
+from timing import median_seconds, report
 
 import tpm_viz as tv
-
-
-def median_seconds(fn, repeat: int, inner: int = 1) -> float:
-    fn()  # warm-up
-    samples = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        for _ in range(inner):
-            fn()
-        samples.append((time.perf_counter() - t0) / inner)
-    return statistics.median(samples)
-
-
-def report(name: str, seconds: float, target: float, unit: str, scale: float) -> None:
-    print(f"{name:<44} median {seconds * scale:9.2f} {unit}   target {target * scale:7.1f} {unit}"
-          f"   ratio {seconds / target:5.2f}")
 
 
 def main() -> None:

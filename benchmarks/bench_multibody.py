@@ -6,30 +6,12 @@ dynamics < 200 µs per state in Python, forward-dynamics replay of the 0.5 s cir
 
 from __future__ import annotations
 
-import statistics
-import time
-
 import numpy as np
+from timing import median_seconds, report
 
 import tpm_viz as tv
 from tpm_viz import multibody
 from tpm_viz.replay import replay
-
-
-def median_seconds(fn, repeat: int, inner: int = 1) -> float:
-    fn()  # warm-up
-    samples = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        for _ in range(inner):
-            fn()
-        samples.append((time.perf_counter() - t0) / inner)
-    return statistics.median(samples)
-
-
-def report(name: str, seconds: float, target: float | None, unit: str, scale: float) -> None:
-    tail = "" if target is None else f"   target {target * scale:7.1f} {unit}   ratio {seconds / target:5.2f}"
-    print(f"{name:<58} median {seconds * scale:9.2f} {unit}{tail}")
 
 
 def main() -> None:
