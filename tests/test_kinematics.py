@@ -12,6 +12,7 @@ from reference import ik_quadratic
 from strategies import params_sets, regular_states
 
 from tpm_viz import (
+    FK_STATUS,
     InputError,
     Params,
     SingularConfigurationError,
@@ -88,6 +89,7 @@ def test_modes_merge_on_the_third_quadrant_direct_singularity(phi):
     sol = forward_kinematics_both(P, d)
     assert np.linalg.norm(sol.plus - sol.minus) < 1e-5
     assert sol.plus == pytest.approx(p, abs=1e-5)
+    assert FK_STATUS[int(sol.status)].startswith("direct singularity: the two assembly modes merge")
     # just inside, two distinct modes on either side of the locus
     sol_in = forward_kinematics_both(P, inverse_kinematics(P, 0.95 * p))
     assert np.linalg.norm(sol_in.plus - sol_in.minus) > 1e-3
@@ -101,6 +103,7 @@ def test_first_quadrant_direct_singularity_is_a_coincidence_of_the_leg_circles()
         assert abs(float(jacobians(P, p).det_jx)) < 1e-12
     with pytest.raises(SingularConfigurationError, match="coincide"):
         forward_kinematics(P, [P.a - P.b] * 2)
+    assert "coincide" in FK_STATUS[int(forward_kinematics_both(P, [P.a - P.b] * 2).status)]
 
 
 def test_unreachable_and_unassemblable_raise_one_line_errors():
@@ -113,6 +116,8 @@ def test_unreachable_and_unassemblable_raise_one_line_errors():
     with pytest.raises(InputError, match=r"shape \(\.\.\., 2\)"):
         inverse_kinematics(P, [0.0, 0.0, 0.0])
     assert not forward_kinematics_both(P, [0.0, 0.9]).exists
+    assert FK_STATUS[int(forward_kinematics_both(P, [0.0, 0.9]).status)].startswith("cannot assemble")
+    assert FK_STATUS[int(forward_kinematics_both(P, [0.1, 0.1]).status)] == "two assembly modes"
 
 
 def test_ik_is_vectorised_over_leading_axes():

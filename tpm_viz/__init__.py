@@ -28,6 +28,7 @@ from .jacobians import (
     theta_dot,
 )
 from .kinematics import (
+    FK_STATUS,
     FkSolutions,
     MechanismPose,
     forward_kinematics,
@@ -55,6 +56,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "DEFAULT_DURATIONS",
+    "FK_STATUS",
     "PARAM_INFO",
     "STATUS_LABELS",
     "DynamicsResult",

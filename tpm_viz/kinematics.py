@@ -21,6 +21,7 @@ from .errors import InputError, SingularConfigurationError, UnreachablePoseError
 from .params import Params
 
 __all__ = [
+    "FK_STATUS",
     "FkSolutions",
     "MechanismPose",
     "as_xy",
@@ -123,12 +124,23 @@ class FkSolutions(NamedTuple):
     takes two forms: ``s_1 = -s_2``, the circles touch and the two modes merge (in the working
     mode: the arc ``p_1² + p_2² = l_a²`` in the third quadrant); ``s_1 = s_2``, the circles
     coincide (``d_1 = d_2 = a - b``, first-quadrant arc) and the position is undetermined.
-    ``exists`` is False where the circles do not meet or coincide (positions are NaN there).
+    ``exists`` is False where the circles do not meet or coincide (positions are NaN there);
+    ``status`` holds a code of :data:`FK_STATUS` per input.
     """
 
     plus: np.ndarray
     minus: np.ndarray
     exists: np.ndarray
+    status: np.ndarray
+
+
+FK_STATUS = {
+    0: "two assembly modes",
+    1: "direct singularity: the two assembly modes merge (eq. 12)",
+    2: "cannot assemble: the leg circles are more than 2 l_a apart",
+    3: "direct singularity: the leg circles coincide, the platform position is undetermined (eq. 12)",
+}
+"""Codes of :attr:`FkSolutions.status`."""
 
 
 def forward_kinematics_both(params: Params, d) -> FkSolutions:
@@ -163,7 +175,10 @@ def _fk_both(params: Params, d: np.ndarray) -> FkSolutions:
     swap = (det_a < 0)[..., None]
     plus = np.where(swap, cand_b, cand_a)
     minus = np.where(swap, cand_a, cand_b)
-    return FkSolutions(plus, minus, exists)
+    status = np.where(h <= 1e-9 * params.l_a, 1, 0)
+    status = np.where(half > params.l_a * (1 + 1e-12), 2, status)
+    status = np.where(dist <= 1e-12 * params.l_a, 3, status)
+    return FkSolutions(plus, minus, exists, np.where(np.isfinite(dist), status, 2))
 
 
 def _cross_s(params: Params, p: np.ndarray, d: np.ndarray) -> np.ndarray:
