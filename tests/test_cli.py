@@ -66,6 +66,28 @@ def test_trajectory_samples_the_cubic_line(tmp_path):
     assert {"d1", "dd1", "ddd1", "tau1", "tau2", "theta1", "det_jx", "cond"} <= set(r[0])
 
 
+def test_trajectory_from_a_users_csv_matches_the_paper_circle(tmp_path):
+    """Timed positions of the paper's circle in, spline derivatives and forces out (vs the exact trajectory)."""
+    t = np.linspace(0, 0.5, 401)
+    phi = 2 * np.pi * (3 * (t / 0.5) ** 2 - 2 * (t / 0.5) ** 3)
+    src = tmp_path / "path.csv"
+    lines = (f"{a:.17g},{0.1 * np.cos(b):.17g},{0.1 * np.sin(b):.17g}" for a, b in zip(t, phi, strict=True))
+    src.write_text("t,p1,p2\n" + "\n".join(lines))
+    res = run("trajectory", "--input", str(src))
+    assert res.returncode == 0, res.stderr
+    r = rows(res.stdout)
+    exact = rows(run("trajectory", "--kind", "circle", "--samples", "401").stdout)
+    mid = slice(40, -40)  # away from the natural spline's free ends
+    for col in ("dp1", "tau1", "tau2"):
+        got = np.array([float(x[col]) for x in r])[mid]
+        ref = np.array([float(x[col]) for x in exact])[mid]
+        assert got == pytest.approx(ref, abs=2e-3 * np.abs(ref).max())
+    bad = run("trajectory", "--input", str(src), "--duration", "1")
+    assert bad.returncode == 2 and "--duration" in bad.stderr
+    both = run("trajectory", "--input", str(src), "--kind", "line")
+    assert both.returncode == 2 and "not allowed with" in both.stderr
+
+
 @pytest.mark.parametrize(
     ("args", "content", "message"),
     [

@@ -12,13 +12,13 @@ import sys
 
 import numpy as np
 
-from .csvio import read_columns, write_columns
+from .csvio import read_columns, read_text, write_columns
 from .dynamics import inverse_dynamics_detail
 from .errors import InputError, TpmVizError
 from .jacobians import STATUS_LABELS, classify, condition_number, jacobians
 from .kinematics import inverse_kinematics, leg_angles, reachable
 from .params import PARAM_INFO, Params
-from .trajectories import paper_trajectory
+from .trajectories import paper_trajectory, parse_trajectory_csv
 
 __all__ = ["build_parser", "main", "params_from_args"]
 
@@ -119,7 +119,12 @@ def _cmd_dynamics(args) -> int:
 
 def _cmd_trajectory(args) -> int:
     params = params_from_args(args)
-    traj = paper_trajectory(args.kind, args.duration, args.samples)
+    if args.input is not None:
+        if args.duration is not None:
+            raise InputError("--duration applies to --kind, not to a trajectory read with --input")
+        traj = parse_trajectory_csv(read_text(args.input), name=args.input)
+    else:
+        traj = paper_trajectory(args.kind, args.duration, args.samples)
     _check_reachable(params, traj.p)
     cols: dict[str, np.ndarray] = {"t": traj.t}
     for name, arr in (("p", traj.p), ("dp", traj.dp), ("ddp", traj.ddp)):
@@ -178,8 +183,15 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--fext", metavar="FX,FY", help="external force on the platform [N]")
     d.set_defaults(func=_cmd_dynamics)
 
-    t = sub.add_parser("trajectory", parents=[common], help="the paper's line or circle, sampled (Figs. 4-5)")
-    t.add_argument("--kind", choices=["line", "circle"], required=True)
+    t = sub.add_parser(
+        "trajectory", parents=[common],
+        help="the paper's line or circle (Figs. 4-5), or your own timed path t,p1,p2, with forces",
+    )
+    source = t.add_mutually_exclusive_group(required=True)
+    source.add_argument("--kind", choices=["line", "circle"], help="the paper's trajectory")
+    source.add_argument(
+        "--input", help="CSV with columns t,p1,p2 [s, m]; derivatives of its natural cubic spline"
+    )
     t.add_argument("--duration", type=_positive_float, help="duration T [s] (default: line 0.2, circle 0.5)")
     t.add_argument("--samples", type=int, default=201, help="number of samples (default 201)")
     t.add_argument("--output", help="output CSV (default: stdout)")

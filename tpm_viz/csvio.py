@@ -18,7 +18,7 @@ import numpy as np
 
 from .errors import InputError
 
-__all__ = ["OPTIONAL_COLUMNS", "parse_columns", "read_columns", "write_columns"]
+__all__ = ["OPTIONAL_COLUMNS", "parse_columns", "read_columns", "read_text", "write_columns"]
 
 OPTIONAL_COLUMNS = ("t",)
 """Columns accepted in any input and passed through to the output (time [s])."""
@@ -26,12 +26,15 @@ OPTIONAL_COLUMNS = ("t",)
 
 def read_columns(path: str, required: Sequence[str]) -> dict[str, np.ndarray]:
     """Read a CSV file (``-`` for stdin) whose header holds exactly ``required`` (+ optional ``t``)."""
+    return parse_columns(read_text(path), required, source=path)
+
+
+def read_text(path: str) -> str:
+    """The text of a file (``-`` for stdin), BOM-tolerant."""
     if path == "-":
-        text = sys.stdin.read()
-    else:
-        with open(path, encoding="utf-8-sig") as fh:
-            text = fh.read()
-    return parse_columns(text, required, source=path)
+        return sys.stdin.read()
+    with open(path, encoding="utf-8-sig") as fh:
+        return fh.read()
 
 
 def parse_columns(text: str, required: Sequence[str], source: str = "input") -> dict[str, np.ndarray]:
