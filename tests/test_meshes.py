@@ -71,3 +71,39 @@ def test_segments_helpers():
     segs = m.polyline_segments([np.zeros((3, 2)), np.zeros((1, 2))], 0.0)
     assert segs.shape == (2, 2, 3)
     assert m.polyline_segments([], 0.0).shape == (0, 2, 3)
+
+
+def test_workspace_region_covers_exactly_the_in_stroke_poses():
+    """The floor overlay, probed at random points, agrees with eq. (4) and the stroke (not only with the mask)."""
+    from tpm_viz import in_stroke, inverse_kinematics, reachable, workspace_map
+    from tpm_viz.meshes import region_mesh
+
+    P = Params.paper()
+    ws = workspace_map(P, n=120)
+    mesh = region_mesh(ws.in_stroke, ws.xs, ws.ys, 0.0)
+    rng = np.random.default_rng(5)
+    pts = rng.uniform(-P.l_a, P.l_a, size=(400, 2))
+    half_cell = ws.xs[1] - ws.xs[0]
+    tri = mesh.triangles[:, :, :2]  # (F, 3, 2), flat at z = 0
+
+    def cross(o, a, b):
+        return (a[..., 0] - o[..., 0]) * (b[..., 1] - o[..., 1]) - (a[..., 1] - o[..., 1]) * (b[..., 0] - o[..., 0])
+
+    q = pts[:, None, :]  # (N, 1, 2) against (F, ...)
+    s0, s1, s2 = (cross(tri[None, :, k], tri[None, :, (k + 1) % 3], q) for k in range(3))
+    inside = np.any(((s0 >= 0) & (s1 >= 0) & (s2 >= 0)) | ((s0 <= 0) & (s1 <= 0) & (s2 <= 0)), axis=1)
+    truth = reachable(P, pts)
+    truth &= in_stroke(P, inverse_kinematics(P, np.where(truth[:, None], pts, 0.0)))
+    # points farther than a cell from the boundary must agree; e.g. (-0.17, -0.17) is in, (0.2, -0.2) is out
+    far = np.array([_far_from_boundary(P, p, half_cell) for p in pts])
+    assert np.array_equal(np.array(inside)[far], truth[far])
+    assert far.sum() > 300
+
+
+def _far_from_boundary(P, p, r) -> bool:
+    from tpm_viz import in_stroke, inverse_kinematics, reachable
+
+    probe = p + r * np.array([[1, 0], [-1, 0], [0, 1], [0, -1], [1, 1], [-1, -1], [1, -1], [-1, 1], [0, 0]])
+    ok = reachable(P, probe)
+    state = ok & in_stroke(P, inverse_kinematics(P, np.where(ok[:, None], probe, 0.0)))
+    return bool(state.all() or (~state).all())
