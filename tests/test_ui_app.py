@@ -80,7 +80,7 @@ def test_loopback_detection_and_warning(monkeypatch):
     import tpm_viz.ui.app as app_module
 
     class Fake:
-        def __init__(self, server):
+        def __init__(self, server, **kwargs):
             self.port = 1234
 
     monkeypatch.setattr(app_module, "build_server", lambda host, port: None)

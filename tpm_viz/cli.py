@@ -139,7 +139,7 @@ def _cmd_trajectory(args) -> int:
 def _cmd_serve(args) -> int:
     from .ui.app import main as serve  # lazy: viser only for the app
 
-    serve(host=args.host, port=args.port)
+    serve(host=args.host, port=args.port, presenter_token=args.presenter_token)
     return 0
 
 
@@ -202,6 +202,11 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("serve", help="start the browser app")
     s.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1, loopback only)")
     s.add_argument("--port", type=int, default=8080, help="port (default 8080; the next free one if busy)")
+    s.add_argument(
+        "--presenter-token",
+        metavar="TOKEN",
+        help="only a tab that logs in with TOKEN changes the shared mechanism (others use their own copy)",
+    )
     s.set_defaults(func=_cmd_serve)
 
     try:

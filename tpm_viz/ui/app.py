@@ -1,10 +1,14 @@
 """The browser app: a viser server on 127.0.0.1, one :class:`ClientView` per tab, one shared mechanism.
 
-``main(host, port)`` is what ``python app.py`` and ``tpm-viz serve`` call. It prints exactly one line with the
-URL the server really got (viser moves to the next port when one is busy) and serves until Ctrl-C.
+``main(host, port, presenter_token=None)`` is what ``python app.py`` and ``tpm-viz serve`` call. It prints
+exactly one line with the URL the server really got (viser moves to the next port when one is busy) and serves
+until Ctrl-C; problems go to the ``tpm_viz.ui`` logger (stderr).
 
-Safety: the default host is loopback. viser's share-URL tunnel (an outside relay that a client can request even
-with the button hidden) is disabled by replacing ``server.request_share_url`` with a no-op.
+Safety: the default host is loopback, and a warning is printed for any other address. viser's share-URL tunnel (an
+outside relay that a client can request even with the button hidden) is disabled by replacing
+``server.request_share_url`` with a no-op. Uploads larger than :data:`~.validate.MAX_UPLOAD_BYTES` are dropped
+before viser buffers them. With a presenter token only the presenter's tab changes the shared mechanism
+(:mod:`.access`). Connect and disconnect handlers are guarded (:mod:`.guard`): one bad tab never stops the server.
 """
 
 from __future__ import annotations
@@ -12,17 +16,22 @@ from __future__ import annotations
 import contextlib
 import io
 import ipaddress
+import logging
 import sys
 import threading
 import time
 
 import viser
 
+from ..errors import TpmVizError
 from ..params import Params
 from ..readouts import Reference
+from .access import Access, LoginPanel
 from .client import ClientView
+from .guard import guarded, log
 from .scene import camera_pose
 from .session import AppState, Hub
+from .validate import MAX_UPLOAD_BYTES
 
 __all__ = ["TpmApp", "build_server", "main"]
 
@@ -32,6 +41,41 @@ BRAND = (13, 148, 136)
 def _no_share_url(*_args, **_kwargs) -> None:
     """Replacement of ``ViserServer.request_share_url``: the share tunnel stays off."""
     return None
+
+
+def limit_uploads(client: viser.ClientHandle, max_bytes: int = MAX_UPLOAD_BYTES) -> None:
+    """Drop file transfers from ``client`` that declare more than ``max_bytes`` (or send more than they declare).
+
+    viser buffers every upload part in memory until the declared size arrives, with no limit of its own; this
+    wraps its two upload handlers on the client's connection (viser 1.1.1 internals, pinned by a test)."""
+    conn, gui = client._websock_connection, client.gui
+    start_handler, part_handler = gui._handle_file_transfer_start, gui._handle_file_transfer_part
+    transfers = gui._current_file_upload_states
+
+    def refuse(what: str) -> None:
+        log.warning("client %s: upload refused: %s", client.client_id, what)
+        with contextlib.suppress(Exception):
+            client.add_notification("Upload refused", what, color="red", auto_close_seconds=8.0)
+
+    def start(client_id, message) -> None:
+        size, parts = message.size_bytes, message.part_count
+        if not (0 <= size <= max_bytes and 0 <= parts <= max(1, size)):
+            refuse(f"the file is too large ({size} bytes; at most {max_bytes} bytes)")
+            return
+        start_handler(client_id, message)
+
+    def part(client_id, message) -> None:
+        state = transfers.get(message.transfer_uuid)
+        if state is not None and state["transferred_bytes"] + len(message.content) > state["total_bytes"]:
+            transfers.pop(message.transfer_uuid, None)
+            refuse("the file sent more bytes than it announced")
+            return
+        part_handler(client_id, message)
+
+    conn.unregister_handler(viser._messages.FileTransferStartUpload, start_handler)
+    conn.unregister_handler(viser._messages.FileTransferPart, part_handler)
+    conn.register_handler(viser._messages.FileTransferStartUpload, start)
+    conn.register_handler(viser._messages.FileTransferPart, part)
 
 
 def _reference() -> Reference | None:
@@ -74,9 +118,16 @@ def build_server(host: str = "127.0.0.1", port: int = 8080) -> viser.ViserServer
 class TpmApp:
     """The app on one server: the hub (shared state, lock) and a view per connected tab."""
 
-    def __init__(self, server: viser.ViserServer, params: Params | None = None, reference="auto") -> None:
+    def __init__(
+        self,
+        server: viser.ViserServer,
+        params: Params | None = None,
+        reference="auto",
+        presenter_token: str | None = None,
+    ) -> None:
         self.server = server
-        self.hub = Hub(AppState.initial(params), _reference() if reference == "auto" else reference)
+        self.access = Access(presenter_token)
+        self.hub = Hub(AppState.initial(params), _reference() if reference == "auto" else reference, self.access)
         self.hub.evaluate(self.hub.shared.state)  # warm-up: builds the Pinocchio model once
         self.views: dict[int, ClientView] = {}
         self._views_lock = threading.Lock()
@@ -92,17 +143,42 @@ class TpmApp:
         """The port the server really listens on."""
         return self.server.get_port()
 
+    @guarded
     def _connect(self, client: viser.ClientHandle) -> None:
+        limit_uploads(client)
         view = ClientView(client, self.hub)
+        if self.access.enabled:
+            view.login = LoginPanel(client.gui, lambda event, view=view: self._login(event, view))
         with self._views_lock:
             self.views[client.client_id] = view
         self._class_info()
 
+    @guarded
     def _disconnect(self, client: viser.ClientHandle) -> None:
         with self._views_lock:
             view = self.views.pop(client.client_id, None)
         if view is not None:
+            self.access.logout(view)
             view.close()
+
+    @guarded
+    def _login(self, event, view: ClientView) -> None:
+        """*Log in as presenter*: check the typed token (cleared at once) and tell this tab only."""
+        if getattr(event, "client", None) is None or view.closed:
+            return
+        attempt = view.login.take()
+        try:
+            ok = self.access.login(view, attempt)
+        except TpmVizError as exc:
+            view.refuse(str(exc), resync=False)
+            return
+        if not ok:
+            log.warning("client %s: wrong presenter token", view.client.client_id)
+            view.refuse("wrong presenter token", resync=False)
+            return
+        log.info("client %s is now a presenter tab", view.client.client_id)
+        view.login.show("**You are the presenter**: your changes go to the shared mechanism.")
+        self._class_info()
 
     def _class_info(self) -> None:
         connected = set(self.server.get_clients())
@@ -111,22 +187,41 @@ class TpmApp:
         shared = self.hub.shared_viewers()
         for view in views:
             where = "your own copy" if not view.session.shared else "the shared mechanism"
-            view.set_class_info(f"{len(views)} tab(s) connected, {shared} on the shared mechanism. You see {where}.")
+            text = f"{len(views)} tab(s) connected, {shared} on the shared mechanism. You see {where}."
+            if self.access.enabled:
+                who = "you are" if self.access.is_presenter(view) else "only the presenter is"
+                text += f" Presenter mode: {who} allowed to change the shared mechanism."
+            view.set_class_info(text)
 
     def stop(self) -> None:
         """Stop the server (the port is free again at once)."""
         self.server.stop()
 
 
-def main(host: str = "127.0.0.1", port: int = 8080, block: bool = True) -> TpmApp:
-    """Serve the app; print one line with the real URL; block until Ctrl-C unless ``block`` is False."""
+def _log_to_stderr() -> None:
+    """Send the app's log (refusals of uploads, failed callbacks with tracebacks) to stderr, once."""
+    logger = logging.getLogger("tpm_viz")
+    if not logger.handlers:
+        handler = logging.StreamHandler(sys.stderr)
+        handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
+        logger.addHandler(handler)
+        logger.setLevel(logging.INFO)
+
+
+def main(host: str = "127.0.0.1", port: int = 8080, block: bool = True, presenter_token: str | None = None) -> TpmApp:
+    """Serve the app; print one line with the real URL; block until Ctrl-C unless ``block`` is False.
+
+    ``presenter_token``: if given, only a tab that logs in with it changes the shared mechanism."""
+    access = Access(presenter_token)  # validates the token before anything starts
     if not is_loopback(host):
+        who = "the presenter (token) can" if access.enabled else "anyone who can reach this address can"
         print(
-            f"warning: serving on {host}: anyone who can reach this address can change the shared mechanism "
-            "(there is no authentication)",
+            f"warning: serving on {host}, not only this machine: {who} change the shared mechanism "
+            "(no encryption: use a trusted network)",
             file=sys.stderr,
         )
-    app = TpmApp(build_server(host, port))
+    _log_to_stderr()
+    app = TpmApp(build_server(host, port), presenter_token=presenter_token)
     shown = "127.0.0.1" if host in ("0.0.0.0", "::") else host
     print(f"tpm-viz serving at http://{shown}:{app.port}", flush=True)
     if not block:

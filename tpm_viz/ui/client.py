@@ -4,7 +4,9 @@ Every callback has the same shape: under the hub's lock, read the widget's *curr
 pure library function (:mod:`tpm_viz.interaction`, :mod:`tpm_viz.poses`, ``Params.replace``, trajectories),
 and commit the new state, which redraws every view of the session. Events that the server caused itself (a
 value written by :meth:`Panel.show`, which viser echoes synchronously with ``client=None``) are ignored.
-A refused input is reported to this tab only; the last good state stays.
+A refused input is reported to this tab only, its widgets are re-synced and the last good state stays. The state
+transitions themselves are the pure functions of :mod:`.transitions`; every callback is wrapped by
+:func:`.guard.guarded`, so an unexpected exception is logged and reported to the tab, never left to the pool.
 """
 
 from __future__ import annotations
@@ -20,34 +22,21 @@ import viser
 
 from .. import meshes
 from ..errors import TpmVizError
-from ..interaction import Move, drag_to, drive_to, place, switch_mode
-from ..params import PARAM_INFO, Params
-from ..poses import DEMO_KINDS, demo_pose, home_pose, settle
-from ..readouts import LOAD_MODES, Load
-from ..trajectories import circle_state, line_state
+from ..params import Params
+from ..poses import DEMO_KINDS
+from . import transitions
 from .frame import Frame
+from .guard import guarded
 from .panels import Panel
 from .scene import MechanismScene, camera_pose
-from .session import TRAJECTORY_KINDS, AppState, Hub, Session, TrajectorySample, read_number, read_vec2
+from .session import AppState, Hub, Session, TrajectorySample
+from .transitions import sampled as _sampled
 
 __all__ = ["ClientView"]
 
 PLAY_SECONDS = 4.0  # s, wall-clock length of a played trajectory (slow motion)
 PLAY_FRAMES = 100
-MAX_FORCE = 1e5  # N, bound on typed forces
-MAX_SPEED = 100.0  # m/s
-MAX_ACCEL = 1e5  # m/s²
-
-
-def _sampled(state: AppState, sample: TrajectorySample) -> AppState:
-    """``state`` driven by a trajectory sample: the pose at ``p(t)`` (working mode) and ``ṗ(t), p̈(t)`` as a
-    dynamic load; unchanged pose and load, with the reason, if ``p(t)`` is not valid for these parameters."""
-    if sample.kind == "none":
-        return state.replace(trajectory=sample, note="")
-    p, dp, ddp = (line_state if sample.kind == "line" else circle_state)(sample.t, sample.duration)
-    move = place(state.params, state.pose, p)
-    load = state.load if move.clamped else Load("dynamic", dp=tuple(dp), ddp=tuple(ddp))
-    return state.replace(pose=move.pose, load=load, trajectory=sample, note=move.reason)
+NOTIFY_AGAIN_SECONDS = 5.0  # the same refusal pops up at most once per this many seconds per tab
 
 
 def _size(params: Params) -> float:
@@ -62,9 +51,15 @@ def _report(future) -> None:
         traceback.print_exception(future.exception())
 
 
+def _internal_error(view: ClientView, exc: Exception) -> None:
+    """The guard's report to the tab whose callback failed (the traceback is in the server log)."""
+    view.refuse(f"internal error ({type(exc).__name__}), logged on the server")
+
+
 def _callback(method):
     """Run a handler under the hub's lock; ignore server-side echoes; report refused input to this tab."""
 
+    @guarded(on_error=_internal_error)
     @functools.wraps(method)
     def wrapper(self: ClientView, event, *args) -> None:
         if getattr(event, "client", None) is None:
@@ -88,6 +83,7 @@ class ClientView:
         self.hub = hub
         self.closed = False
         self._pending_drags: list[tuple[str, np.ndarray]] = []
+        self._notified: tuple[str, float] = ("", 0.0)
         with hub.lock:
             state = hub.shared.state
             self.scene = MechanismScene(client.scene, state.params)
@@ -109,10 +105,18 @@ class ClientView:
                 self.frame_camera(frame.state.params)
         self.client.flush()
 
-    def refuse(self, text: str) -> None:
-        """Tell this tab (only) that its input was refused; the mechanism keeps its last good state."""
+    def refuse(self, text: str, resync: bool = True) -> None:
+        """Tell this tab (only) that its input was refused; the mechanism keeps its last good state and, with
+        ``resync``, this tab's widgets and gizmo show that state again."""
         self.panel.tell(f"Refused: {text}")
-        self.client.add_notification("Input refused", text, color="red", auto_close_seconds=8.0)
+        now = time.monotonic()
+        if self._notified[0] != text or now - self._notified[1] > NOTIFY_AGAIN_SECONDS:
+            self._notified = (text, now)
+            self.client.add_notification("Input refused", text, color="red", auto_close_seconds=8.0)
+        if resync and self.session.frame is not None:
+            self.panel.forget()
+            self.scene.forget()
+            self.render(self.session.frame)
         self.client.flush()
 
     def frame_camera(self, params: Params) -> None:
@@ -134,14 +138,10 @@ class ClientView:
 
     # -- commits -------------------------------------------------------------------------------------------
     def _commit(self, state: AppState, dragging: bool = False) -> None:
+        self.hub.authorize(self, self.session)  # before anything changes (presenter mode)
         self.panel.tell("")
         self.session.play_token += 1  # any input stops a playing trajectory
         self.hub.commit(self.session, state, origin=self, dragging=dragging)
-
-    def _move(self, move: Move, **changes) -> None:
-        state = self.session.state
-        changes.setdefault("trajectory", TrajectorySample("none", state.trajectory.duration, 0.0))
-        self._commit(state.replace(pose=move.pose, note=move.reason, **changes))
 
     # -- wiring --------------------------------------------------------------------------------------------
     def _wire(self) -> None:
@@ -166,11 +166,13 @@ class ClientView:
             handle.on_update(lambda event, what=what: self._on_show(event, what))
         panel.frame_camera.on_click(self._on_frame)
 
+    @guarded
     async def _on_drag(self, event) -> None:
         """Gizmo events, in arrival order on the event loop: keep a snapshot, hand the work to the pool."""
         self._pending_drags.append((event.phase, np.array(event.target.position, dtype=float)))
         asyncio.get_running_loop().run_in_executor(None, self._drain_drags).add_done_callback(_report)
 
+    @guarded(on_error=_internal_error)
     def _drain_drags(self) -> None:
         """Apply the latest pending gizmo position (latest value wins); ``end`` writes the gizmo back."""
         with self.hub.lock:
@@ -179,79 +181,57 @@ class ClientView:
             phase, position = self._pending_drags[-1]
             self._pending_drags.clear()
             try:
-                p_req = read_vec2(position[:2], "platform position")
-            except TpmVizError as exc:
-                self.refuse(str(exc))
-                return
-            state = self.session.state
-            move = drag_to(state.params, state.pose, p_req)
-            self.panel.tell("")
-            sample = TrajectorySample("none", state.trajectory.duration)
-            changed = state.replace(pose=move.pose, note=move.reason, trajectory=sample)
-            self._commit(changed, dragging=phase != "end")
+                self._commit(transitions.drag(self.session.state, position), dragging=phase != "end")
+            except TpmVizError as exc:  # the gizmo goes back to the last good pose when the drag ends
+                self.refuse(str(exc), resync=phase == "end")
 
     @_callback
     def _on_p(self, event) -> None:
         if self.panel.is_echo(self.panel.p):
             return
-        p_req = read_vec2(self.panel.p.value, "platform position p", scale=1e-3, bound=10.0)
-        state = self.session.state
-        self._move(drag_to(state.params, state.pose, p_req))
+        self._commit(transitions.move(self.session.state, self.panel.p.value))
 
     @_callback
     def _on_d(self, event, i: int) -> None:
         if self.panel.is_echo(self.panel.d[i]):
             return
-        state = self.session.state
-        d_req = np.array(state.pose.d, dtype=float)
-        d_req[i] = read_number(self.panel.d[i].value, f"d{i + 1}", scale=1e-3, lo=-10.0, hi=10.0)
-        self._move(drive_to(state.params, state.pose, d_req))
+        self._commit(transitions.drive(self.session.state, i, self.panel.d[i].value))
 
     @_callback
     def _on_switch_mode(self, event) -> None:
-        state = self.session.state
-        self._move(switch_mode(state.params, state.pose))
+        self._commit(transitions.switch(self.session.state))
 
     @_callback
     def _on_home(self, event) -> None:
-        state = self.session.state
-        self._move(Move(home_pose(state.params)))
+        self._commit(transitions.home(self.session.state))
 
     @_callback
     def _on_demo(self, event, kind: str) -> None:
-        state = self.session.state
-        self._move(demo_pose(state.params, kind, near=state.pose.p))
+        self._commit(transitions.demo(self.session.state, kind))
 
     @_callback
     def _on_load(self, event) -> None:
         panel = self.panel
         if panel.is_echo(panel.load_mode, panel.f_ext, panel.dp, panel.ddp):
             return
-        mode = panel.load_mode.value if panel.load_mode.value in LOAD_MODES else "static"
-        load = Load(
-            mode=mode,
-            f_ext=tuple(read_vec2(panel.f_ext.value, "f_ext", bound=MAX_FORCE)),
-            dp=tuple(read_vec2(panel.dp.value, "platform velocity", bound=MAX_SPEED)),
-            ddp=tuple(read_vec2(panel.ddp.value, "platform acceleration", bound=MAX_ACCEL)),
-        )
         state = self.session.state
-        if load != state.load:
-            self._commit(state.replace(load=load, note=""))
+        new = transitions.set_load(state, panel.load_mode.value, panel.f_ext.value, panel.dp.value, panel.ddp.value)
+        if new is not state:
+            self._commit(new)
 
     @_callback
     def _on_trajectory(self, event) -> None:
         panel = self.panel
         if panel.is_echo(panel.trajectory, panel.duration, panel.time):
             return
-        kind = panel.trajectory.value if panel.trajectory.value in TRAJECTORY_KINDS else "none"
-        duration = read_number(panel.duration.value, "duration T", lo=0.01, hi=100.0)
-        t = read_number(panel.time.value, "time t", lo=0.0, hi=duration)
-        self._commit(_sampled(self.session.state, TrajectorySample(kind, duration, t)))
+        state = self.session.state
+        self._commit(transitions.set_trajectory(state, panel.trajectory.value, panel.duration.value, panel.time.value))
 
     @_callback
     def _on_play(self, event) -> None:
         """Play the selected trajectory (the line if none) in slow motion, in a background thread."""
         session = self.session
+        self.hub.authorize(self, session)  # playing moves the session's mechanism
         traj = session.state.trajectory
         kind = traj.kind if traj.kind != "none" else "line"
         duration = traj.duration
@@ -276,24 +256,16 @@ class ClientView:
     @_callback
     def _on_apply(self, event) -> None:
         state = self.session.state
-        raw = self.panel.read_params()
         try:
-            changes = {
-                name: read_number(value, name, scale=1.0 / PARAM_INFO[name]["ui_scale"]) for name, value in raw.items()
-            }
-            params = state.params.replace(**changes)
-            move = settle(params, state.pose)
+            new = transitions.apply_params(state, self.panel.read_params())
         except TpmVizError:
             self.panel.show_params(state.params)  # revert the inputs to the last good mechanism
             raise
-        self._commit(state.replace(params=params, pose=move.pose, note=move.reason))
+        self._commit(new)
 
     @_callback
     def _on_paper(self, event) -> None:
-        state = self.session.state
-        params = Params.paper()
-        move = settle(params, state.pose)
-        self._commit(state.replace(params=params, pose=move.pose, note=move.reason))
+        self._commit(transitions.paper_params(self.session.state))
 
     @_callback
     def _on_own_copy(self, event) -> None:
@@ -305,6 +277,7 @@ class ClientView:
         self.session = self.hub.join(self, private=private, session=old)
         self.hub.membership_changed()
 
+    @guarded
     def _on_show(self, event, what: str) -> None:
         if getattr(event, "client", None) is None:
             return
@@ -313,6 +286,7 @@ class ClientView:
             if self.session.frame is not None:
                 self.render(self.session.frame)
 
+    @guarded
     def _on_frame(self, event) -> None:
         if getattr(event, "client", None) is None:
             return

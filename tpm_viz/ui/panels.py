@@ -130,6 +130,11 @@ class Panel:
         if state.params != self._shown_params:
             self.show_params(state.params)
 
+    def forget(self) -> None:
+        """Write every widget again at the next :meth:`show` (after a refused input left the browser's value)."""
+        self._shown_params = self._shown_load = self._shown_trajectory = None
+        self._written.clear()
+
     def _put(self, handle, value) -> None:
         """Write a widget value and remember it (see :meth:`is_echo`)."""
         handle.value = value

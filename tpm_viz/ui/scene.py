@@ -228,6 +228,10 @@ class MechanismScene:
         setattr(handle, attr, value)
         self._sent[key] = value
 
+    def forget(self) -> None:
+        """Send every pose again at the next :meth:`update` (e.g. to put a refused gizmo drag back)."""
+        self._sent.clear()
+
     def set_visible(self, what: str, visible: bool) -> None:
         """Show or hide a family of nodes: ``labels``, ``loci``, ``circles`` or ``forces``."""
         self.show[what] = bool(visible)

@@ -6,14 +6,15 @@ lock, so callbacks that arrive concurrently from viser's thread pool apply one a
 the *current* value of their widget inside the lock, so an older event that runs late applies the latest value
 (latest value wins) instead of undoing a newer one.
 
-Incoming widget values are untrusted (the browser does not range-check them): :func:`read_vec2` and
-:func:`read_number` validate them and raise :class:`~tpm_viz.InputError` with a one-line message.
+Incoming widget values are untrusted (the browser does not range-check them): the readers of :mod:`.validate`
+(re-exported here: :func:`read_vec2`, :func:`read_number`) check them and raise :class:`~tpm_viz.InputError`.
+With a presenter token (:mod:`.access`) only the presenter's tabs may commit to the shared session.
+A failure while drawing one tab is logged and does not stop the others (:mod:`.guard`).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import math
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -26,6 +27,9 @@ from ..interaction import Pose
 from ..params import Params
 from ..poses import home_pose
 from ..readouts import Load, Readout, Reference, evaluate
+from .access import Access
+from .guard import report
+from .validate import read_number, read_vec2
 
 __all__ = ["TRAJECTORY_KINDS", "AppState", "Hub", "Session", "View", "read_number", "read_vec2"]
 
@@ -92,15 +96,33 @@ class Session:
 class Hub:
     """The shared session and the private copies; :meth:`commit` is the only way state changes."""
 
-    def __init__(self, state: AppState, reference: Reference | None = None) -> None:
+    def __init__(self, state: AppState, reference: Reference | None = None, access: Access | None = None) -> None:
         self.lock = threading.RLock()
         self.shared = Session(state, shared=True)
         self.reference = reference
+        self.access = access if access is not None else Access()
+        """Who may commit to the shared session (everybody unless a presenter token is set)."""
         self.on_membership: Callable[[], None] | None = None
 
     def evaluate(self, state: AppState) -> Readout:
         """All displayed numbers for ``state`` (closed form and reference forces)."""
         return evaluate(state.params, state.pose, state.load, self.reference)
+
+    def frame(self, state: AppState, dragging: bool = False):
+        """The :class:`~tpm_viz.ui.frame.Frame` of ``state`` with the data every view draws, computed and checked
+        before anything changes: raises :class:`~tpm_viz.InputError` if a drawn number is not finite."""
+        from .frame import Frame  # viser-free, but keeps this module free of trimesh
+
+        frame = Frame(state, self.evaluate(state), in_drag=dragging)
+        positions, wxyzs = frame.links
+        if not (np.all(np.isfinite(positions)) and np.all(np.isfinite(wxyzs))):
+            raise InputError("this pose cannot be drawn (non-finite geometry); the last good state stays")
+        _ = frame.dashboard
+        return frame
+
+    def authorize(self, view: View, session: Session) -> None:
+        """Raise :class:`~tpm_viz.ui.access.AccessDenied` unless ``view`` may change ``session``."""
+        self.access.check(view, session)
 
     def join(self, view: View, private: bool, session: Session | None = None) -> Session:
         """Attach ``view`` to the shared session, or to a new private copy of ``session``'s state; draws it.
@@ -108,7 +130,11 @@ class Hub:
         The caller stores the returned session in the view, then calls :meth:`membership_changed`."""
         with self.lock:
             source = session if session is not None else self.shared
-            target = Session(source.state, shared=False) if private else self.shared
+            if private:
+                target = Session(source.state, shared=False)
+                target.frame = source.frame  # same state: same drawing
+            else:
+                target = self.shared
             target.views.append(view)
             self._draw(target, [view], origin=None, dragging=False)
         return target
@@ -121,22 +147,28 @@ class Hub:
         self.membership_changed()
 
     def commit(self, session: Session, state: AppState, origin: View | None = None, dragging: bool = False) -> None:
-        """Make ``state`` current in ``session`` and draw it in every view, ``origin`` first."""
+        """Make ``state`` current in ``session`` and draw it in every view, ``origin`` first.
+
+        Refused (nothing changes) if ``origin`` may not change ``session`` or the state cannot be drawn. A view
+        that fails to draw is logged and skipped; the others are drawn."""
         with self.lock:
-            session.state = state
-            session.frame = None
+            if origin is not None:
+                self.authorize(origin, session)
+            frame = self.frame(state, dragging)
+            session.state, session.frame = state, frame
             self._draw(session, list(session.views), origin, dragging)
 
     def _draw(self, session: Session, views: list[View], origin: View | None, dragging: bool) -> None:
         if session.frame is None:
-            from .frame import Frame  # viser-free, but keeps this module free of trimesh
-
-            session.frame = Frame(session.state, self.evaluate(session.state), in_drag=dragging)
+            session.frame = self.frame(session.state, dragging)
         if origin in views:
             views.remove(origin)
             views.insert(0, origin)
         for view in views:
-            view.render(session.frame, dragging=dragging and view is origin)
+            try:
+                view.render(session.frame, dragging=dragging and view is origin)
+            except Exception as exc:  # one broken tab (e.g. gone mid-push) must not stop the others
+                report(exc, f"drawing {type(view).__name__}")
 
     def shared_viewers(self) -> int:
         """How many tabs show the shared mechanism."""
@@ -146,27 +178,3 @@ class Hub:
         """Tell the app that tabs joined, left or switched sessions (it updates the classroom line)."""
         if self.on_membership is not None:
             self.on_membership()
-
-
-def read_number(value, name: str, scale: float = 1.0, lo: float = -math.inf, hi: float = math.inf) -> float:
-    """A finite number from a widget, times ``scale`` (UI unit -> SI), clipped to ``[lo, hi]`` (SI)."""
-    if isinstance(value, bool):
-        raise InputError(f"{name} must be a number, got {value!r}")
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(x):
-        raise InputError(f"{name} must be finite, got {value!r}")
-    return float(np.clip(x * scale, lo, hi))
-
-
-def read_vec2(value, name: str, scale: float = 1.0, bound: float = math.inf) -> np.ndarray:
-    """Two finite numbers from a widget, times ``scale`` (UI unit -> SI), each clipped to ``[-bound, bound]``."""
-    try:
-        items = list(value)
-    except TypeError:
-        raise InputError(f"{name} must be two numbers, got {value!r}") from None
-    if len(items) != 2:
-        raise InputError(f"{name} must be two numbers, got {value!r}")
-    return np.array([read_number(v, name, scale, -bound, bound) for v in items])
