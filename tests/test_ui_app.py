@@ -16,7 +16,6 @@ import pytest
 from conftest import wait_for
 
 from tpm_viz import Params, forward_kinematics_both, inverse_kinematics
-from tpm_viz.trajectories import line_state
 from tpm_viz.ui.app import is_loopback, main
 from tpm_viz.ui.scene import COLORS
 
@@ -235,18 +234,6 @@ def test_static_and_dynamic_loads_show_forces_and_the_reference(connect):
     assert abs(float(_q(view, "tau1_diff"))) < 1e-6
 
 
-def test_trajectory_sample_drives_pose_and_motion(connect):
-    client, view = connect()
-    client.set_value(view.panel.trajectory, "line")
-    wait_for(lambda: _state(view).trajectory.kind == "line", what="line selected")
-    client.set_value(view.panel.time, 0.05)
-    wait_for(lambda: _state(view).trajectory.t == pytest.approx(0.05), what="t = 0.05 s")
-    p, _dp, ddp = line_state(0.05, 0.2)
-    np.testing.assert_allclose(_state(view).pose.p, p)
-    assert _state(view).load.mode == "dynamic"
-    np.testing.assert_allclose(_state(view).load.ddp, ddp)
-
-
 def test_view_toggles_are_per_tab(connect):
     client, view = connect()
     _other_client, other = connect()
@@ -311,30 +298,6 @@ def test_simultaneous_drags_are_serialised_and_never_corrupt_state(app, connect)
         assert _state(v) is state
         np.testing.assert_allclose(v.scene.platform.position[:2], state.pose.p)
     assert "nan" not in _dashboard(view).lower()
-
-
-def test_play_steps_through_the_trajectory_and_any_input_stops_it(connect, monkeypatch):
-    import tpm_viz.ui.client as client_module
-
-    monkeypatch.setattr(client_module, "PLAY_SECONDS", 0.5)
-    client, view = connect()
-    client.set_value(view.panel.trajectory, "circle")
-    wait_for(lambda: _state(view).trajectory.kind == "circle", what="circle selected")
-    client.set_value(view.panel.duration, 0.5)
-    wait_for(lambda: _state(view).trajectory.duration == 0.5, what="T = 0.5 s")
-    client.click(view.panel.play)
-    wait_for(lambda: _state(view).trajectory.t == pytest.approx(0.5), what="the end of the trajectory")
-    np.testing.assert_allclose(_state(view).pose.p, (0.1, 0.0), atol=1e-12)  # one full turn
-    assert view.panel.time.value == pytest.approx(0.5)
-
-    monkeypatch.setattr(client_module, "PLAY_SECONDS", 30.0)
-    client.click(view.panel.play)
-    wait_for(lambda: 0 < _state(view).trajectory.t < 0.5, what="playing")
-    client.click(view.panel.home)
-    wait_for(lambda: _state(view).trajectory.kind == "none", what="home")
-    version = _state(view).version
-    time.sleep(0.6)  # more than two frames of the player
-    assert _state(view).version == version  # stopped
 
 
 def test_equations_tab_follows_the_state_but_not_every_drag_frame(connect):

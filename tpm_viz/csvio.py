@@ -78,8 +78,8 @@ def _cell(x) -> str:
     return format(x, ".17g") if math.isfinite(x) else ""
 
 
-def write_columns(path: str | None, columns: Mapping[str, np.ndarray]) -> None:
-    """Write equal-length columns as CSV to ``path`` (stdout when ``None`` or ``-``)."""
+def format_columns(columns: Mapping[str, np.ndarray]) -> str:
+    """Equal-length columns as CSV text (header line, then one line per row), as :func:`write_columns` writes."""
     names = list(columns)
     n = len(next(iter(columns.values())))
     out = io.StringIO()
@@ -88,8 +88,14 @@ def write_columns(path: str | None, columns: Mapping[str, np.ndarray]) -> None:
     cols = [columns[c] for c in names]
     for r in range(n):
         writer.writerow([_cell(col[r]) for col in cols])
+    return out.getvalue()
+
+
+def write_columns(path: str | None, columns: Mapping[str, np.ndarray]) -> None:
+    """Write equal-length columns as CSV to ``path`` (stdout when ``None`` or ``-``)."""
+    text = format_columns(columns)
     if path in (None, "-"):
-        sys.stdout.write(out.getvalue())
+        sys.stdout.write(text)
     else:
         with open(path, "w", encoding="utf-8", newline="") as fh:
-            fh.write(out.getvalue())
+            fh.write(text)

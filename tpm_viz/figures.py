@@ -12,7 +12,7 @@ import pathlib
 from .crosscheck import ForceComparison, compare_forces
 from .params import Params
 
-__all__ = ["TITLES", "plot_forces", "write_paper_figures"]
+__all__ = ["TITLES", "force_plot_png", "plot_forces", "write_paper_figures"]
 
 TITLES = {
     "line": "Fig. 4: line from (-100, -50) to (+100, +50) mm",
@@ -21,34 +21,63 @@ TITLES = {
 FILE_NAMES = {"line": "fig4_line.png", "circle": "fig5_circle.png"}
 
 
-def plot_forces(cmp: ForceComparison, path: str | pathlib.Path, dpi: int = 100) -> pathlib.Path:
-    """Write one force figure (two panels, N vs s) for a :class:`ForceComparison`; returns the path."""
+def _force_figure(t, tau_paper, tau_ref, title: str, dpi: int):
+    """The figure of :func:`plot_forces`: forces (paper solid, reference dotted) over their difference; one
+    panel when there is no reference."""
+    import numpy as np
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(7.0, 6.0), dpi=dpi, layout="constrained")
+    fig = Figure(figsize=(7.0, 6.0 if tau_ref is not None else 4.2), dpi=dpi, layout="constrained")
     FigureCanvasAgg(fig)
-    top, bottom = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [2.2, 1.0]})
+    if tau_ref is not None:
+        top, bottom = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [2.2, 1.0]})
+    else:
+        top, bottom = fig.subplots(1, 1), None
     colours = ("tab:blue", "tab:red")
     for i, colour in enumerate(colours):
-        top.plot(cmp.t, cmp.tau_paper[:, i], "-", color=colour, lw=1.6, label=f"τ{i + 1} paper eqs. (29)-(31)")
-        top.plot(cmp.t, cmp.tau_pinocchio[:, i], ":", color="black", lw=2.2, label=f"τ{i + 1} Pinocchio model")
-        bottom.plot(cmp.t, cmp.tau_pinocchio[:, i] - cmp.tau_paper[:, i], "-", color=colour, lw=1.2, label=f"Δτ{i + 1}")
+        top.plot(t, tau_paper[:, i], "-", color=colour, lw=1.6, label=f"τ{i + 1} paper eqs. (29)-(31)")
+        if tau_ref is not None:
+            top.plot(t, tau_ref[:, i], ":", color="black", lw=2.2, label=f"τ{i + 1} Pinocchio model")
+            bottom.plot(t, tau_ref[:, i] - tau_paper[:, i], "-", color=colour, lw=1.2, label=f"Δτ{i + 1}")
     top.axhline(0.0, color="0.6", lw=0.6)
     top.set_ylabel("actuator force [N]")
     top.legend(loc="lower center", bbox_to_anchor=(0.5, 1.0), fontsize=8, ncols=2, frameon=False)
     top.grid(alpha=0.3)
-    fig.suptitle(f"{TITLES.get(cmp.kind, cmp.kind)}, T = {cmp.duration:g} s", fontsize=11)
-    bottom.set_ylabel("Pinocchio − paper [N]")
-    bottom.set_xlabel("time [s]")
-    bottom.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
-    bottom.grid(alpha=0.3)
-    bottom.legend(loc="upper right", fontsize=8, ncols=2)
-    bottom.set_title(f"max |Δτ| = {cmp.max_abs_diff:.1e} N, max |Δτ|/(1 N + |τ|) = {cmp.max_rel_diff:.1e}", fontsize=9)
-    bottom.set_xlim(cmp.t[0], cmp.t[-1])
+    fig.suptitle(title, fontsize=11)
+    last = top
+    if bottom is not None:
+        diff = np.asarray(tau_ref) - np.asarray(tau_paper)
+        rel = float(np.max(np.abs(diff) / (1.0 + np.abs(tau_paper))))
+        bottom.set_ylabel("Pinocchio − paper [N]")
+        bottom.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
+        bottom.grid(alpha=0.3)
+        bottom.legend(loc="upper right", fontsize=8, ncols=2)
+        bottom.set_title(f"max |Δτ| = {np.max(np.abs(diff)):.1e} N, max |Δτ|/(1 N + |τ|) = {rel:.1e}", fontsize=9)
+        last = bottom
+    last.set_xlabel("time [s]")
+    last.set_xlim(t[0], t[-1])
+    return fig
+
+
+def plot_forces(cmp: ForceComparison, path: str | pathlib.Path, dpi: int = 100) -> pathlib.Path:
+    """Write one force figure (two panels, N vs s) for a :class:`ForceComparison`; returns the path."""
+    title = f"{TITLES.get(cmp.kind, cmp.kind)}, T = {cmp.duration:g} s"
+    fig = _force_figure(cmp.t, cmp.tau_paper, cmp.tau_pinocchio, title, dpi)
     path = pathlib.Path(path)
     fig.savefig(path, format="png", dpi=dpi)
     return path
+
+
+def force_plot_png(t, tau_paper, tau_ref=None, title: str = "actuator forces", dpi: int = 100) -> bytes:
+    """PNG bytes of the force figure for any trajectory (e.g. the app's player): ``t`` (n,) [s], forces (n, 2)
+    [N]; the reference model (Pinocchio) dotted with a difference panel when ``tau_ref`` is given."""
+    import io
+
+    fig = _force_figure(t, tau_paper, tau_ref, title, dpi)
+    out = io.BytesIO()
+    fig.savefig(out, format="png", dpi=dpi)
+    return out.getvalue()
 
 
 def write_paper_figures(

@@ -30,6 +30,7 @@ __all__ = [
     "direct_singularity_locus",
     "inverse_singularity_loci",
     "stroke_limit_loci",
+    "workspace_area",
     "workspace_map",
 ]
 
@@ -76,6 +77,15 @@ def workspace_map(params: Params, n: int = 200, extent: float | None = None) -> 
         det_jq=np.where(ok, jac.det_jq, nan),
         cond=np.where(ok, cond, nan),
     )
+
+
+def workspace_area(ws: WorkspaceMap, which: str = "in_stroke") -> float:
+    """Area [m²] of the grid cells where ``which`` (``"in_stroke"`` or ``"reachable"``) holds; each grid point
+    owns the cell of one grid spacing around it."""
+    if which not in ("in_stroke", "reachable"):
+        raise InputError(f"workspace area of 'in_stroke' or 'reachable', got {which!r}")
+    cell = float(ws.xs[1] - ws.xs[0]) * float(ws.ys[1] - ws.ys[0])
+    return float(np.count_nonzero(getattr(ws, which))) * cell
 
 
 def direct_singularity_locus(params: Params, n: int = 90) -> list[np.ndarray]:

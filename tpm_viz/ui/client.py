@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import asyncio
 import functools
-import threading
 import time
 import traceback
 
@@ -29,13 +28,11 @@ from .frame import Frame
 from .guard import guarded
 from .panels import Panel
 from .scene import MechanismScene, camera_pose
-from .session import AppState, Hub, Session, TrajectorySample
-from .transitions import sampled as _sampled
+from .session import AppState, Hub, Session
+from .teaching import Teaching
 
 __all__ = ["ClientView"]
 
-PLAY_SECONDS = 4.0  # s, wall-clock length of a played trajectory (slow motion)
-PLAY_FRAMES = 100
 NOTIFY_AGAIN_SECONDS = 5.0  # the same refusal pops up at most once per this many seconds per tab
 
 
@@ -87,10 +84,12 @@ class ClientView:
         with hub.lock:
             state = hub.shared.state
             self.scene = MechanismScene(client.scene, state.params)
-            self.panel = Panel(client.gui, state)
+            self.teaching = Teaching(self)  # player, explorer, demonstrations (ui/teaching.py)
+            self.panel = Panel(client.gui, state, extra_tabs=self.teaching.build_tabs)
             self._wire()
             self.frame_camera(state.params)
             self.session: Session = hub.join(self, private=False)
+            self.teaching.attach()
 
     # -- drawing -------------------------------------------------------------------------------------------
     def render(self, frame: Frame, *, dragging: bool = False) -> None:
@@ -100,6 +99,7 @@ class ClientView:
         with self.client.atomic():
             self.scene.update(frame, dragging=dragging)
             self.panel.show(frame)
+            self.teaching.render(frame)
             size = _size(frame.state.params)
             if not 0.8 < size / self._framed_size < 1.25:  # the mechanism grew or shrank a lot: reframe
                 self.frame_camera(frame.state.params)
@@ -131,6 +131,7 @@ class ClientView:
         with self.hub.lock:
             self.closed = True
             self.hub.leave(self, self.session)
+            self.teaching.close()
 
     def set_class_info(self, text: str) -> None:
         """The classroom line of the *Class & view* tab."""
@@ -156,9 +157,6 @@ class ClientView:
             panel.demo[kind].on_click(lambda event, kind=kind: self._on_demo(event, kind))
         for handle in (panel.load_mode, panel.f_ext, panel.dp, panel.ddp):
             handle.on_update(self._on_load)
-        for handle in (panel.trajectory, panel.duration, panel.time):
-            handle.on_update(self._on_trajectory)
-        panel.play.on_click(self._on_play)
         panel.apply.on_click(self._on_apply)
         panel.paper.on_click(self._on_paper)
         panel.own_copy.on_update(self._on_own_copy)
@@ -220,40 +218,6 @@ class ClientView:
             self._commit(new)
 
     @_callback
-    def _on_trajectory(self, event) -> None:
-        panel = self.panel
-        if panel.is_echo(panel.trajectory, panel.duration, panel.time):
-            return
-        state = self.session.state
-        self._commit(transitions.set_trajectory(state, panel.trajectory.value, panel.duration.value, panel.time.value))
-
-    @_callback
-    def _on_play(self, event) -> None:
-        """Play the selected trajectory (the line if none) in slow motion, in a background thread."""
-        session = self.session
-        self.hub.authorize(self, session)  # playing moves the session's mechanism
-        traj = session.state.trajectory
-        kind = traj.kind if traj.kind != "none" else "line"
-        duration = traj.duration
-        session.play_token += 1
-        threading.Thread(
-            target=self._play, args=(session, kind, duration, session.play_token), name="tpm-viz-play", daemon=True
-        ).start()
-
-    def _play(self, session: Session, kind: str, duration: float, token: int) -> None:
-        """Step through ``PLAY_FRAMES`` samples over ``PLAY_SECONDS``; any other input stops it."""
-        for k in range(PLAY_FRAMES + 1):
-            if k:
-                time.sleep(PLAY_SECONDS / PLAY_FRAMES)
-            with self.hub.lock:
-                if session.play_token != token or not session.views:
-                    return
-                state = _sampled(session.state, TrajectorySample(kind, duration, duration * k / PLAY_FRAMES))
-                self.hub.commit(session, state)
-                if state.note:
-                    return
-
-    @_callback
     def _on_apply(self, event) -> None:
         state = self.session.state
         try:
@@ -275,6 +239,7 @@ class ClientView:
         old = self.session
         self.hub.leave(self, old)
         self.session = self.hub.join(self, private=private, session=old)
+        self.teaching.switched(old)
         self.hub.membership_changed()
 
     @guarded

@@ -12,7 +12,7 @@ from ..params import PARAM_INFO, Params
 from ..poses import DEMO_KINDS
 from ..readouts import LOAD_MODES
 from .frame import Frame
-from .session import TRAJECTORY_KINDS, AppState
+from .session import AppState
 from .text import legend_html
 
 __all__ = ["PARAM_LABELS", "Panel"]
@@ -52,7 +52,7 @@ def _ui(name: str, value_si: float) -> float:
 class Panel:
     """GUI handles of one tab (``client.gui``); callbacks are attached by the client view."""
 
-    def __init__(self, gui: viser.GuiApi, state: AppState) -> None:
+    def __init__(self, gui: viser.GuiApi, state: AppState, extra_tabs=None) -> None:
         self._gui = gui
         self._shown_params: Params | None = None
         self._shown_load = None
@@ -76,10 +76,9 @@ class Panel:
             self.f_ext = gui.add_vector2("External load on platform f_ext (N)", (0.0, 0.0), step=1.0)
             self.dp = gui.add_vector2("Platform velocity ṗ (m/s)", (0.0, 0.0), step=0.01)
             self.ddp = gui.add_vector2("Platform acceleration p̈ (m/s²)", (0.0, 0.0), step=0.1)
-            self.trajectory = gui.add_dropdown("Trajectory sample (Figs. 4-5)", TRAJECTORY_KINDS, initial_value="none")
-            self.duration = gui.add_number("Duration T (s)", 0.2, min=0.01, max=100.0, step=0.01)
-            self.time = gui.add_slider("Time t (s)", 0.0, 0.2, 0.001, 0.0)
-            self.play = gui.add_button("Play the trajectory (slow motion)", icon=viser.Icon.PLAYER_PLAY)
+            gui.add_markdown("Trajectories (the paper's line and circle, your CSV): *Player* tab.")
+        if extra_tabs is not None:  # the teaching layer's tabs (ui/teaching.py)
+            extra_tabs(tabs)
         with tabs.add_tab("Parameters"):
             self.params = {
                 name: gui.add_number(PARAM_LABELS[name], _ui(name, getattr(state.params, name)), step=0.01)
@@ -119,14 +118,6 @@ class Panel:
             self._put(self.f_ext, load.f_ext)
             self._put(self.dp, tuple(round(v, 6) for v in load.dp))
             self._put(self.ddp, tuple(round(v, 6) for v in load.ddp))
-        if state.trajectory != self._shown_trajectory:
-            self._shown_trajectory = traj = state.trajectory
-            self._put(self.trajectory, traj.kind)
-            self._put(self.duration, traj.duration)
-            if self.time.max != traj.duration:
-                self.time.max = traj.duration
-                self.time.step = traj.duration / 200.0
-            self._put(self.time, min(traj.t, traj.duration))
         if state.params != self._shown_params:
             self.show_params(state.params)
 

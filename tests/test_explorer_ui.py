@@ -1,0 +1,101 @@
+"""Wiring of the singularity explorer, without a browser: the floor map arrives from the background worker
+(never inside a callback), follows parameter changes, and a slow map never stalls another tab's drag."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+from conftest import wait_for
+
+from tpm_viz import Params
+from tpm_viz.overlays import MAP_KINDS
+from tpm_viz.ui import explorer as explorer_module
+
+P = Params.paper()
+
+
+def _image(view):
+    ex = view.teaching.explorer
+    return ex._image if ex._image is not None and ex._image.visible else None
+
+
+def _region(view):
+    return next(h for h in view.scene.loci if h.name == explorer_module.REGION_NODE)
+
+
+def test_a_map_is_drawn_on_the_floor_and_replaces_the_plain_workspace(connect):
+    client, view = connect()
+    ex = view.teaching.explorer
+    assert _region(view).visible and _image(view) is None
+    client.set_value(ex.map_kind, MAP_KINDS["det_jx"])
+    wait_for(lambda: _image(view) is not None, what="the map image")
+    image = _image(view)
+    assert image._data[:4] == b"\x89PNG" and image.render_width == pytest.approx(2 * P.l_a * 200 / 199)
+    assert tuple(image.position) == pytest.approx((0.0, 0.0, explorer_module.MAP_Z))
+    assert not _region(view).visible
+    assert "det J_x" in ex.legend.content and "nan" not in ex.legend.content.lower()
+    client.set_value(ex.map_kind, MAP_KINDS["off"])
+    wait_for(lambda: _image(view) is None, what="the map hidden")
+    assert _region(view).visible
+
+
+def test_a_parameter_change_regenerates_the_map_once_for_all_tabs(connect, monkeypatch):
+    client, view = connect()
+    _other_client, other = connect()
+    service = view.teaching.services.maps
+    assert other.teaching.services.maps is service
+    computed = []
+    original = service._compute
+    monkeypatch.setattr(service, "_compute", lambda params: computed.append(params) or original(params))
+    for tab, c in ((view, client), (other, _other_client)):
+        c.set_value(tab.teaching.explorer.map_kind, MAP_KINDS["workspace"])
+    wait_for(lambda: _image(view) is not None and _image(other) is not None, what="both maps")
+    client.set_value(view.panel.params["l_a"], 220.0)
+    wait_for(lambda: view.panel.params["l_a"].value == 220.0, what="the input")
+    client.click(view.panel.apply)
+    wait_for(
+        lambda: all(_image(v) is not None and v.teaching.explorer._image_key[0].l_a == pytest.approx(0.22)
+                    for v in (view, other)),
+        what="the new map in both tabs",
+    )
+    assert _image(view).render_width == pytest.approx(0.44 * 200 / 199)
+    assert sum(1 for p in computed if p.l_a == pytest.approx(0.22)) == 1  # computed once, shown twice
+
+
+def test_a_slow_map_does_not_stall_another_tabs_drag(connect, monkeypatch):
+    client, view = connect()
+    other_client, other = connect()
+    real = explorer_module.cached_map
+
+    def slow(params, n):
+        time.sleep(1.5)
+        return real(params, n)
+
+    monkeypatch.setattr(explorer_module, "cached_map", slow)
+    client.set_value(view.teaching.explorer.map_kind, MAP_KINDS["cond"])
+    wait_for(lambda: "Computing" in view.teaching.explorer.status.content, what="the map being computed")
+    t0 = time.monotonic()
+    other_client.set_value(other.panel.p, (30.0, 20.0))  # a move from another tab meanwhile
+    wait_for(lambda: np.allclose(other.session.state.pose.p, (0.03, 0.02)), what="the other tab's move")
+    assert time.monotonic() - t0 < 0.7  # not behind the 1.5 s map
+    wait_for(lambda: _image(view) is not None, timeout=10, what="the slow map, eventually")
+
+
+def test_the_ellipses_follow_the_platform_and_say_their_axes(connect):
+    client, view = connect()
+    ex = view.teaching.explorer
+    client.set_value(ex.ellipses, True)
+    wait_for(lambda: "velocity ellipse" in ex.readout.content, what="the ellipse readout")
+    vel = ex._ellipses["velocity"]
+    assert vel.visible and vel.name.startswith("/tpm/platform/")  # children of the platform: they move with it
+    r = np.linalg.norm(vel.points[:, 0, :2], axis=1)
+    assert r == pytest.approx(np.full(len(r), explorer_module.ELLIPSE_SCALE), rel=1e-6)  # J = I at home
+    client.set_value(view.panel.p, (-170.0, -170.0))  # towards the direct singularity
+    wait_for(lambda: np.allclose(view.session.state.pose.p, (-0.17, -0.17)), what="the move")
+    wait_for(lambda: np.ptp(np.linalg.norm(vel.points[:, 0, :2], axis=1)) > 0.1, what="a stretched ellipse")
+    assert "nan" not in ex.readout.content.lower()
+    client.set_value(ex.ellipses, False)
+    wait_for(lambda: not vel.visible, what="ellipses hidden")
+    assert ex.readout.content == ""
