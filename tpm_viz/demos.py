@@ -109,7 +109,7 @@ DEMOS: tuple[Demo, ...] = (
             "either an acceleration or a product of two velocities, so every force is divided by exactly 4: the "
             "peak force goes as 1/T². The Player's summary line keeps the previous run's peak for comparison."
         ),
-        camera=Camera((0.0, -0.38, 0.6), (0.0, -0.02, 0.0)),
+        camera=Camera((-0.05, -0.5, 0.72), (-0.05, -0.1, 0.0)),
         motion=Motion("circle", 0.5),
         compare=(0.5, 1.0),
     ),
@@ -124,7 +124,7 @@ DEMOS: tuple[Demo, ...] = (
             "error in eq. (15) is corrected (see the Equations tab, errata): the dotted curves lie exactly on the "
             "solid ones."
         ),
-        camera=Camera((0.0, -0.38, 0.6), (0.0, -0.02, 0.0)),
+        camera=Camera((-0.05, -0.5, 0.72), (-0.05, -0.1, 0.0)),
         motion=Motion("line", 0.2),
     ),
     Demo(

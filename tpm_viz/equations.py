@@ -54,7 +54,8 @@ def _mat(m, digits: int = 3) -> str:
 
 
 def _math(*parts: str) -> str:
-    return '<math display="block">' + _row(*parts) + "</math>"
+    """A display formula in a box of the panel's width that scrolls sideways when the matrices are wider."""
+    return '<div style="overflow-x:auto;max-width:100%"><math display="block">' + _row(*parts) + "</math></div>"
 
 
 def _unit(text: str) -> str:
@@ -90,9 +91,14 @@ def procedure_html(params: Params, res: DynamicsResult, jac: Jacobians, f_ext=(0
               "<msub><mover><mi>J</mi><mo>˙</mo></mover><mi>q</mi></msub><mover><mi>d</mi><mo>˙</mo></mover><mo>)</mo>"),
         "<p><b>(d) Lagrange multipliers, eqs. (28)-(29).</b> The constraint forces that keep each link at "
         "length l<sub>a</sub>; v<sub>i</sub> gathers the platform's inertia terms, f the external load:</p>",
-        _math("<mi>λ</mi><mo>=</mo>", _mat(g, 4), "<msup><mi></mi><mn>−1</mn></msup>", _unit("m⁻¹"),
-              "<mo>(</mo>", _vec(res.v, 2), "<mo>−</mo>", _vec(f, 2), "<mo>)</mo>", _unit("N"), "<mo>=</mo>",
-              _vec(res.lam, 1), _unit("N/m")),
+        _math(  # two lines: the result stays in view in a narrow panel
+            '<mtable columnalign="left"><mtr><mtd>',
+            _row("<mi>λ</mi><mo>=</mo>", _mat(g, 4), "<msup><mi></mi><mn>−1</mn></msup>", _unit("m⁻¹"),
+                 "<mo>(</mo>", _vec(res.v, 2), "<mo>−</mo>", _vec(f, 2), "<mo>)</mo>", _unit("N")),
+            "</mtd></mtr><mtr><mtd>",
+            _row("<mspace width='1em'/><mo>=</mo>", _vec(res.lam, 1), _unit("N/m")),
+            "</mtd></mtr></mtable>",
+        ),
         "<p><b>(e) Actuator forces, eq. (31).</b> The slider's own inertia w<sub>i</sub> plus the pull of "
         "its leg's constraint, 2 λ<sub>i</sub> (p<sub>i</sub> − d<sub>i</sub> + a − b):</p>",
         _math("<mi>τ</mi><mo>=</mo>", _vec(res.w, 2), "<mo>+</mo><mn>2</mn>", _vec(res.lam, 1), "<mo>∘</mo>",
@@ -101,7 +107,8 @@ def procedure_html(params: Params, res: DynamicsResult, jac: Jacobians, f_ext=(0
         "has determinant 4 l<sub>a</sub>² det J<sub>x</sub>, so the multipliers, and with them the forces, grow "
         "without bound at the direct singularity.</p>",
     ]
-    return '<div class="tpm-equations">' + "".join(parts) + "</div>"
+    # contain:inline-size: the panel's width decides the block's width, not the widest matrix (which scrolls)
+    return '<div class="tpm-equations" style="contain:inline-size;padding-right:10px">' + "".join(parts) + "</div>"
 
 
 def _plain(x) -> str:
@@ -110,6 +117,7 @@ def _plain(x) -> str:
 
 
 ERRATA_HTML = (
+    '<div style="contain:inline-size;padding-right:10px">'
     "<p><b>Errata confirmed numerically</b> (evidence in the README and the test suite):</p><ol>"
     "<li>Eq. (15): the derivative of cos θ<sub>i</sub> is −sin θ<sub>i</sub> θ̇<sub>i</sub>; the paper prints +. "
     "Finite differences of eq. (4) agree with the corrected sign to 1e-6; with the printed sign the circle's "
@@ -118,5 +126,6 @@ ERRATA_HTML = (
     "at rest).</li>"
     "<li>Eq. (28): d/dt(∂L/∂ṗ<sub>j</sub>), not ∂L/∂p<sub>j</sub>, in the first bracket.</li>"
     "<li>Eqs. (7)-(8): the actuator Jacobian is called J<sub>d</sub> in eq. (7) and J<sub>q</sub> after.</li></ol>"
+    "</div>"
 )
 """The confirmed errata, as HTML, for the equations panel."""

@@ -5,7 +5,7 @@ uPlot takes one array per series on a shared x axis, and nothing but numbers (no
 wire, so the time marker is a series of its own on a hidden scale ``c`` fixed to ``[0, 1]``: ``-1`` (off the
 chart) everywhere except ``+1`` at the current sample, a spike that draws as a vertical line across the chart.
 No NaN is ever sent. Charts are built once per tab; a new run replaces their data; the marker moves by
-re-sending the (decimated, <= 201 points) data, which the caller throttles during playback.
+re-sending the (decimated, <= :data:`CHART_POINTS` points) data, which the caller throttles during playback.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from ..playback import Run
 
 __all__ = ["CHART_POINTS", "Charts", "marker"]
 
-CHART_POINTS = 201
+CHART_POINTS = 151
 X_LABEL = "time t (s)"
 FORCE_COLOURS = ("#2563eb", "#dc2626")  # τ1, τ2 as in the PNG figures (tab:blue, tab:red)
 LEG_COLOURS = ("#0d9488", "#6d28d9")  # leg 1 teal, leg 2 purple as in the 3D view
@@ -123,8 +123,9 @@ class Charts:
         self.forces.series = tuple(series)
         self.show_time(t)
 
-    def show_time(self, t: float | None) -> None:
-        """Move the marker to the sample nearest ``t`` [s] (None hides it)."""
+    def show_time(self, t: float | None, forces_only: bool = False) -> None:
+        """Move the marker to the sample nearest ``t`` [s] (None hides it), in the force chart only if
+        ``forces_only`` (playback alternates, to halve the bytes the three kinematic charts cost)."""
         run = self._run
         if run is None:
             return
@@ -134,3 +135,5 @@ class Charts:
         m = marker(len(self._idx), k)
         for handle, base in zip(self.handles, self._base, strict=True):
             handle.data = (*base, m)
+            if forces_only:
+                break

@@ -11,10 +11,9 @@ transitions themselves are the pure functions of :mod:`.transitions`; every call
 
 from __future__ import annotations
 
-import asyncio
 import functools
 import time
-import traceback
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import viser
@@ -42,10 +41,11 @@ def _size(params: Params) -> float:
     return hi - lo
 
 
-def _report(future) -> None:
-    """Print the traceback of a failed background drain (it would be lost otherwise)."""
-    if not future.cancelled() and future.exception() is not None:
-        traceback.print_exception(future.exception())
+INLINE_DRAG_VIEWS = 4
+"""A drag of a session shown by at most this many tabs is applied on the event loop itself (bench_load.py)."""
+_DRAGS = ThreadPoolExecutor(max_workers=2, thread_name_prefix="tpm-viz-drag")
+"""Where gizmo updates are applied: two threads (they serialise on the hub's lock anyway); a plain executor, not
+``loop.run_in_executor``, so that finishing a drag does not wake the event loop once more."""
 
 
 def _internal_error(view: ClientView, exc: Exception) -> None:
@@ -166,9 +166,19 @@ class ClientView:
 
     @guarded
     async def _on_drag(self, event) -> None:
-        """Gizmo events, in arrival order on the event loop: keep a snapshot, hand the work to the pool."""
+        """Gizmo events, in arrival order on the event loop: keep a snapshot, then apply the latest one, here if
+        the hub is free and few tabs show this session (a private copy: no thread hop), else in the pool."""
         self._pending_drags.append((event.phase, np.array(event.target.position, dtype=float)))
-        asyncio.get_running_loop().run_in_executor(None, self._drain_drags).add_done_callback(_report)
+        if len(self.session.views) <= INLINE_DRAG_VIEWS and self.hub.lock.acquire(blocking=False):
+            try:
+                self._drain_drags()  # ~1 ms, never blocks (the lock is ours, pushes and flushes are queued)
+            finally:
+                self.hub.lock.release()
+            return
+        try:
+            _DRAGS.submit(self._drain_drags)  # guarded: its errors are logged, never lost in a future
+        except RuntimeError:  # the interpreter is shutting down
+            return
 
     @guarded(on_error=_internal_error)
     def _drain_drags(self) -> None:

@@ -35,7 +35,7 @@ ELLIPSE_SCALE = 0.12
 """Drawing scale of the ellipses [m per unit radius]: the unit circle (J = I, at p = 0) is 120 mm."""
 ELLIPSE_CAP = 3.0
 ELLIPSE_Z = meshes.PLATFORM_Z[1] + 0.004
-ELLIPSE_COLOURS = {"velocity": (37, 99, 235), "force": (234, 88, 12)}
+ELLIPSE_COLOURS = {"velocity": (30, 58, 138), "force": (234, 88, 12)}  # dark blue (not the leg circles' blue)
 REGION_NODE = "/tpm/loci/workspace"
 
 
@@ -133,7 +133,7 @@ class ExplorerView:
         self.legend = gui.add_html(colour_bar_html("off"))
         self.status = gui.add_markdown("")
         self.ellipses = gui.add_checkbox(
-            "Manipulability ellipses", False, hint="Velocity (blue) and force (orange) ellipses at the platform"
+            "Manipulability ellipses", False, hint="Velocity (dark blue) and force (orange) ellipses at the platform"
         )
         self.readout = gui.add_html("")
         self.map_kind.on_update(self._on_kind)
@@ -249,7 +249,7 @@ class ExplorerView:
         else:
             v, f = drawing.velocity_radii, drawing.force_radii
             body = (
-                f"<span style='color:#2563eb'>velocity ellipse</span> semi-axes {num(v.min(), '.3f')} × "
+                f"<span style='color:#1e3a8a'>velocity ellipse</span> semi-axes {num(v.min(), '.3f')} × "
                 f"{num(v.max(), '.3f')} (m/s per m/s of actuator speed)<br>"
                 f"<span style='color:#ea580c'>force ellipse</span> semi-axes {num(f.min(), '.3f')} × "
                 f"{num(f.max(), '.3f')} (N per N of actuator force)<br>"

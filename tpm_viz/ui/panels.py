@@ -88,7 +88,8 @@ class Panel:
             self.paper = gui.add_button("Paper values (Tables 1-2)", color="gray")
         with tabs.add_tab("Equations"):
             gui.add_markdown(
-                "The paper's procedure (a)-(e) with the current numbers (refreshed when you release the platform)."
+                "The paper's procedure (a)-(e) with the current numbers (refreshed when you release the platform "
+                "and at every trajectory sample you pause on or scrub to)."
             )
             self.equations = gui.add_html("")
         with tabs.add_tab("Class & view"):

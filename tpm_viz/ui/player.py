@@ -4,7 +4,8 @@ run as CSV and the force plot as PNG.
 
 The run and the playback belong to the session (:mod:`.runs`); this view only reads widgets, calls
 :class:`~.runs.RunHub` and draws. During playback the charts and the trace are refreshed at most
-:data:`CHART_HZ` times a second (the 3D platform at every frame); the last frame is always drawn in full.
+:data:`CHART_HZ` times a second (the kinematic charts every other time), with the time slider and the summary;
+the 3D platform moves at every frame, and the last frame is always drawn in full.
 """
 
 from __future__ import annotations
@@ -31,11 +32,11 @@ __all__ = ["CHART_HZ", "SPEEDS", "PlayerView"]
 
 SPEEDS = {"0.01×": 0.01, "0.02×": 0.02, "0.05×": 0.05, "0.1×": 0.1, "0.2×": 0.2, "0.5×": 0.5, "1× (real time)": 1.0}
 """Playback speeds (the paper's motions last 0.2-0.5 s)."""
-CHART_HZ = 5.0
+CHART_HZ = 4.0
 NONE = "none"
 PAPER = {"line (Fig. 4)": "line", "circle (Fig. 5)": "circle"}
 TRACE_Z = meshes.PLATFORM_Z[1] + 0.003  # m, just over the platform: the path leaves the tool marker
-PATH_COLOUR = (148, 163, 184)
+PATH_COLOUR = (234, 179, 8)  # the tool marker's yellow: where P will go
 TRACE_COLOUR = (15, 23, 42)
 _UNSET = object()
 
@@ -71,6 +72,7 @@ class PlayerView:
         self._run = None
         self._written: dict[int, object] = {}
         self._last_push = 0.0
+        self._pushes = 0
         self._shown_t = _UNSET
         self._path = None
         self._trace = None
@@ -266,11 +268,13 @@ class PlayerView:
         if (new_run or force or t != self._shown_t) and (due or new_run or force):
             self._shown_t = t
             self._last_push = now
-            self.charts.show_time(t)
+            self._pushes += 1
+            self.charts.show_time(t, forces_only=frame.in_drag and self._pushes % 2 == 1)
             self._draw_trace(run, t)
-        if t is not None:
-            self._put(self.time, float(np.clip(round(t, 4), 0.0, self.time.max)))
-        self.summary.content = self._summary(ps, run, t)
+            if t is not None:
+                self._put(self.time, float(np.clip(round(t, 4), 0.0, self.time.max)))
+        if due or new_run or force:
+            self.summary.content = self._summary(ps, run, self._shown_t if self._shown_t is not _UNSET else t)
 
     def _set_run(self, run) -> None:
         self._run = run
@@ -292,7 +296,7 @@ class PlayerView:
         self.time.max = run.duration
         self.time.step = max(run.duration / 400.0, 1e-4)
         self._path = scene.add_line_segments(
-            "/player/path", _segments(run.p, TRACE_Z, 400), PATH_COLOUR, thickness=2.0, thickness_units="screen"
+            "/player/path", _segments(run.p, TRACE_Z, 400), PATH_COLOUR, thickness=2.5, thickness_units="screen"
         )
         if self._trace is None:
             self._trace = scene.add_line_segments(
@@ -310,7 +314,7 @@ class PlayerView:
         k = run.index_at(t)
         _, p_now, _, _ = run.state_at(t)
         pts = np.vstack([run.p[: k + 1], p_now[None]])
-        self._trace.points = _segments(pts, TRACE_Z + 0.0005, 200)
+        self._trace.points = _segments(pts, TRACE_Z + 0.0005, 150)
         if not self._trace.visible:
             self._trace.visible = True
 

@@ -12,9 +12,10 @@ import numpy as np
 import viser
 
 from .. import meshes
+from ..overlays import cached_map
 from ..params import Params
 from ..readouts import Readout
-from ..workspace import direct_singularity_locus, inverse_singularity_loci, workspace_map
+from ..workspace import direct_singularity_locus, inverse_singularity_loci
 from .frame import Frame
 from .session import AppState
 
@@ -194,7 +195,7 @@ class MechanismScene:
         """The floor overlay: the workspace inside the stroke (eq. 4), the inverse singularity square (eq. 11)
         and the direct singularity arcs (eq. 12), all in the working mode."""
         s = self._scene
-        ws = workspace_map(params, n=100)
+        ws = cached_map(params, 100)  # once per parameter set for all tabs
         region = meshes.region_mesh(ws.in_stroke, ws.xs, ws.ys, LOCI_Z / 2)
         self.loci = []
         if region is not None:

@@ -33,6 +33,9 @@ from .validate import read_number, read_vec2
 
 __all__ = ["TRAJECTORY_KINDS", "AppState", "Hub", "Session", "View", "read_number", "read_vec2"]
 
+LIVE_REFERENCE_NOTE = "Pinocchio: computed when the motion stops (live frames show the closed form only)"
+"""Why the reference forces are missing from the intermediate frames of a drag or a playback (speed)."""
+
 TRAJECTORY_KINDS = ("none", "line", "circle")
 """Trajectory sample that drives the platform: none, the paper's line (Fig. 4) or circle (Fig. 5)."""
 
@@ -104,21 +107,25 @@ class Hub:
         """Who may commit to the shared session (everybody unless a presenter token is set)."""
         self.on_membership: Callable[[], None] | None = None
 
-    def evaluate(self, state: AppState) -> Readout:
-        """All displayed numbers for ``state`` (closed form and reference forces)."""
-        return evaluate(state.params, state.pose, state.load, self.reference)
+    def evaluate(self, state: AppState, live: bool = False) -> Readout:
+        """All displayed numbers for ``state``: closed form and reference forces; ``live`` (an intermediate frame
+        of a drag or a playback) leaves the reference out (it is computed again when the motion stops)."""
+        if not live or self.reference is None:
+            return evaluate(state.params, state.pose, state.load, self.reference)
+        readout = evaluate(state.params, state.pose, state.load, None)
+        note = readout.forces.note.replace("no reference model", LIVE_REFERENCE_NOTE)
+        return dataclasses.replace(readout, forces=dataclasses.replace(readout.forces, note=note))
 
     def frame(self, state: AppState, dragging: bool = False):
         """The :class:`~tpm_viz.ui.frame.Frame` of ``state`` with the data every view draws, computed and checked
         before anything changes: raises :class:`~tpm_viz.InputError` if a drawn number is not finite."""
         from .frame import Frame  # viser-free, but keeps this module free of trimesh
 
-        frame = Frame(state, self.evaluate(state), in_drag=dragging)
+        frame = Frame(state, self.evaluate(state, live=dragging), in_drag=dragging)
         positions, wxyzs = frame.links
         if not (np.all(np.isfinite(positions)) and np.all(np.isfinite(wxyzs))):
             raise InputError("this pose cannot be drawn (non-finite geometry); the last good state stays")
-        _ = frame.dashboard
-        return frame
+        return frame  # its texts print a dash for any non-finite number (tpm_viz.ui.text.num)
 
     def authorize(self, view: View, session: Session) -> None:
         """Raise :class:`~tpm_viz.ui.access.AccessDenied` unless ``view`` may change ``session``."""

@@ -1,0 +1,139 @@
+"""Load: N protocol-level tabs dragging the platform at 20 Hz against the app in a child process (loopback only).
+
+For each N (default 1, 10, 30) a fresh server (``python app.py --port 0``) and N asyncio tabs
+(``benchmarks/wsclient.py``); each tab drags its gizmo around its own small circle at ``--rate`` Hz for
+``--seconds`` seconds, with a random phase. Reported per N:
+
+- server CPU: user + system time of the server process over the drag window / wall time (100 % = one core);
+- latency: a drag update sent -> the platform update with that position received by the same tab (median, p95);
+  updates that the server merged into a later one (latest value wins) have no latency and count as "merged";
+- the server log: lines reporting an exception (should be none);
+- the CPU of this benchmark's own process and of any other process (the machine has 2 cores: a busy neighbour,
+  e.g. a test run, skews the latencies; rerun on a quiet machine).
+
+Scenarios (``--mode``): ``private`` (default: every tab on its own copy, a class working on its own),
+``presenter`` (presenter mode: one presenter drags the shared mechanism, N-1 tabs watch; the watchers'
+latency is the presenter's send -> the update reaching them) and ``shared`` (no token, everybody drags the one
+shared mechanism at once: the worst case).
+
+Run: ``python benchmarks/bench_load.py`` (about a minute); ``--quick`` for 4 s per N. Target: p95 < 50 ms at N = 30
+(private). Bounded: every loop has a count and a time limit; the servers stop by themselves (their own pid).
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import math
+import random
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from wsclient import ServerProcess, Tab, machine_busy_seconds
+
+TOKEN = "bench-presenter-token"
+
+
+async def _drag_loop(tab: Tab, seconds: float, rate: float, index: int, rng: random.Random) -> int:
+    """Drag around a 40 mm circle (centre offset per tab) at ``rate`` Hz for ``seconds``; returns sends."""
+    cx, cy = 0.02 * math.cos(index), 0.02 * math.sin(index)
+    phase = rng.uniform(0, 2 * math.pi)
+    await asyncio.sleep(rng.uniform(0, 1.0 / rate))
+    await tab.drag(0, 0, "start")
+    start, sends = time.perf_counter(), 0
+    while (now := time.perf_counter()) - start < seconds and sends < seconds * rate + 10:
+        angle = phase + 2 * math.pi * 0.25 * (now - start) + 1e-4 * sends  # distinct targets
+        await tab.drag(cx + 0.04 * math.cos(angle), cy + 0.04 * math.sin(angle))
+        sends += 1
+        await asyncio.sleep(max(0.0, start + sends / rate - time.perf_counter()))
+    await tab.drag(0, 0, "end")
+    return sends
+
+
+async def _scenario(server: ServerProcess, n: int, mode: str, seconds: float, rate: float) -> dict:
+    tabs = [Tab(server.port, f"tab{k}") for k in range(n)]
+    for tab in tabs:  # one at a time, like a class arriving
+        await tab.open()
+    if mode == "private":
+        for tab in tabs:
+            await tab.set_value("Work on my own copy", True)
+    draggers = tabs
+    if mode == "presenter":
+        await tabs[0].set_value("Presenter token", TOKEN)
+        await tabs[0].send(type="GuiUpdateMessage", uuid=tabs[0].uuids["Log in as presenter"], updates={"value": True})
+        draggers = tabs[:1]
+        for tab in tabs[1:]:
+            tab.watch = tabs[0].sent
+    await asyncio.sleep(1.0)  # joins, copies and login settle before measuring
+    for tab in tabs:
+        tab.latencies.clear()
+    rng = random.Random(0)
+    cpu0, t0, own0, all0 = server.cpu_seconds(), time.perf_counter(), time.process_time(), machine_busy_seconds()
+    sends = await asyncio.gather(*(_drag_loop(t, seconds, rate, k, rng) for k, t in enumerate(draggers)))
+    await asyncio.sleep(0.5)  # the last updates arrive
+    wall, cpu, own_cpu = time.perf_counter() - t0, server.cpu_seconds() - cpu0, time.process_time() - own0
+    others = max(0.0, machine_busy_seconds() - all0 - cpu - own_cpu)
+    own = [x for t in draggers for x in t.latencies]
+    watched = [x for t in tabs[1:] for x in t.latencies] if mode == "presenter" else []
+    for tab in tabs:
+        await tab.close()
+    return {
+        "n": n,
+        "sends": sum(sends),
+        "cpu": cpu / wall,
+        "client_cpu": own_cpu / wall,
+        "others": others / wall,
+        "own": np.array(own) * 1e3,
+        "watched": np.array(watched) * 1e3,
+        "rss": server.rss_mb(),
+    }
+
+
+def _line(r: dict, mode: str) -> str:
+    own = r["own"]
+    merged = 1 - len(own) / max(r["sends"], 1)
+    text = (
+        f"  N = {r['n']:>3}   server CPU {100 * r['cpu']:5.1f} %   latency median {np.median(own):6.1f} ms"
+        f"   p95 {np.percentile(own, 95):6.1f} ms   max {own.max():6.1f} ms   merged {100 * merged:4.1f} %"
+        f"   ({r['sends']} updates, RSS {r['rss']:.0f} MB; CPU of this client {100 * r['client_cpu']:.0f} %,"
+        f" of other processes {100 * r['others']:.0f} %)"
+    )
+    if mode == "presenter" and len(r["watched"]):
+        w = r["watched"]
+        text += f"\n           watchers: median {np.median(w):6.1f} ms   p95 {np.percentile(w, 95):6.1f} ms"
+    return text
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--mode", choices=["private", "presenter", "shared"], default="private")
+    parser.add_argument("--tabs", type=int, nargs="+", default=[1, 10, 30], help="values of N (max 60)")
+    parser.add_argument("--seconds", type=float, default=10.0, help="drag time per N (max 120)")
+    parser.add_argument("--rate", type=float, default=20.0, help="drag updates per second per tab")
+    parser.add_argument("--quick", action="store_true", help="4 s per N")
+    args = parser.parse_args()
+    seconds = min(4.0 if args.quick else args.seconds, 120.0)
+    print(f"Load, mode {args.mode}: N tabs dragging at {args.rate:g} Hz for {seconds:g} s (server in a child process)")
+    problems = 0
+    for n in args.tabs:
+        n = max(1, min(n, 60))
+        server = ServerProcess(TOKEN if args.mode == "presenter" else None)
+        try:
+            result = asyncio.run(asyncio.wait_for(_scenario(server, n, args.mode, seconds, args.rate), seconds + 120))
+            print(_line(result, args.mode), flush=True)
+        finally:
+            server.stop()
+            found = server.log_problems()
+            problems += len(found)
+            for line in found[:5]:
+                print(f"    server log: {line}")
+    print(f"server log: {problems} line(s) reporting an exception")
+
+
+if __name__ == "__main__":
+    main()

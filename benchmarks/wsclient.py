@@ -1,0 +1,191 @@
+"""Helpers of the load and soak benchmarks: the app in a child process, and asyncio tabs that speak viser's protocol.
+
+:class:`ServerProcess` starts ``python app.py --port 0`` on 127.0.0.1 (optionally with a presenter token), reads the
+port from its one printed line, measures its CPU time and resident memory from ``/proc/<pid>``, keeps its stderr
+(the server log) in a temporary file and stops it by its own pid.
+
+:class:`Tab` is one browser tab without a browser (websocket subprotocol ``viser-v<version>``, msgpack messages,
+a camera message first): it learns its gizmo owner id and the uuids of the widgets it needs from the messages the
+server sends, drags the gizmo, and timestamps every incoming platform position (decoded like viser's own client:
+16-byte header, zstd-compressed msgpack). Latency = a drag update sent -> the platform update with that exact
+position received.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import msgspec
+import viser
+import zstandard
+from websockets.asyncio.client import connect
+
+ROOT = Path(__file__).resolve().parents[1]
+CLK_TCK = os.sysconf("SC_CLK_TCK")
+GIZMO_Z = 0.09
+
+
+class ServerProcess:
+    """``python app.py --port 0`` on loopback, in a child process."""
+
+    def __init__(self, presenter_token: str | None = None) -> None:
+        self.log = tempfile.NamedTemporaryFile(prefix="tpm-viz-server-", suffix=".log", delete=False)
+        cmd = [sys.executable, str(ROOT / "app.py"), "--host", "127.0.0.1", "--port", "0"]
+        if presenter_token:
+            cmd += ["--presenter-token", presenter_token]
+        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=self.log, text=True, cwd=ROOT)
+        line = self.proc.stdout.readline().strip()
+        if not line.startswith("tpm-viz serving at http://127.0.0.1:"):
+            self.stop()
+            raise RuntimeError(f"the server did not start: {line!r}; log in {self.log.name}")
+        self.port = int(line.rsplit(":", 1)[1])
+        self.pid = self.proc.pid
+
+    def cpu_seconds(self) -> float:
+        """User + system CPU time of the server so far [s] (``/proc/<pid>/stat``, all threads)."""
+        fields = Path(f"/proc/{self.pid}/stat").read_text().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / CLK_TCK
+
+    def rss_mb(self) -> float:
+        """Resident memory of the server [MB] (``/proc/<pid>/status``)."""
+        for line in Path(f"/proc/{self.pid}/status").read_text().splitlines():
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024
+        return float("nan")
+
+    def log_problems(self) -> list[str]:
+        """Lines of the server log that report an exception or an error."""
+        text = Path(self.log.name).read_text(errors="replace")
+        keys = ("Traceback", "ERROR", "Error:", "Exception")
+        return [line for line in text.splitlines() if any(k in line for k in keys)]
+
+    def stop(self) -> None:
+        """Stop the server (SIGTERM to its own pid, then SIGKILL after 10 s)."""
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait(timeout=10)
+        self.proc.stdout.close()
+        self.log.close()
+
+
+def machine_busy_seconds() -> float:
+    """CPU time [s] all processes of the machine have used so far (``/proc/stat``: everything but idle, iowait)."""
+    fields = [int(x) for x in Path("/proc/stat").read_text().splitlines()[0].split()[1:]]
+    return (sum(fields[:8]) - fields[3] - fields[4]) / CLK_TCK
+
+
+_decompress = zstandard.ZstdDecompressor()
+_encode = msgspec.msgpack.encode
+
+
+def decode_batch(raw: bytes) -> list[dict]:
+    """The messages of one server -> client websocket frame."""
+    size, compressed = int.from_bytes(raw[:8], "little"), int.from_bytes(raw[8:16], "little")
+    inner = _decompress.decompress(raw[16 : 16 + compressed], max_output_size=size)
+    return msgspec.msgpack.decode(inner)["messages"]
+
+
+def key(x: float, y: float) -> tuple[int, int]:
+    """A drag target as an exact lookup key (0.1 µm)."""
+    return round(x * 1e7), round(y * 1e7)
+
+
+class Tab:
+    """One protocol-level tab (see the module docstring)."""
+
+    def __init__(self, port: int, name: str = "tab") -> None:
+        self.port, self.name = port, name
+        self.owner: str | None = None
+        self.uuids: dict[str, str] = {}  # widget label -> uuid
+        self.sent: dict[tuple[int, int], float] = {}  # drag target -> send time (perf_counter)
+        self.watch: dict[tuple[int, int], float] | None = None  # another tab's sends this tab also times
+        self.latencies: list[float] = []
+        self.received = 0
+        self.ready = asyncio.Event()
+        self.ws = None
+        self._reader: asyncio.Task | None = None
+
+    async def open(self, timeout: float = 30.0) -> None:
+        self.ws = await connect(
+            f"ws://127.0.0.1:{self.port}",
+            subprotocols=[f"viser-v{viser.__version__}"],
+            max_size=None,
+            compression=None,
+            open_timeout=timeout,
+        )
+        self._reader = asyncio.create_task(self._read())
+        await self.send(
+            type="ViewerCameraMessage",
+            wxyz=(1.0, 0.0, 0.0, 0.0),
+            position=(0.0, -1.0, 1.0),
+            fov=1.0,
+            near=0.01,
+            far=100.0,
+            image_height=720,
+            image_width=1280,
+            look_at=(0.0, 0.0, 0.0),
+            up_direction=(0.0, 0.0, 1.0),
+        )
+        await asyncio.wait_for(self.ready.wait(), timeout)
+
+    async def send(self, **message) -> None:
+        await self.ws.send(_encode(message))
+
+    async def _read(self) -> None:
+        try:
+            async for raw in self.ws:
+                now = time.perf_counter()
+                self.received += 1
+                for m in decode_batch(raw):
+                    kind = m["type"]
+                    if kind == "SetPositionMessage" and m["name"] == "/tpm/platform" and m["owner"] == self.owner:
+                        k = key(m["position"][0], m["position"][1])
+                        for table in (self.sent, self.watch):
+                            if table is not None and k in table:
+                                self.latencies.append(now - table.pop(k))
+                                break
+                    elif kind == "TransformControlsMessage" and m["name"] == "/gizmo":
+                        self.owner = m["owner"]
+                    elif kind.startswith("Gui") and "uuid" in m and isinstance(m.get("props"), dict):
+                        label = m["props"].get("label")
+                        if label:
+                            self.uuids[label] = m["uuid"]
+                if self.owner is not None and "Work on my own copy" in self.uuids:
+                    self.ready.set()
+        except Exception:  # connection closed
+            return
+
+    async def set_value(self, label: str, value) -> None:
+        await self.send(type="GuiUpdateMessage", uuid=self.uuids[label], updates={"value": value})
+
+    async def drag(self, x: float, y: float, phase: str = "update") -> None:
+        """One gizmo message: ``start``, ``update`` (timed) or ``end``."""
+        if phase == "start":
+            await self.send(type="TransformControlsDragStartMessage", name="/gizmo", owner=self.owner)
+        elif phase == "end":
+            await self.send(type="TransformControlsDragEndMessage", name="/gizmo", owner=self.owner)
+        else:
+            self.sent[key(x, y)] = time.perf_counter()
+            await self.send(
+                type="TransformControlsUpdateMessage",
+                name="/gizmo",
+                wxyz=(1.0, 0.0, 0.0, 0.0),
+                position=(float(x), float(y), GIZMO_Z),
+                owner=self.owner,
+            )
+
+    async def close(self) -> None:
+        if self.ws is not None:
+            await self.ws.close()
+        if self._reader is not None:
+            await asyncio.wait([self._reader], timeout=5.0)

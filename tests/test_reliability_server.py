@@ -1,0 +1,192 @@
+"""Bad input through a real server: generated protocol messages from one tab, checked on every tab.
+
+A :class:`~tpm_viz.ui.app.TpmApp` on ``ViserServer(port=0)`` (loopback) and two protocol-level clients: the
+*actor* sends what a hostile or careless browser can send (GUI updates with NaN, ±inf, huge, negative, text such
+as ``"nan"``/``"1e999"`` that viser itself casts to floats, None, wrong-length lists; button clicks; gizmo drags
+with NaN or far-away positions), the *observer* only watches the shared mechanism. After every
+example the test waits until every callback has run (``guard.ACTIVITY``) and checks: no callback raised, every
+session holds a valid state, every number in the actor's widgets and in both scenes is finite, no text shows NaN
+or inf, and the observer never got a message meant for the actor.
+
+A deterministic sweep sends each of 21 nasty values to each of 14 fields (~330 messages); the property test
+300 examples x 1-5 messages (+ an Apply and a sync click each): ~900 generated messages.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+
+import numpy as np
+import pytest
+from conftest import ProtocolClient, wait_for
+from fake_viser import assert_clean
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from test_reliability_app import NASTY_FLOAT, assert_valid
+
+from tpm_viz.ui.guard import ACTIVITY
+
+INT64 = st.integers(-(2**62), 2**62)
+NASTY_VALUES = [
+    float("nan"),
+    float("inf"),
+    float("-inf"),
+    1e300,
+    -1e300,
+    5e-324,
+    -0.0,
+    -1.0,
+    2**62,
+    "nan",
+    "inf",
+    "-1e999",
+    "abc",
+    "",
+    None,
+    True,
+    [],
+    [1.0, 2.0, 3.0],
+    ["nan", 1.0],
+    [float("inf"), 0.0],
+    [1e300, -1e300],
+]
+"""What a browser or a hand-written client can put in a GUI update (viser casts it to the widget's type)."""
+RAW = (
+    st.sampled_from(NASTY_VALUES)
+    | st.floats(allow_nan=True, allow_infinity=True)
+    | st.floats(-400.0, 400.0)
+    | INT64
+    | st.sampled_from(["static", "dynamic", "line", "circle"])
+    | st.lists(st.floats(allow_nan=True, allow_infinity=True) | st.sampled_from(["nan", "x"]), max_size=3)
+)
+FIELDS = [
+    "p",
+    "d0",
+    "d1",
+    "load_mode",
+    "f_ext",
+    "dp",
+    "ddp",
+    "param:a",
+    "param:b",
+    "param:l_a",
+    "param:stroke",
+    "param:m_p",
+    "own_copy",
+    "show:labels",
+]
+BUTTONS = ["switch_mode", "home", "demo:inverse", "demo:direct", "demo:stroke", "apply", "paper"]
+POSITION = st.tuples(
+    st.floats(-0.5, 0.5) | NASTY_FLOAT, st.floats(-0.5, 0.5) | NASTY_FLOAT, st.floats(-1.0, 1.0) | NASTY_FLOAT
+)
+MESSAGE = st.one_of(
+    st.tuples(st.just("set"), st.sampled_from(FIELDS), RAW | st.tuples(RAW, RAW) | st.tuples(RAW, RAW)),
+    st.tuples(st.just("click"), st.sampled_from(BUTTONS)),
+    st.tuples(st.just("drag"), st.lists(POSITION, min_size=1, max_size=4), st.booleans()),
+)
+
+
+def _handle(view, name: str):
+    panel = view.panel
+    if name.startswith("param:"):
+        return panel.params[name[6:]]
+    if name.startswith("show:"):
+        return panel.show_toggles[name[5:]]
+    if name.startswith("demo:"):
+        return panel.demo[name[5:]]
+    if name in ("d0", "d1"):
+        return panel.d[int(name[1])]
+    return getattr(panel, name)
+
+
+def _numeric_widgets(view):
+    p = view.panel
+    yield from (p.p, *p.d, p.f_ext, p.dp, p.ddp, *p.params.values())
+
+
+def _scene_values(view):
+    s = view.scene
+    yield from (s.platform.position, s.gizmo.position, s.ghost.position, *(x.position for x in s.sliders))
+    yield from (s.links.batched_positions, s.links.batched_wxyzs, *(f.points for f in s.forces), s.load_arrow.points)
+
+
+@pytest.fixture
+def two_tabs(app, connect):
+    actor, view = connect()
+    _observer, other = connect()
+    pinged = threading.Event()
+    view.panel.frame_camera.on_click(lambda _event: pinged.set())
+    return actor, view, other, pinged
+
+
+def _sync(actor: ProtocolClient, view, pinged: threading.Event) -> None:
+    """Wait until every message sent so far has been handled (see the module docstring)."""
+    pinged.clear()
+    actor.click(view.panel.frame_camera)
+    assert pinged.wait(10.0), "the sync click was not handled"
+    for _ in range(3):
+        time.sleep(0.002)
+        assert ACTIVITY.wait_idle(10.0)
+        wait_for(lambda: not view._pending_drags, what="pending drags to drain")
+
+
+def _check(view, other, errors_before: int) -> None:
+    """The checks of the module docstring, under the hub's lock."""
+    assert ACTIVITY.snapshot()[1] == errors_before, "a callback raised (see the log)"
+    with view.hub.lock:
+        for v in (view, other):
+            assert_valid(v.session.state)
+            assert_clean("dashboard", v.panel.dashboard.content)
+            assert_clean("equations", v.panel.equations.content)
+            for value in _scene_values(v):
+                assert_clean("scene", np.asarray(value, dtype=float))
+        for handle in _numeric_widgets(view):
+            assert_clean(handle.label, handle.value)
+        assert other.panel.message.content == ""  # refusals go to the actor only
+        if view.session.shared:
+            assert view.session.state is other.session.state
+
+
+def test_every_field_refuses_every_nasty_value(two_tabs):
+    """A deterministic sweep: each numeric or choice field gets each of :data:`NASTY_VALUES` (and paired with a
+    good number for the vector fields), then Apply; the app must stay clean after each."""
+    actor, view, other, pinged = two_tabs
+    errors_before = ACTIVITY.snapshot()[1]
+    pairs = {"p", "f_ext", "dp", "ddp"}
+    for name in FIELDS:
+        values = NASTY_VALUES + ([(v, 1.0) for v in NASTY_VALUES[:9]] if name in pairs else [])
+        for value in values:
+            actor.set_value(_handle(view, name), value)
+            actor.click(view.panel.apply)
+            _sync(actor, view, pinged)
+            _check(view, other, errors_before)
+
+
+def test_generated_protocol_messages_never_break_the_app(two_tabs):
+    actor, view, other, pinged = two_tabs
+    owner = str(view.client.client_id)
+    errors_before = ACTIVITY.snapshot()[1]
+
+    @settings(
+        max_examples=300,
+        deadline=None,
+        derandomize=True,
+        suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
+    )
+    @given(messages=st.lists(MESSAGE, min_size=1, max_size=5))
+    def run(messages):
+        for message in messages:
+            kind = message[0]
+            if kind == "set":
+                actor.set_value(_handle(view, message[1]), message[2])
+            elif kind == "click":
+                actor.click(_handle(view, message[1]))
+            else:
+                actor.drag(view.scene.gizmo, owner, message[1], end=message[2])
+        actor.drag(view.scene.gizmo, owner, [], end=True)  # every drag ends (a real mouse is released)
+        actor.click(view.panel.apply)  # a refused parameter set reverts the inputs
+        _sync(actor, view, pinged)
+        _check(view, other, errors_before)
+
+    run()
