@@ -6,5 +6,8 @@
 - :mod:`.session`: shared state, private copies and the lock that serialises changes;
 - :mod:`.frame`: one committed state and its drawing data, computed once for all tabs;
 - :mod:`.client`: one tab's callbacks (widget -> pure library function -> commit);
+- :mod:`.teaching`: the teaching layer of one tab: :mod:`.player` (trajectories, with :mod:`.runs` per session
+  and :mod:`.charts`), :mod:`.explorer` (floor maps, ellipses), :mod:`.demos_panel`; :mod:`.worker` runs their slow
+  computations off the callbacks;
 - :mod:`.app`: the server and ``main(host, port)``.
 """

@@ -55,6 +55,7 @@ def _options(y_label: str, height: int) -> dict:
         legend={"live": False},
         cursor={"points": {"show": False}},
         height=height,
+        padding=(12, 18, 0, 0),  # top: room for the highest tick label under the title
     )
 
 
