@@ -97,10 +97,6 @@ ACTIONS = st.one_of(
             st.tuples(st.floats(-100.0, 100.0), st.floats(-100.0, 100.0)),
         ),
     ).map(lambda a: (a[0], *a[1])),
-    st.tuples(
-        st.just("trajectory"),
-        mostly_valid(st.sampled_from(["none", "line", "circle"]), st.floats(0.0, 2.0), st.floats(0.0, 2.0)),
-    ).map(lambda a: (a[0], *a[1])),
     st.tuples(st.just("params"), PARAM_RAW),
     st.tuples(st.just("paper")),
 )
@@ -118,7 +114,6 @@ def apply(state: AppState, action: tuple) -> AppState:
         "home": T.home,
         "demo": T.demo,
         "load": T.set_load,
-        "trajectory": T.set_trajectory,
         "params": T.apply_params,
         "paper": T.paper_params,
     }[kind]

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import threading
 import time
+import uuid
 
 import numpy as np
 import pytest
@@ -23,7 +24,7 @@ from conftest import ProtocolClient, wait_for
 from fake_viser import assert_clean
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from test_reliability_app import NASTY_FLOAT, assert_valid
+from test_reliability_app import CSV_TEXT, GOOD_ROWS, NASTY_FLOAT, _timed, assert_valid
 
 from tpm_viz.ui.guard import ACTIVITY
 
@@ -75,13 +76,39 @@ FIELDS = [
     "param:m_p",
     "own_copy",
     "show:labels",
+    "player:choice",
+    "player:duration",
+    "player:time",
+    "player:speed",
+    "player:loop",
+    "player:controls",
+    "explorer:map_kind",
+    "explorer:ellipses",
+    "demos:choice",
+    "demos:steps",
 ]
-BUTTONS = ["switch_mode", "home", "demo:inverse", "demo:direct", "demo:stroke", "apply", "paper"]
+BUTTONS = [
+    "switch_mode",
+    "home",
+    "demo:inverse",
+    "demo:direct",
+    "demo:stroke",
+    "apply",
+    "paper",
+    "player:export_csv",
+    "demos:play",
+]
+OPTIONS = st.sampled_from(
+    ["circle (Fig. 5)", "line (Fig. 4)", "none", "Play", "Pause", "To start", "0.05×", "1× (real time)"]
+) | st.sampled_from(["Show this one", "Next", "Previous", "your CSV: upload.csv"])
+"""Valid option labels of the player's, explorer's and demonstrations' dropdowns and button groups."""
+UPLOAD_BYTES = st.one_of(CSV_TEXT.map(str.encode), GOOD_ROWS.map(_timed).map(str.encode), st.binary(max_size=300))
 POSITION = st.tuples(
     st.floats(-0.5, 0.5) | NASTY_FLOAT, st.floats(-0.5, 0.5) | NASTY_FLOAT, st.floats(-1.0, 1.0) | NASTY_FLOAT
 )
 MESSAGE = st.one_of(
-    st.tuples(st.just("set"), st.sampled_from(FIELDS), RAW | st.tuples(RAW, RAW) | st.tuples(RAW, RAW)),
+    st.tuples(st.just("set"), st.sampled_from(FIELDS), RAW | st.tuples(RAW, RAW) | st.tuples(RAW, RAW) | OPTIONS),
+    st.tuples(st.just("upload"), UPLOAD_BYTES),
     st.tuples(st.just("click"), st.sampled_from(BUTTONS)),
     st.tuples(st.just("drag"), st.lists(POSITION, min_size=1, max_size=4), st.booleans()),
 )
@@ -89,6 +116,9 @@ MESSAGE = st.one_of(
 
 def _handle(view, name: str):
     panel = view.panel
+    for part in ("player", "explorer", "demos"):
+        if name.startswith(part + ":"):
+            return getattr(getattr(view.teaching, part), name[len(part) + 1 :])
     if name.startswith("param:"):
         return panel.params[name[6:]]
     if name.startswith("show:"):
@@ -103,6 +133,7 @@ def _handle(view, name: str):
 def _numeric_widgets(view):
     p = view.panel
     yield from (p.p, *p.d, p.f_ext, p.dp, p.ddp, *p.params.values())
+    yield from (view.teaching.player.duration, view.teaching.player.time)
 
 
 def _scene_values(view):
@@ -112,11 +143,19 @@ def _scene_values(view):
 
 
 @pytest.fixture
-def two_tabs(app, connect):
+def two_tabs(app, connect, monkeypatch):
+    """The actor and the observer; exceptions printed by the background worker or escaping a thread fail the test
+    (they would be lines in the server log)."""
+    import tpm_viz.ui.worker as worker_module
+
+    crashes: list[BaseException] = []
+    monkeypatch.setattr(worker_module.traceback, "print_exception", lambda exc, *a, **k: crashes.append(exc))
+    monkeypatch.setattr(threading, "excepthook", lambda args: crashes.append(args.exc_value))
     actor, view = connect()
     _observer, other = connect()
     pinged = threading.Event()
     view.panel.frame_camera.on_click(lambda _event: pinged.set())
+    view.crashes = crashes
     return actor, view, other, pinged
 
 
@@ -125,15 +164,35 @@ def _sync(actor: ProtocolClient, view, pinged: threading.Event) -> None:
     pinged.clear()
     actor.click(view.panel.frame_camera)
     assert pinged.wait(10.0), "the sync click was not handled"
+    worker = view.teaching.services.worker
     for _ in range(3):
         time.sleep(0.002)
         assert ACTIVITY.wait_idle(10.0)
         wait_for(lambda: not view._pending_drags, what="pending drags to drain")
+        wait_for(worker.idle, what="background runs and maps")
+
+
+def _upload(client: ProtocolClient, button, content: bytes) -> None:
+    """What viser's upload button sends: a transfer start, then the parts."""
+    transfer = str(uuid.uuid4())
+    parts = [content[i : i + 4096] for i in range(0, len(content), 4096)]
+    head = {"source_component_uuid": button._impl.uuid, "transfer_uuid": transfer}
+    client.send(
+        type="FileTransferStartUpload",
+        **head,
+        filename="upload.csv",
+        mime_type="text/csv",
+        part_count=len(parts),
+        size_bytes=len(content),
+    )
+    for k, part in enumerate(parts):
+        client.send(type="FileTransferPart", **head, part_index=k, content=part)
 
 
 def _check(view, other, errors_before: int) -> None:
     """The checks of the module docstring, under the hub's lock."""
     assert ACTIVITY.snapshot()[1] == errors_before, "a callback raised (see the log)"
+    assert not view.crashes, view.crashes[0]
     with view.hub.lock:
         for v in (view, other):
             assert_valid(v.session.state)
@@ -143,6 +202,11 @@ def _check(view, other, errors_before: int) -> None:
                 assert_clean("scene", np.asarray(value, dtype=float))
         for handle in _numeric_widgets(view):
             assert_clean(handle.label, handle.value)
+        teaching = view.teaching
+        for chart in teaching.player.charts.handles:  # the plots: no NaN or inf on the wire
+            assert_clean("chart", [np.asarray(series, dtype=float) for series in chart.data])
+        for text in (teaching.player.summary, teaching.explorer.status, teaching.explorer.readout, teaching.demos.text):
+            assert_clean("teaching text", text.content)
         assert other.panel.message.content == ""  # refusals go to the actor only
         if view.session.shared:
             assert view.session.state is other.session.state
@@ -182,6 +246,8 @@ def test_generated_protocol_messages_never_break_the_app(two_tabs):
                 actor.set_value(_handle(view, message[1]), message[2])
             elif kind == "click":
                 actor.click(_handle(view, message[1]))
+            elif kind == "upload":
+                _upload(actor, view.teaching.player.upload, message[1])
             else:
                 actor.drag(view.scene.gizmo, owner, message[1], end=message[2])
         actor.drag(view.scene.gizmo, owner, [], end=True)  # every drag ends (a real mouse is released)

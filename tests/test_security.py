@@ -205,11 +205,14 @@ def test_malformed_gui_updates_are_dropped_with_one_log_line(app, connect, caplo
         client.set_value(view.panel.d[1], "abc")
         client.set_value(view.panel.f_ext, 3.0)
         client.set_value(view.panel.p, None)
+        client.set_value(view.panel.d[1], float("nan"))  # no browser sends these; viser would cast "1e999" to inf
+        client.set_value(view.panel.f_ext, ("1e999", 0.0))
         client.send(type="GuiUpdateMessage", uuid=str(uuid.uuid4()), updates={"value": 1.0})
         client.set_value(view.panel.d[0], 160.0)
         wait_for(lambda: abs(_state(view).pose.d[0] - 0.16) < 1e-9, what="a good update after the bad ones")
     assert view.panel.d[0].label == label and view.panel.d[0].max == pytest.approx(300.0)
     assert "GUI update dropped" in caplog.text
+    assert np.all(np.isfinite(view.panel.f_ext.value)) and np.isfinite(view.panel.d[1].value)
     assert ACTIVITY.snapshot()[1] == errors
     assert _state(other) is _state(view)
 

@@ -22,6 +22,7 @@ import logging
 import sys
 import threading
 import time
+import warnings
 
 import viser
 
@@ -188,6 +189,9 @@ def main(host: str = "127.0.0.1", port: int = 8080, block: bool = True, presente
             file=sys.stderr,
         )
     _log_to_stderr()
+    # A tab that closes while its frame is being pushed makes viser warn once per connection; expected in a
+    # classroom (the tab is dropped a moment later), and not worth a line in the log each time.
+    warnings.filterwarnings("ignore", message=r"Queued a \w+ on a closed connection", category=UserWarning)
     app = TpmApp(build_server(host, port), presenter_token=presenter_token)
     gc.collect()
     gc.freeze()  # the start-up heap (numpy, trimesh, Pinocchio, viser) is never scanned again: full collections

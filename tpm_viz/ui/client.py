@@ -169,7 +169,8 @@ class ClientView:
         """Gizmo events, in arrival order on the event loop: keep a snapshot, then apply the latest one, here if
         the hub is free and few tabs show this session (a private copy: no thread hop), else in the pool."""
         self._pending_drags.append((event.phase, np.array(event.target.position, dtype=float)))
-        if len(self.session.views) <= INLINE_DRAG_VIEWS and self.hub.lock.acquire(blocking=False):
+        session = getattr(self, "session", None)  # None while this tab is still being built (under the lock)
+        if session is not None and len(session.views) <= INLINE_DRAG_VIEWS and self.hub.lock.acquire(blocking=False):
             try:
                 self._drain_drags()  # ~1 ms, never blocks (the lock is ours, pushes and flushes are queued)
             finally:

@@ -3,8 +3,8 @@
 One function per control of the panel. Each validates its raw inputs (:mod:`.validate`), calls a pure library
 function (:mod:`tpm_viz.interaction`, :mod:`tpm_viz.poses`, ``Params``, the trajectories) and returns a new
 state; a refused input raises :class:`~tpm_viz.TpmVizError` with a one-line message and changes nothing. The
-callbacks of :mod:`.client` are these functions plus a commit, so the property tests
-(``tests/test_reliability_app.py``) drive exactly the path a browser drives, without a browser.
+callbacks of :mod:`.client` are these functions plus a commit (the trajectory player's are in :mod:`.runs`), so
+the property tests (``tests/test_reliability_app.py``) drive exactly the path a browser drives, without a browser.
 
 Invariant (tested with generated inputs): from a valid state every function returns a valid state (finite pose
 on the pose's branch, inside the stroke, clear of both singularities) or raises a ``TpmVizError``.
@@ -14,12 +14,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..interaction import Move, drag_to, drive_to, place, switch_mode
+from ..interaction import Move, drag_to, drive_to, switch_mode
 from ..params import Params
 from ..poses import DEMO_KINDS, demo_pose, home_pose, settle
 from ..readouts import LOAD_MODES, Load
-from ..trajectories import circle_state, line_state
-from .session import TRAJECTORY_KINDS, AppState, TrajectorySample
+from .session import AppState, TrajectorySample
 from .validate import read_choice, read_number, read_params, read_vec2
 
 __all__ = [
@@ -34,9 +33,7 @@ __all__ = [
     "home",
     "move",
     "paper_params",
-    "sampled",
     "set_load",
-    "set_trajectory",
     "switch",
 ]
 
@@ -44,7 +41,6 @@ MAX_POSITION = 10.0  # m, bound on typed positions (any pose beyond l_a is unrea
 MAX_FORCE = 1e5  # N, bound on typed forces
 MAX_SPEED = 100.0  # m/s
 MAX_ACCEL = 1e5  # m/s²
-MIN_DURATION, MAX_DURATION = 0.01, 100.0  # s, trajectory duration T
 
 
 def _moved(state: AppState, move: Move) -> AppState:
@@ -101,25 +97,6 @@ def set_load(state: AppState, mode, f_ext, dp, ddp) -> AppState:
         ddp=tuple(read_vec2(ddp, "platform acceleration", bound=MAX_ACCEL)),
     )
     return state if load == state.load else state.replace(load=load, note="")
-
-
-def sampled(state: AppState, sample: TrajectorySample) -> AppState:
-    """``state`` driven by a trajectory sample: the pose at ``p(t)`` (working mode) and ``ṗ(t), p̈(t)`` as a
-    dynamic load; unchanged pose and load, with the reason, if ``p(t)`` is not valid for these parameters."""
-    if sample.kind == "none":
-        return state.replace(trajectory=sample, note="")
-    p, dp, ddp = (line_state if sample.kind == "line" else circle_state)(sample.t, sample.duration)
-    move = place(state.params, state.pose, p)
-    load = state.load if move.clamped else Load("dynamic", dp=tuple(dp), ddp=tuple(ddp))
-    return state.replace(pose=move.pose, load=load, trajectory=sample, note=move.reason)
-
-
-def set_trajectory(state: AppState, kind, duration, t) -> AppState:
-    """The trajectory-sample inputs: kind (none, line, circle), duration ``T`` [s] and time ``t`` [s]."""
-    kind = read_choice(kind, "trajectory", TRAJECTORY_KINDS)
-    duration = read_number(duration, "duration T", lo=MIN_DURATION, hi=MAX_DURATION)
-    t = read_number(t, "time t", lo=0.0, hi=duration)
-    return sampled(state, TrajectorySample(kind, duration, t))
 
 
 def apply_params(state: AppState, raw) -> AppState:

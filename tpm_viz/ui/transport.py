@@ -4,20 +4,22 @@ A browser only ever sends ``GuiUpdateMessage(uuid, {"value": v})`` with a ``v`` 
 files no larger than the user picked. A hand-written client can send anything, and viser 1.1.1 then
 
 - casts the value with the widget's Python type in its event loop (``float("abc")``, ``float(None)``, ``tuple(3.0)``
-  raise there and print a traceback per message), and lets a client rewrite any property of its own widgets
-  (label, min, max, disabled);
+  raise there and print a traceback per message; ``float("nan")`` and ``float("1e999")`` succeed), and lets a
+  client rewrite any property of its own widgets (label, min, max, disabled);
 - buffers every upload part in memory until the declared size has arrived, with no limit of its own.
 
 :func:`harden` wraps both handlers on the tab's own connection: a GUI update must carry exactly ``value`` and cast
-like viser casts it, else it is dropped with one warning line (at most one per second per tab); an upload larger
-than :data:`~.validate.MAX_UPLOAD_BYTES` is refused before any byte is buffered, and a transfer that sends more
-than it declared is dropped. What passes still goes through the callbacks' own validation (:mod:`.validate`).
-Uses viser internals (``client._websock_connection``, ``gui._handle_*``); ``tests/test_security.py`` pins them.
+like viser casts it, into finite numbers, else it is dropped with one warning line (at most one per second per
+tab); an upload larger than :data:`~.validate.MAX_UPLOAD_BYTES` is refused before any byte is buffered, and a
+transfer that sends more than it declared is dropped. What passes still goes through the callbacks' own
+validation (:mod:`.validate`). Uses viser internals (``client._websock_connection``, ``gui._handle_*``);
+``tests/test_security.py`` pins them.
 """
 
 from __future__ import annotations
 
 import contextlib
+import math
 import time
 
 import viser
@@ -38,15 +40,15 @@ def update_problem(current, updates) -> str | None:
     try:
         if isinstance(current, tuple):
             items = tuple(value)
-            if current:
-                typ = type(current[0])
-                tuple(typ(item) for item in items)
+            cast = tuple(type(current[0])(item) for item in items) if current else items
         elif current is not None:
-            type(current)(value)
+            cast = (type(current)(value),)
         else:
             return "this widget takes no value"
     except (TypeError, ValueError, OverflowError):
         return f"a value of the wrong type for this widget ({type(value).__name__})"
+    if any(isinstance(x, float) and not math.isfinite(x) for x in cast):
+        return "not a finite number"  # no browser input yields NaN or inf; viser would cast "nan" to one
     return None
 
 
