@@ -99,3 +99,22 @@ def test_the_ellipses_follow_the_platform_and_say_their_axes(connect):
     client.set_value(ex.ellipses, False)
     wait_for(lambda: not vel.visible, what="ellipses hidden")
     assert ex.readout.content == ""
+
+
+def test_a_map_that_cannot_be_computed_is_reported_not_retried(connect, monkeypatch):
+    from tpm_viz import InputError
+
+    client, view = connect()
+    service = view.teaching.services.maps
+    calls = []
+
+    def broken(params):
+        calls.append(params)
+        raise InputError("grid too coarse")
+
+    monkeypatch.setattr(service, "_compute", broken)
+    client.set_value(view.teaching.explorer.map_kind, MAP_KINDS["cond"])
+    wait_for(lambda: "Map unavailable: grid too coarse" in view.teaching.explorer.status.content, what="the report")
+    client.set_value(view.panel.p, (10.0, 0.0))  # more frames: no second attempt for the same parameters
+    wait_for(lambda: np.allclose(view.session.state.pose.p, (0.01, 0.0)), what="a move")
+    assert len(calls) == 1 and _image(view) is None

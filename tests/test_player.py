@@ -153,3 +153,20 @@ def test_the_force_plot_is_a_png_with_or_without_the_reference():
     for ref in (None, run.tau + 1e-13):
         png = force_plot_png(run.t, run.tau, ref, title="line")
         assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
+
+
+def test_trace_segments_and_the_summary_never_show_nan():
+    from tpm_viz.ui.player_text import summary_html
+    from tpm_viz.ui.runs import PlayerSession
+    from tpm_viz.ui.trace import segments
+
+    p = np.stack([np.linspace(0, 0.1, 1001), np.zeros(1001)], -1)
+    segs = segments(p, 0.08, 150)
+    assert segs.dtype == np.float32 and len(segs) <= 150 and np.allclose(segs[-1, 1, :2], (0.1, 0.0))
+    assert np.all(segs[1:, 0] == segs[:-1, 1]) and np.all(segs[..., 2] == np.float32(0.08))  # a chained polyline
+    assert segments(p[:1], 0.0, 10).shape == (1, 2, 3)
+    run = build_run(P, Source.paper("line"))
+    ps = PlayerSession(run=run, previous=("circle", float("nan")))
+    text = summary_html(ps, run, None)
+    assert "nan" not in text.lower() and "moved by hand" in text and "151.1" in text
+    assert "<b>line (Fig. 4), T = 0.2 s</b>" in summary_html(PlayerSession(), run, 0.1)

@@ -73,7 +73,16 @@ def test_choosing_the_circle_loads_it_with_its_default_duration_and_both_models(
         assert all(np.all(np.isfinite(arr)) for arr in handle.data)  # never NaN on the wire
     assert charts.forces.series[3]["show"] is True  # the Pinocchio (dotted) series
     assert "run-peak'>177.1<" in pl.summary.content
-    assert view.teaching.player._path.visible
+    assert view.teaching.player.trace.path.visible
+
+
+def test_a_tab_that_connects_later_sees_the_loaded_run(connect):
+    client, view = connect()
+    _choose(client, view, "circle (Fig. 5)", "circle", 0.5)
+    _late_client, late = connect()
+    pl = late.teaching.player
+    wait_for(lambda: pl.charts.forces.visible and pl.choice.value == "circle (Fig. 5)", what="the run in the new tab")
+    assert "circle (Fig. 5), T = 0.5 s" in pl.summary.content and pl.trace.path.visible
 
 
 def test_scrubbing_moves_the_platform_the_marker_and_the_equations(connect):
@@ -91,7 +100,7 @@ def test_scrubbing_moves_the_platform_the_marker_and_the_equations(connect):
     t_chart, marker = pl.charts.forces.data[0], pl.charts.forces.data[-1]
     assert t_chart[np.argmax(marker)] == pytest.approx(0.05, abs=0.001)  # the marker at the sample nearest 0.05 s
     assert marker.max() == 1.0 and marker.min() == -1.0 and np.count_nonzero(marker == 1.0) == 1
-    assert pl._trace.visible and len(pl._trace.points) >= 2
+    assert pl.trace.trace.visible and len(pl.trace.trace.points) >= 2
     eq = view.panel.equations.content  # the equations follow the trajectory sample (not a drag frame)
     assert eq != before and "(e) Actuator forces" in eq
     d_mm = f"{_state(view).pose.d[0] * 1e3:.1f}"

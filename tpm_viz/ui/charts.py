@@ -104,6 +104,9 @@ class Charts:
 
     def show_run(self, run: Run | None, t: float | None) -> None:
         """Plot ``run`` (decimated to <= :data:`CHART_POINTS` samples) with the marker at ``t`` [s] (None: none)."""
+        arrays = () if run is None else (run.t, run.tau, run.d, run.dd, run.ddd)
+        if run is not None and not all(np.all(np.isfinite(a)) for a in arrays):
+            run = None  # never a NaN on the wire (runs are checked, this is a guard)
         self._run = run
         for handle in self.handles:
             handle.visible = run is not None

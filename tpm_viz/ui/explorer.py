@@ -47,6 +47,7 @@ class MapService:
         self._lock = threading.Lock()
         self._maps: OrderedDict[Params, dict[str, np.ndarray]] = OrderedDict()
         self._pending: set[Params] = set()
+        self._failed: dict[Params, str] = {}  # why a map could not be computed (not retried)
         self.subscribers: weakref.WeakSet = weakref.WeakSet()
         self.last_seconds = float("nan")
         """Wall time of the last map computation [s] (for the benchmark)."""
@@ -58,10 +59,17 @@ class MapService:
             if images is not None:
                 self._maps.move_to_end(params)
                 return images
-            if params not in self._pending:
+            if params not in self._pending and params not in self._failed:
                 self._pending.add(params)
-                self.worker.submit(("map", params), lambda: self._compute(params), lambda r, e: self._done(params, r))
+                self.worker.submit(
+                    ("map", params), lambda: self._compute(params), lambda r, e: self._done(params, r, e)
+                )
             return None
+
+    def failure(self, params: Params) -> str | None:
+        """Why the map of ``params`` could not be computed, or None."""
+        with self._lock:
+            return self._failed.get(params)
 
     def _compute(self, params: Params) -> dict[str, np.ndarray]:
         import time
@@ -72,15 +80,16 @@ class MapService:
         self.last_seconds = time.perf_counter() - t0
         return images
 
-    def _done(self, params: Params, images) -> None:
+    def _done(self, params: Params, images, error: Exception | None = None) -> None:
         with self._lock:
             self._pending.discard(params)
             if images is None:
-                return
-            self._maps[params] = images
-            while len(self._maps) > 8:
-                self._maps.popitem(last=False)
-        for view in list(self.subscribers):
+                self._failed[params] = str(error) if error is not None else "no map"
+            else:
+                self._maps[params] = images
+                while len(self._maps) > 8:
+                    self._maps.popitem(last=False)
+        for view in list(self.subscribers):  # the map, or why there is none
             view.map_ready(params)
 
 
@@ -196,7 +205,9 @@ class ExplorerView:
             return
         images = self.maps.get(params)
         if images is None:
-            self.status.content = "*Computing the map for these parameters…*"
+            failure = self.maps.failure(params)
+            computing = "*Computing the map for these parameters…*"
+            self.status.content = f"Map unavailable: {html.escape(failure)}" if failure else computing
             if self._image is not None:
                 self._image.visible = False
             return

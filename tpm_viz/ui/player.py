@@ -10,13 +10,11 @@ the 3D platform moves at every frame, and the last frame is always drawn in full
 
 from __future__ import annotations
 
-import html
 import time
 
 import numpy as np
 import viser
 
-from .. import meshes
 from ..csvio import format_columns
 from ..errors import InputError, TpmVizError
 from ..playback import Source
@@ -24,8 +22,9 @@ from ..trajectories import DEFAULT_DURATIONS
 from .charts import Charts
 from .frame import Frame
 from .guard import guarded
+from .player_text import summary_html
 from .runs import RunHub, following
-from .text import num
+from .trace import PathTrace
 from .validate import MAX_UPLOAD_BYTES, read_number, read_upload
 
 __all__ = ["CHART_HZ", "SPEEDS", "PlayerView"]
@@ -35,25 +34,12 @@ SPEEDS = {"0.01×": 0.01, "0.02×": 0.02, "0.05×": 0.05, "0.1×": 0.1, "0.2×":
 CHART_HZ = 4.0
 NONE = "none"
 PAPER = {"line (Fig. 4)": "line", "circle (Fig. 5)": "circle"}
-TRACE_Z = meshes.PLATFORM_Z[1] + 0.003  # m, just over the platform: the path leaves the tool marker
-PATH_COLOUR = (234, 179, 8)  # the tool marker's yellow: where P will go
-TRACE_COLOUR = (15, 23, 42)
 _UNSET = object()
 
 
 def _internal_error(owner, exc: Exception) -> None:
     """The guard's report to the tab whose callback failed (the traceback is in the server log)."""
     owner.view.refuse(f"internal error ({type(exc).__name__}), logged on the server", resync=False)
-
-
-def _segments(p: np.ndarray, z: float, max_segments: int) -> np.ndarray:
-    step = max(1, int(np.ceil((len(p) - 1) / max_segments)))
-    pts = p[np.unique(np.r_[np.arange(0, len(p), step), len(p) - 1])]
-    segs = np.zeros((max(len(pts) - 1, 1), 2, 3), dtype=np.float32)
-    if len(pts) >= 2:
-        segs[:, 0, :2], segs[:, 1, :2] = pts[:-1], pts[1:]
-    segs[..., 2] = z
-    return segs
 
 
 def _option(source: Source) -> str:
@@ -74,8 +60,7 @@ class PlayerView:
         self._last_push = 0.0
         self._pushes = 0
         self._shown_t = _UNSET
-        self._path = None
-        self._trace = None
+        self.trace = PathTrace(view.client.scene)
         self._frame: Frame | None = None
 
     def build(self, gui: viser.GuiApi) -> None:
@@ -270,87 +255,28 @@ class PlayerView:
             self._last_push = now
             self._pushes += 1
             self.charts.show_time(t, forces_only=frame.in_drag and self._pushes % 2 == 1)
-            self._draw_trace(run, t)
+            self.trace.show_time(run, t)
             if t is not None:
                 self._put(self.time, float(np.clip(round(t, 4), 0.0, self.time.max)))
         if due or new_run or force:
-            self.summary.content = self._summary(ps, run, self._shown_t if self._shown_t is not _UNSET else t)
+            self.summary.content = summary_html(ps, run, self._shown_t if self._shown_t is not _UNSET else t)
 
     def _set_run(self, run) -> None:
         self._run = run
         self._shown_t = _UNSET
         self.charts.show_run(run, None)
-        scene = self.view.client.scene
         sources = self._sources()
         self.choice.options = tuple(sources)
+        self.trace.show_run(run)
         if run is None:
             if self.runs.of(self.session).loading is None:
                 self._put(self.choice, NONE)
-            for handle in (self._path, self._trace):
-                if handle is not None:
-                    handle.visible = False
             return
         self._put(self.choice, _option(run.source))
         self._put(self.duration, round(run.duration, 6))
         self.duration.disabled = run.source.kind not in ("line", "circle")
         self.time.max = run.duration
         self.time.step = max(run.duration / 400.0, 1e-4)
-        self._path = scene.add_line_segments(
-            "/player/path", _segments(run.p, TRACE_Z, 400), PATH_COLOUR, thickness=2.5, thickness_units="screen"
-        )
-        if self._trace is None:
-            self._trace = scene.add_line_segments(
-                "/player/trace", _segments(run.p[:2], TRACE_Z + 0.0005, 1), TRACE_COLOUR, thickness=4.0,
-                thickness_units="screen", visible=False,
-            )
-
-    def _draw_trace(self, run, t) -> None:
-        if self._trace is None:
-            return
-        if run is None or t is None or t <= 0.0:
-            if self._trace.visible:
-                self._trace.visible = False
-            return
-        k = run.index_at(t)
-        _, p_now, _, _ = run.state_at(t)
-        pts = np.vstack([run.p[: k + 1], p_now[None]])
-        self._trace.points = _segments(pts, TRACE_Z + 0.0005, 150)
-        if not self._trace.visible:
-            self._trace.visible = True
-
-    def _summary(self, ps, run, t) -> str:
-        esc = html.escape
-        lines = []
-        if ps.loading is not None:
-            lines.append(f"<i>Computing {esc(ps.loading.label)} (closed form and Pinocchio)…</i>")
-        if ps.status:
-            lines.append(f'<span style="color:#991b1b">{esc(ps.status)}</span>')
-        if run is None:
-            if not lines:
-                lines.append("No trajectory loaded: choose one above or upload a CSV.")
-        else:
-            diff = run.max_diff
-            lines.append(
-                f"<b>{esc(run.source.label)}</b>: peak |τ| = <span data-q='run-peak'>{num(run.peak, '.1f')}</span> N "
-                "(closed form)"
-            )
-            lines.append(
-                "Pinocchio − paper: max |Δτ| = "
-                + (f"<span data-q='run-diff'>{num(diff, '.1e')}</span> N" if diff is not None else esc(run.ref_note))
-            )
-            if ps.previous is not None:
-                label, peak = ps.previous
-                ratio = f" (this / previous = {num(run.peak / peak, '.3f')})" if peak > 0 else ""
-                lines.append(f"Previous run: {esc(label)}, peak {num(peak, '.1f')} N{ratio}")
-            if ps.playing:
-                where = "playing"
-            elif t is None:
-                where = "not on the path (moved by hand): press Play or move the time slider"
-            else:
-                where = "paused"
-            t_text = num(t, ".3f") if t is not None else "—"
-            lines.append(f"t = <span data-q='player-t'>{t_text}</span> s of {num(run.duration, '.3f')} s, {where}")
-        return '<div style="font-size:0.85em;color:#334155;line-height:1.45">' + "<br>".join(lines) + "</div>"
 
     def close(self) -> None:
         """The tab went away (nothing to release: scene nodes go with the client)."""
