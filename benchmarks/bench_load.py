@@ -65,10 +65,10 @@ async def _scenario(server: ServerProcess, n: int, mode: str, seconds: float, ra
     draggers = tabs
     if mode == "presenter":
         await tabs[0].set_value("Presenter token", TOKEN)
-        await tabs[0].send(type="GuiUpdateMessage", uuid=tabs[0].uuids["Log in as presenter"], updates={"value": True})
+        await tabs[0].set_value("Log in as presenter", True)
         draggers = tabs[:1]
         for tab in tabs[1:]:
-            tab.watch = tabs[0].sent
+            tab.watch = tabs[0].log
     await asyncio.sleep(1.0)  # joins, copies and login settle before measuring
     for tab in tabs:
         tab.latencies.clear()

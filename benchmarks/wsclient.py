@@ -107,8 +107,10 @@ class Tab:
         self.port, self.name = port, name
         self.owner: str | None = None
         self.uuids: dict[str, str] = {}  # widget label -> uuid
-        self.sent: dict[tuple[int, int], float] = {}  # drag target -> send time (perf_counter)
-        self.watch: dict[tuple[int, int], float] | None = None  # another tab's sends this tab also times
+        self.sent: dict[tuple[int, int], float] = {}  # drag target -> send time (perf_counter), until received
+        self.log: dict[tuple[int, int], float] = {}  # every drag target sent -> send time (kept)
+        self.watch: dict[tuple[int, int], float] | None = None  # another tab's ``log``: this tab times its sends
+        self._seen: set[tuple[int, int]] = set()
         self.latencies: list[float] = []
         self.received = 0
         self.ready = asyncio.Event()
@@ -150,10 +152,11 @@ class Tab:
                     kind = m["type"]
                     if kind == "SetPositionMessage" and m["name"] == "/tpm/platform" and m["owner"] == self.owner:
                         k = key(m["position"][0], m["position"][1])
-                        for table in (self.sent, self.watch):
-                            if table is not None and k in table:
-                                self.latencies.append(now - table.pop(k))
-                                break
+                        if k in self.sent:
+                            self.latencies.append(now - self.sent.pop(k))
+                        elif self.watch is not None and k in self.watch and k not in self._seen:
+                            self._seen.add(k)
+                            self.latencies.append(now - self.watch[k])
                     elif kind == "TransformControlsMessage" and m["name"] == "/gizmo":
                         self.owner = m["owner"]
                     elif kind.startswith("Gui") and "uuid" in m and isinstance(m.get("props"), dict):
@@ -166,6 +169,11 @@ class Tab:
             return
 
     async def set_value(self, label: str, value) -> None:
+        """What the browser sends when the widget labelled ``label`` changes (a button: ``value=True``)."""
+        for _ in range(1000):  # widgets added after the first ones (e.g. the presenter login) arrive later
+            if label in self.uuids:
+                break
+            await asyncio.sleep(0.01)
         await self.send(type="GuiUpdateMessage", uuid=self.uuids[label], updates={"value": value})
 
     async def drag(self, x: float, y: float, phase: str = "update") -> None:
@@ -175,7 +183,7 @@ class Tab:
         elif phase == "end":
             await self.send(type="TransformControlsDragEndMessage", name="/gizmo", owner=self.owner)
         else:
-            self.sent[key(x, y)] = time.perf_counter()
+            self.sent[key(x, y)] = self.log[key(x, y)] = time.perf_counter()
             await self.send(
                 type="TransformControlsUpdateMessage",
                 name="/gizmo",

@@ -347,6 +347,53 @@ def test_presenter_mode_students_are_refused_on_the_shared_mechanism_only(pconne
     assert _state(pv).pose.d[1] == pytest.approx(0.13)
 
 
+def test_student_drags_never_swallow_the_presenters(presenter_app, pconnect, monkeypatch):
+    """Drags on the shared mechanism are merged (latest value wins) only among tabs allowed to change it: with five
+    tabs (drags applied in the pool, merged) a student tugging all along never makes a presenter's drag vanish."""
+    presenter, pv = pconnect()
+    student, sv = pconnect()
+    for _ in range(3):
+        pconnect()  # watchers
+    committed = []
+    commit = presenter_app.hub.commit
+
+    def spy(session, state, *args, **kwargs):
+        commit(session, state, *args, **kwargs)
+        committed.append(tuple(np.round(state.pose.p, 9)))
+
+    monkeypatch.setattr(presenter_app.hub, "commit", spy)
+    _login(presenter, pv, TOKEN)
+    wait_for(lambda: "You are the presenter" in pv.login.status.content, what="the presenter login")
+    p_owner, s_owner = str(pv.client.client_id), str(sv.client.client_id)
+    stop = threading.Event()
+
+    def pull() -> None:  # a student tugging at the shared platform all along
+        k = 0
+        while not stop.is_set():
+            student.drag(sv.scene.gizmo, s_owner, [(-0.05, 0.04 * np.sin(k / 5), 0.09)], end=False)
+            k += 1
+            time.sleep(0.01)
+
+    thread = threading.Thread(target=pull)
+    thread.start()
+    try:
+        targets = [(0.01 * k, 0.005 * k, 0.09) for k in range(1, 9)]
+        for target in targets:
+            presenter.drag(pv.scene.gizmo, p_owner, [target], end=False)
+            time.sleep(0.06)
+        presenter.drag(pv.scene.gizmo, p_owner, [targets[-1]])
+        wait_for(lambda: np.allclose(_state(pv).pose.p, targets[-1][:2]), what="the presenter's last drag")
+    finally:
+        stop.set()
+        thread.join()
+    student.drag(sv.scene.gizmo, s_owner, [], end=True)
+    assert ACTIVITY.wait_idle()
+    np.testing.assert_allclose(_state(sv).pose.p, targets[-1][:2])
+    for target in targets:  # 60 ms apart: each was the latest allowed drag when it was applied
+        assert tuple(np.round(target[:2], 9)) in committed, target
+    assert "only the presenter" in sv.panel.message.content and pv.panel.message.content == ""
+
+
 def test_presenter_login_is_rate_limited_per_tab(presenter_app, pconnect):
     guesser, gv = pconnect()
     for k in range(MAX_FAILURES):

@@ -12,6 +12,7 @@ transitions themselves are the pure functions of :mod:`.transitions`; every call
 from __future__ import annotations
 
 import functools
+import itertools
 import time
 from concurrent.futures import ThreadPoolExecutor
 
@@ -41,6 +42,7 @@ def _size(params: Params) -> float:
     return hi - lo
 
 
+_ARRIVALS = itertools.count()  # gizmo events in arrival order (they arrive on the event loop, one at a time)
 INLINE_DRAG_VIEWS = 4
 """A drag of a session shown by at most this many tabs is applied on the event loop itself (bench_load.py)."""
 _DRAGS = ThreadPoolExecutor(max_workers=2, thread_name_prefix="tpm-viz-drag")
@@ -80,6 +82,7 @@ class ClientView:
         self.hub = hub
         self.closed = False
         self._pending_drags: list[tuple[str, np.ndarray]] = []
+        self._last_arrival = -1  # arrival number of this tab's latest gizmo event
         self._notified: tuple[str, float] = ("", 0.0)
         with hub.lock:
             state = hub.shared.state
@@ -169,6 +172,7 @@ class ClientView:
         """Gizmo events, in arrival order on the event loop: keep a snapshot, then apply the latest one, here if
         the hub is free and few tabs show this session (a private copy: no thread hop), else in the pool."""
         self._pending_drags.append((event.phase, np.array(event.target.position, dtype=float)))
+        self._last_arrival = next(_ARRIVALS)
         session = getattr(self, "session", None)  # None while this tab is still being built (under the lock)
         if session is not None and len(session.views) <= INLINE_DRAG_VIEWS and self.hub.lock.acquire(blocking=False):
             try:
@@ -183,16 +187,34 @@ class ClientView:
 
     @guarded(on_error=_internal_error)
     def _drain_drags(self) -> None:
-        """Apply the latest pending gizmo position (latest value wins); ``end`` writes the gizmo back."""
+        """Apply the latest pending gizmo position (latest value wins); ``end`` writes the gizmo back.
+
+        Latest value wins across the session: the pending drags of every other tab that may change this
+        mechanism are merged into the one commit (30 students pulling the shared platform at once make one
+        commit per round, not 30)."""
         with self.hub.lock:
             if self.closed or not self._pending_drags:
                 return
-            phase, position = self._pending_drags[-1]
+            mover, latest, arrival = self, self._pending_drags[-1], self._last_arrival
+            ended = any(entry[0] == "end" for entry in self._pending_drags)
             self._pending_drags.clear()
+            if self.hub.access.may_change(self, self.session):
+                for view in self.session.views:
+                    pending = getattr(view, "_pending_drags", None)
+                    if view is self or not pending or view.closed or not self.hub.access.may_change(view, view.session):
+                        continue
+                    if any(entry[0] == "end" for entry in pending):
+                        view.scene.forget()  # its drag ended: its gizmo is written back by this commit
+                    if view._last_arrival > arrival:
+                        mover, latest, arrival = view, pending[-1], view._last_arrival
+                    pending.clear()
+            if ended and mover is not self:
+                self.scene.forget()
+            phase, position = latest
             try:
-                self._commit(transitions.drag(self.session.state, position), dragging=phase != "end")
+                mover._commit(transitions.drag(mover.session.state, position), dragging=phase != "end")
             except TpmVizError as exc:  # the gizmo goes back to the last good pose when the drag ends
-                self.refuse(str(exc), resync=phase == "end")
+                mover.refuse(str(exc), resync=phase == "end")
 
     @_callback
     def _on_p(self, event) -> None:

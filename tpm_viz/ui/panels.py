@@ -20,7 +20,8 @@ from .text import legend_html
 __all__ = ["PARAM_LABELS", "Panel"]
 
 LIVE_DASHBOARD_INTERVAL = 0.1
-"""Shortest time [s] between two dashboard refreshes on the intermediate frames of a drag or a playback."""
+"""Shortest time [s] between two refreshes of the dashboard, ``p`` and ``d`` on the intermediate frames of a drag or
+a playback (the scene itself moves at every frame)."""
 
 _UNSET = object()
 
@@ -111,17 +112,20 @@ class Panel:
         """Write every value of the frame's state and readout into the widgets (viser skips unchanged ones)."""
         state, readout = frame.state, frame.readout
         now = time.monotonic()
-        if not frame.in_drag or now - self._dashboard_at >= LIVE_DASHBOARD_INTERVAL:
-            self.dashboard.content = frame.dashboard  # mid-drag at most 10 times a second (load: bench_load.py)
+        due = not frame.in_drag or now - self._dashboard_at >= LIVE_DASHBOARD_INTERVAL
+        if due:  # mid-drag the numbers are refreshed at most 10 times a second (load: bench_load.py)
+            self.dashboard.content = frame.dashboard
             self._dashboard_at = now
         if not frame.in_drag or not self.equations.content:
             self.equations.content = frame.equations
-        self._put(self.p, (round(float(readout.p[0]) * 1e3, 2), round(float(readout.p[1]) * 1e3, 2)))
         stroke_mm = state.params.stroke * 1e3
         for i, slider in enumerate(self.d):
             if slider.max != stroke_mm:
                 slider.max = stroke_mm
-            self._put(slider, min(max(round(float(readout.d[i]) * 1e3, 2), 0.0), stroke_mm))
+            if due:
+                self._put(slider, min(max(round(float(readout.d[i]) * 1e3, 2), 0.0), stroke_mm))
+        if due:
+            self._put(self.p, (round(float(readout.p[0]) * 1e3, 2), round(float(readout.p[1]) * 1e3, 2)))
         if state.load != self._shown_load:
             self._shown_load = load = state.load
             self._put(self.load_mode, load.mode)
