@@ -137,6 +137,20 @@ def test_a_callback_that_raises_is_logged_told_and_survived(app, connect, monkey
     _consistent(view, other)
 
 
+def test_a_callback_registered_without_the_guard_is_still_logged(app, connect, caplog):
+    """The safety net: viser's callback pool is guarded as a whole (``guard.guard_executor``)."""
+    client, view = connect()
+    button = view.client.gui.add_button("unguarded")
+    button.on_click(lambda event: 1 / 0)  # e.g. a new feature that forgot @guarded
+    errors = ACTIVITY.snapshot()[1]
+    with caplog.at_level(logging.ERROR, logger="tpm_viz.ui"):
+        client.click(button)
+        wait_for(lambda: ACTIVITY.snapshot()[1] == errors + 1, what="the logged failure")
+    assert "ZeroDivisionError" in caplog.text and "Traceback" in caplog.text
+    client.set_value(view.panel.d[0], 175.0)
+    wait_for(lambda: abs(_state(view).pose.d[0] - 0.175) < 1e-9, what="the app to keep working")
+
+
 def test_a_drag_whose_update_raises_is_survived(app, connect, monkeypatch, caplog):
     client, view = connect()
     owner = str(view.client.client_id)

@@ -11,7 +11,7 @@ None, booleans, lists of the wrong length, unreachable poses, impossible geometr
   run on checking stand-ins, ``tests/fake_viser.py``), and the readout, dashboard and equations hold no NaN/inf.
 
 Generated inputs (``derandomize=True``, so every run is the same): sequences 1 500 examples x 1-6 controls
-(~5 200 control inputs), single controls 5 000, uploads 1 200: ~11 400 app-side inputs, on top of the 10 200
+(~5 050 control inputs), single controls 5 000, uploads 1 200: ~11 250 app-side inputs, on top of the 10 200
 library cases of ``test_robustness.py``. The real-server subset is in ``test_reliability_server.py``.
 """
 

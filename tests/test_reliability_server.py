@@ -6,10 +6,12 @@ as ``"nan"``/``"1e999"`` that viser itself casts to floats, None, wrong-length l
 with NaN or far-away positions), the *observer* only watches the shared mechanism. After every
 example the test waits until every callback has run (``guard.ACTIVITY``) and checks: no callback raised, every
 session holds a valid state, every number in the actor's widgets and in both scenes is finite, no text shows NaN
-or inf, and the observer never got a message meant for the actor.
+or inf, and the observer never got a message meant for the actor. (NaN and inf in a GUI update are dropped by
+``ui/transport.py`` before any callback; the callbacks' own refusal of them is covered by the pure tests.)
 
-A deterministic sweep sends each of 21 nasty values to each of 14 fields (~330 messages); the property test
-300 examples x 1-5 messages (+ an Apply and a sync click each): ~900 generated messages.
+A deterministic sweep sends each of 21 nasty values to each of 24 fields (540 messages); the property test
+300 examples x 1-5 messages (+ an Apply and a sync click each): ~870 generated messages (GUI updates, clicks, drags
+and uploads to the panel, the player, the explorer and the demonstrations).
 """
 
 from __future__ import annotations

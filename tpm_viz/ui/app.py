@@ -31,7 +31,7 @@ from ..params import Params
 from ..readouts import Reference
 from .access import Access, LoginPanel
 from .client import ClientView
-from .guard import guarded, log
+from .guard import guard_executor, guarded, log
 from .scene import camera_pose
 from .session import AppState, Hub
 from .transport import harden
@@ -70,6 +70,7 @@ def build_server(host: str = "127.0.0.1", port: int = 8080) -> viser.ViserServer
     with contextlib.redirect_stdout(io.StringIO()):  # viser prints its own banner even with verbose=False
         server = viser.ViserServer(host=host, port=port, label="tpm-viz", verbose=False)
     server.request_share_url = _no_share_url  # type: ignore[method-assign]
+    guard_executor(server._thread_executor)  # every callback's exception is logged (viser 1.1.1 internals)
     server.gui.configure_theme(
         control_width="large", show_share_button=False, show_logo=False, brand_color=BRAND, dark_mode=False
     )

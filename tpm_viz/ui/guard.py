@@ -7,6 +7,9 @@ on the ``tpm_viz.ui`` logger and handed to an optional ``on_error(owner, exc)`` 
 for that tab); the callback returns None. Expected refusals (:class:`~tpm_viz.TpmVizError`) are the callback's own
 business and never reach the guard.
 
+:func:`guard_executor` applies the guard to every task of viser's callback pool as a safety net, so a callback
+that forgot the decorator is still logged and counted.
+
 :data:`ACTIVITY` counts guarded calls: how many ran, failed and are running now. The soak test and the load
 benchmark read it ("no exception in the server log"); protocol-level tests wait on it
 (:meth:`Activity.wait_idle`) instead of sleeping.
@@ -20,7 +23,7 @@ import logging
 import threading
 import time
 
-__all__ = ["ACTIVITY", "Activity", "guarded", "log"]
+__all__ = ["ACTIVITY", "Activity", "guard_executor", "guarded", "log"]
 
 log = logging.getLogger("tpm_viz.ui")
 
@@ -123,3 +126,14 @@ def guarded(func=None, *, on_error=None):
         return wrapper
 
     return decorate if func is None else decorate(func)
+
+
+def guard_executor(executor) -> None:
+    """Guard every task later submitted to ``executor`` (viser's callback pool): a callback registered without
+    :func:`guarded` still has its exception logged and counted here instead of only printed by viser."""
+    submit = executor.submit
+
+    def guarded_submit(fn, /, *args, **kwargs):
+        return submit(guarded(fn), *args, **kwargs)
+
+    executor.submit = guarded_submit
