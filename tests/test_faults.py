@@ -271,3 +271,17 @@ def test_a_parameter_change_during_playback(app, connect, capfd, changes, unreac
     assert ACTIVITY.wait_idle() and ACTIVITY.snapshot()[1] == errors
     captured = capfd.readouterr()
     assert "Traceback" not in captured.err and "Traceback" not in captured.out
+
+
+def test_a_background_thread_that_dies_is_logged(monkeypatch, caplog):
+    """``main()`` routes uncaught exceptions of threads (playback, worker) to the app's log and counts them."""
+    from tpm_viz.ui.app import _thread_died
+
+    monkeypatch.setattr(threading, "excepthook", _thread_died)
+    errors = ACTIVITY.snapshot()[1]
+    with caplog.at_level(logging.ERROR, logger="tpm_viz.ui"):
+        thread = threading.Thread(target=lambda: 1 / 0, name="tpm-viz-play")
+        thread.start()
+        thread.join()
+    assert ACTIVITY.snapshot()[1] == errors + 1
+    assert "thread tpm-viz-play failed: ZeroDivisionError" in caplog.text and "Traceback" in caplog.text

@@ -31,7 +31,7 @@ from ..params import Params
 from ..readouts import Reference
 from .access import Access, LoginPanel
 from .client import ClientView
-from .guard import guard_executor, guarded, log
+from .guard import guard_executor, guarded, log, report
 from .scene import camera_pose
 from .session import AppState, Hub
 from .transport import harden
@@ -168,13 +168,20 @@ class TpmApp:
 
 
 def _log_to_stderr() -> None:
-    """Send the app's log (refusals of uploads, failed callbacks with tracebacks) to stderr, once."""
+    """Send the app's log (refusals of uploads, failed callbacks and threads with tracebacks) to stderr, once."""
     logger = logging.getLogger("tpm_viz")
     if not logger.handlers:
         handler = logging.StreamHandler(sys.stderr)
         handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
         logger.addHandler(handler)
         logger.setLevel(logging.INFO)
+    threading.excepthook = _thread_died
+
+
+def _thread_died(args) -> None:
+    """A background thread (playback, worker) that dies of a bug: its traceback goes to the same log, counted."""
+    if not issubclass(args.exc_type, SystemExit):
+        report(args.exc_value, f"thread {args.thread.name if args.thread else '?'}")
 
 
 def main(host: str = "127.0.0.1", port: int = 8080, block: bool = True, presenter_token: str | None = None) -> TpmApp:

@@ -23,7 +23,7 @@ import logging
 import threading
 import time
 
-__all__ = ["ACTIVITY", "Activity", "guard_executor", "guarded", "log"]
+__all__ = ["ACTIVITY", "Activity", "guard_executor", "guarded", "log", "report"]
 
 log = logging.getLogger("tpm_viz.ui")
 
