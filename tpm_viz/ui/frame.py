@@ -7,6 +7,7 @@ and the dashboard HTML are the same for all of them, so they are computed at mos
 from __future__ import annotations
 
 import html
+from collections.abc import Callable
 from functools import cached_property
 
 import numpy as np
@@ -32,6 +33,13 @@ class Frame:
         self.readout = readout
         self.in_drag = in_drag
         """True for the intermediate frames of a gizmo drag (views may skip costly, non-essential parts)."""
+        self.complete_readout: Callable[[], Readout] | None = None
+        """For a live frame whose ``readout`` lacks the reference forces: computes the readout with them."""
+
+    @cached_property
+    def displayed_readout(self) -> Readout:
+        """The readout the dashboard shows: always with the reference (Pinocchio) forces beside the closed form."""
+        return self.readout if self.complete_readout is None else self.complete_readout()
 
     @cached_property
     def mechanism(self) -> MechanismPose:
@@ -60,4 +68,4 @@ class Frame:
     @cached_property
     def dashboard(self) -> str:
         """The HTML of the always-visible top of the panel."""
-        return dashboard_html(self.state, self.readout)
+        return dashboard_html(self.state, self.displayed_readout)

@@ -33,8 +33,6 @@ from .validate import read_number, read_vec2
 
 __all__ = ["TRAJECTORY_KINDS", "AppState", "Hub", "Session", "View", "read_number", "read_vec2"]
 
-LIVE_REFERENCE_NOTE = "Pinocchio: computed when the motion stops (live frames show the closed form only)"
-"""Why the reference forces are missing from the intermediate frames of a drag or a playback (speed)."""
 
 TRAJECTORY_KINDS = ("none", "line", "circle")
 """Trajectory sample that drives the platform: none, the paper's line (Fig. 4) or circle (Fig. 5)."""
@@ -108,13 +106,10 @@ class Hub:
         self.on_membership: Callable[[], None] | None = None
 
     def evaluate(self, state: AppState, live: bool = False) -> Readout:
-        """All displayed numbers for ``state``: closed form and reference forces; ``live`` (an intermediate frame
-        of a drag or a playback) leaves the reference out (it is computed again when the motion stops)."""
-        if not live or self.reference is None:
-            return evaluate(state.params, state.pose, state.load, self.reference)
-        readout = evaluate(state.params, state.pose, state.load, None)
-        note = readout.forces.note.replace("no reference model", LIVE_REFERENCE_NOTE)
-        return dataclasses.replace(readout, forces=dataclasses.replace(readout.forces, note=note))
+        """All numbers for ``state``: closed form and reference (Pinocchio) forces. ``live`` (an intermediate frame
+        of a drag or a playback) leaves the reference out: :meth:`frame` adds it lazily, for the dashboards that
+        are actually redrawn (at most 10 Hz mid-drag), so every displayed force has both numbers beside it."""
+        return evaluate(state.params, state.pose, state.load, None if live else self.reference)
 
     def frame(self, state: AppState, dragging: bool = False):
         """The :class:`~tpm_viz.ui.frame.Frame` of ``state`` with the data every view draws, computed and checked
@@ -122,6 +117,8 @@ class Hub:
         from .frame import Frame  # viser-free, but keeps this module free of trimesh
 
         frame = Frame(state, self.evaluate(state, live=dragging), in_drag=dragging)
+        if dragging and self.reference is not None:
+            frame.complete_readout = lambda: self.evaluate(state)  # both models, computed when displayed
         positions, wxyzs = frame.links
         if not (np.all(np.isfinite(positions)) and np.all(np.isfinite(wxyzs))):
             raise InputError("this pose cannot be drawn (non-finite geometry); the last good state stays")
