@@ -96,3 +96,21 @@ def test_commits_from_many_threads_are_serialised():
         t.join()
     assert overlaps == []
     assert hub.shared.state.version == 40  # no update lost
+
+
+def test_live_frames_show_the_pinocchio_forces_beside_the_closed_form():
+    """Issue 3: both numbers side by side on every displayed frame, intermediate drag frames included."""
+    import dataclasses
+
+    from tpm_viz import inverse_dynamics, multibody
+    from tpm_viz.readouts import Load
+
+    hub = Hub(AppState.initial(Params.paper()), reference=multibody.inverse_dynamics)
+    state = hub.shared.state
+    state = dataclasses.replace(state, load=Load(mode="dynamic", dp=(0.3, -0.2), ddp=(4.0, 1.0)))
+    for dragging in (True, False):
+        shown = hub.frame(state, dragging=dragging).displayed_readout.forces
+        closed = inverse_dynamics(state.params, state.pose.p, [0.3, -0.2], [4.0, 1.0])
+        assert shown.tau == pytest.approx(closed, rel=1e-12)
+        assert shown.tau_ref == pytest.approx(closed, rel=1e-9, abs=1e-9)
+        assert "Pinocchio" in hub.frame(state, dragging=dragging).dashboard
