@@ -96,8 +96,14 @@ def test_command_lines_default_to_loopback_and_pass_the_token(monkeypatch):
         {"host": "127.0.0.1", "port": 0, "presenter_token": None},
         {"host": "10.0.0.5", "port": 0, "presenter_token": TOKEN},
     ]
-    text = (Path(__file__).resolve().parents[1] / "app.py").read_text()
-    assert 'default="127.0.0.1"' in text and "presenter_token=args.presenter_token" in text
+    # python app.py is the same command: it binds 127.0.0.1 unless --host says otherwise
+    import runpy
+
+    for argv, host in ((["app.py", "--port", "0"], "127.0.0.1"), (["app.py", "--host", "10.0.0.5"], "10.0.0.5")):
+        monkeypatch.setattr("sys.argv", argv)
+        with pytest.raises(SystemExit) as exit_:
+            runpy.run_path(str(Path(__file__).resolve().parents[1] / "app.py"), run_name="__main__")
+        assert exit_.value.code == 0 and calls[-1]["host"] == host
 
 
 def test_a_blank_token_is_refused_before_serving():
