@@ -96,6 +96,26 @@ def test_vectorised_equals_pointwise():
     assert inverse_dynamics(P, p, dp, 0 * dp).shape == (7, 1, 2)
 
 
+@settings(max_examples=200, deadline=None, derandomize=True)
+@given(params=params_sets(), data=st.data(), branch=st.tuples(st.sampled_from([1, -1]), st.sampled_from([1, -1])))
+def test_the_one_state_fast_path_equals_the_vectorised_path_on_every_branch(params, data, branch):
+    """One state (shape (2,)) takes the scalar fast path, a batch of one (shape (1, 2)) the vectorised one: same τ,
+    with the branch given by ``d`` (c_i = ±sqrt(l_a² - p_j²), the legs of the other assembly modes) or not."""
+    p, dp, ddp = data.draw(regular_states(params))
+    c = np.array(branch) * np.sqrt(params.l_a**2 - p[::-1] ** 2)
+    d = p - c + params.a - params.b  # eq. (3) on that branch
+    f = np.array([data.draw(st.floats(-50, 50)), data.draw(st.floats(-50, 50))])
+    for dd in (None, d) if branch == (1, 1) else (d,):
+        try:
+            batch = inverse_dynamics(params, p[None], dp[None], ddp[None], f, d=None if dd is None else dd[None])[0]
+        except SingularConfigurationError:
+            with pytest.raises(SingularConfigurationError):
+                inverse_dynamics(params, p, dp, ddp, f, d=dd)
+            continue
+        one = inverse_dynamics(params, p, dp, ddp, f, d=dd)
+        assert one.shape == (2,) and one == pytest.approx(batch, rel=1e-12, abs=1e-9)
+
+
 def test_paper_trajectory_peaks_are_of_the_expected_order():
     """conventions.md: with T = 0.2 s / 0.5 s the peaks are of the order of 150-180 N."""
     for kind in ("line", "circle"):

@@ -129,7 +129,7 @@ def inverse_dynamics_detail(params: Params, p, dp, ddp, f_ext=None, d=None) -> D
     return DynamicsResult(p=p, dp=dp, ddp=ddp, d=d, dd=dd, ddd=ddd, v=v, w=w, lam=lam, tau=tau)
 
 
-def _inverse_dynamics_one(params: Params, p, dp, ddp, f_ext) -> np.ndarray | None:
+def _inverse_dynamics_one(params: Params, p, dp, ddp, f_ext, d=None) -> np.ndarray | None:
     """Fast path for one state given as length-2 sequences: pure ``math``, no temporaries.
 
     Returns None when the input is not a plain single state (the caller then vectorises).
@@ -139,13 +139,19 @@ def _inverse_dynamics_one(params: Params, p, dp, ddp, f_ext) -> np.ndarray | Non
         dp1, dp2 = float(dp[0]), float(dp[1])
         ddp1, ddp2 = float(ddp[0]), float(ddp[1])
         f1, f2 = (0.0, 0.0) if f_ext is None else (float(f_ext[0]), float(f_ext[1]))
+        d1, d2 = (0.0, 0.0) if d is None else (float(d[0]), float(d[1]))
+        if d is not None and len(d) != 2:
+            return None
     except (TypeError, ValueError, IndexError):
         return None
-    vals = (p1, p2, dp1, dp2, ddp1, ddp2, f1, f2)
+    vals = (p1, p2, dp1, dp2, ddp1, ddp2, f1, f2, d1, d2)
     if not all(map(math.isfinite, vals)) or not abs(p1) < params.l_a or not abs(p2) < params.l_a:
         return None  # let the vectorised path raise the precise error
     la2 = params.l_a**2
-    c1, c2 = math.sqrt(la2 - p2 * p2), math.sqrt(la2 - p1 * p1)  # eq. (4): c_i = sqrt(l_a² - p_j²)
+    if d is None:
+        c1, c2 = math.sqrt(la2 - p2 * p2), math.sqrt(la2 - p1 * p1)  # eq. (4): c_i = sqrt(l_a² - p_j²)
+    else:
+        c1, c2 = p1 - d1 + params.a - params.b, p2 - d2 + params.a - params.b  # c_i = l_a cos θ_i on d's branch
     _check_regular(params, c1, c2, p1, p2)
     try:
         out = _procedure(params, p1, p2, dp1, dp2, ddp1, ddp2, c1, c2, f1, f2)
@@ -158,11 +164,11 @@ def inverse_dynamics(params: Params, p, dp, ddp, f_ext=None, d=None) -> np.ndarr
     """Actuator forces ``τ`` [N], shape ``(..., 2)``, by the paper's closed form (eqs. 29, 31).
 
     See :func:`inverse_dynamics_detail` for the arguments and the intermediates. One state of
-    shape ``(2,)`` takes a scalar fast path (same formulas, ~10 µs).
+    shape ``(2,)`` (with or without ``d``) takes a scalar fast path (same formulas, ~10 µs).
     """
-    if d is None and np.ndim(p) == 1 and np.ndim(dp) == 1 and np.ndim(ddp) == 1 and np.ndim(f_ext) <= 1:
+    if np.ndim(p) == 1 and np.ndim(dp) == 1 and np.ndim(ddp) == 1 and np.ndim(f_ext) <= 1 and np.ndim(d) <= 1:
         if len(p) == 2 and len(dp) == 2 and len(ddp) == 2:
-            tau = _inverse_dynamics_one(params, p, dp, ddp, f_ext)
+            tau = _inverse_dynamics_one(params, p, dp, ddp, f_ext, d)
             if tau is not None:
                 return tau
     return finite_result(np.stack(_vectorised(params, p, dp, ddp, f_ext, d)[4][10:12], -1), "the actuator forces")
