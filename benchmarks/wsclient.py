@@ -29,6 +29,8 @@ from websockets.asyncio.client import connect
 ROOT = Path(__file__).resolve().parents[1]
 CLK_TCK = os.sysconf("SC_CLK_TCK")
 GIZMO_Z = 0.09
+PLATFORM_NODES = ("/tpm/platform", "/own/platform")
+"""The shared platform (broadcast, owner "") and a private copy's (this tab's own scope)."""
 
 
 class ServerProcess:
@@ -150,7 +152,7 @@ class Tab:
                 self.received += 1
                 for m in decode_batch(raw):
                     kind = m["type"]
-                    if kind == "SetPositionMessage" and m["name"] == "/tpm/platform" and m["owner"] == self.owner:
+                    if kind == "SetPositionMessage" and m["name"] in PLATFORM_NODES and m["owner"] in (self.owner, ""):
                         k = key(m["position"][0], m["position"][1])
                         if k in self.sent:
                             self.latencies.append(now - self.sent.pop(k))

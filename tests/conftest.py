@@ -87,6 +87,8 @@ class ProtocolClient:
             f"ws://127.0.0.1:{port}", subprotocols=[f"viser-v{viser.__version__}"], max_size=None, compression=None
         )
         self.received = 0
+        self.nodes: dict[tuple[str, str], dict] = {}
+        """Scene nodes this tab was sent, ``(name, owner) -> message`` (owner "" = the broadcast scope)."""
         self._stop = threading.Event()
         self._reader = threading.Thread(target=self._drain, daemon=True)
         self._reader.start()
@@ -104,14 +106,36 @@ class ProtocolClient:
         )
 
     def _drain(self) -> None:
+        import msgspec
+        import zstandard
+
+        decompress = zstandard.ZstdDecompressor().decompress
         while not self._stop.is_set():
             try:
-                self.ws.recv(timeout=0.2)
+                raw = self.ws.recv(timeout=0.2)
                 self.received += 1
             except TimeoutError:
                 continue
             except Exception:  # connection closed
                 return
+            size, compressed = int.from_bytes(raw[:8], "little"), int.from_bytes(raw[8:16], "little")
+            for m in msgspec.msgpack.decode(decompress(raw[16 : 16 + compressed], max_output_size=size))["messages"]:
+                if "owner" in m and "name" in m:  # a scene-node message (viser 1.1.1: stamped with its scope)
+                    self._record(m)
+
+    def _record(self, m: dict) -> None:
+        key = (m["name"], m["owner"])
+        if m["type"] == "RemoveSceneNodeMessage":
+            self.nodes.pop(key, None)
+        elif "props" in m:  # a node created (or re-created); its visibility follows in its own message
+            self.nodes[key] = {"type": m["type"], "visible": True, "virtual": m.get("virtual", False)}
+        elif m["type"] == "SetSceneNodeVisibilityMessage" and key in self.nodes:
+            self.nodes[key]["visible"] = m["visible"]
+
+    def shadows(self) -> set[str]:
+        """Names this tab hides with an invisible node of its own over a broadcast node (viser's scope shadowing)."""
+        own = {name for (name, owner), n in self.nodes.items() if owner != "" and not n["visible"] and not n["virtual"]}
+        return {name for name in own if (name, "") in self.nodes} | {n for n in own if n == "/tpm"}
 
     def send(self, **message) -> None:
         """Send one message (a dict with its ``type``), msgpack-encoded like viser's client does."""

@@ -112,17 +112,22 @@ class FakeView:
     """A browser tab without a browser: the real scene and panel code on fake APIs, drawn like ClientView."""
 
     def __init__(self, state) -> None:
+        from types import SimpleNamespace
+
         from tpm_viz.ui.panels import Panel
         from tpm_viz.ui.scene import MechanismScene
+        from tpm_viz.ui.tabscene import TabScene
 
         self.scene_api, self.gui_api = FakeApi(), FakeApi()
-        self.scene = MechanismScene(self.scene_api, state.params)
+        self.mechanism = MechanismScene(self.scene_api, state.params)
+        self.scene = TabScene(SimpleNamespace(scene=self.scene_api), self.mechanism)
         self.panel = Panel(self.gui_api, state)
         self.frames = 0
         self.failures: list[BaseException] = []
 
     def render(self, frame, *, dragging: bool) -> None:
         try:
+            self.mechanism.update(frame)
             self.scene.update(frame, dragging=dragging)
             self.panel.show(frame)
         except BaseException as exc:  # the hub logs and swallows it: keep it for the test to raise

@@ -21,24 +21,34 @@ def _image(view):
     return ex._image if ex._image is not None and ex._image.visible else None
 
 
-def _region(view):
-    return next(h for h in view.scene.loci if h.name == explorer_module.REGION_NODE)
+def _region_shown(view, client) -> bool:
+    """Whether this tab shows the shared workspace floor: not shadowed, by the server's account and by the
+    messages the tab received."""
+    name = view.scene.shared.family("region")[0]
+    hidden = name in view.scene.hidden()
+    assert hidden == (name in client.shadows())
+    return view.scene.shared.region.visible and not hidden
 
 
 def test_a_map_is_drawn_on_the_floor_and_replaces_the_plain_workspace(connect):
     client, view = connect()
+    other_client, other = connect()
     ex = view.teaching.explorer
-    assert _region(view).visible and _image(view) is None
+    assert _region_shown(view, client) and _image(view) is None
     client.set_value(ex.map_kind, MAP_KINDS["det_jx"])
     wait_for(lambda: _image(view) is not None, what="the map image")
     image = _image(view)
     assert image._data[:4] == b"\x89PNG" and image.render_width == pytest.approx(2 * P.l_a * 200 / 199)
     assert tuple(image.position) == pytest.approx((0.0, 0.0, explorer_module.MAP_Z))
-    assert not _region(view).visible
+    wait_for(lambda: not _region_shown(view, client), what="the floor hidden in this tab")
+    assert _region_shown(other, other_client)  # only in this tab
     assert "det J_x" in ex.legend.content and "nan" not in ex.legend.content.lower()
     client.set_value(ex.map_kind, MAP_KINDS["off"])
     wait_for(lambda: _image(view) is None, what="the map hidden")
-    assert _region(view).visible
+    wait_for(lambda: _region_shown(view, client), what="the floor back")
+    client.set_value(ex.map_kind, MAP_KINDS["det_jx"])  # an own copy keeps the floor hidden under the map
+    client.set_value(view.panel.own_copy, True)
+    wait_for(lambda: view.scene.private is not None and not view.scene.private.region.visible, what="own floor hidden")
 
 
 def test_a_parameter_change_regenerates_the_map_once_for_all_tabs(connect, monkeypatch):
@@ -89,12 +99,14 @@ def test_the_ellipses_follow_the_platform_and_say_their_axes(connect):
     client.set_value(ex.ellipses, True)
     wait_for(lambda: "velocity ellipse" in ex.readout.content, what="the ellipse readout")
     vel = ex._ellipses["velocity"]
-    assert vel.visible and vel.name.startswith("/tpm/platform/")  # children of the platform: they move with it
+    assert vel.visible and vel.name.startswith("/explorer/")  # this tab's own scope, world coordinates
     r = np.linalg.norm(vel.points[:, 0, :2], axis=1)
     assert r == pytest.approx(np.full(len(r), explorer_module.ELLIPSE_SCALE), rel=1e-6)  # J = I at home
     client.set_value(view.panel.p, (-170.0, -170.0))  # towards the direct singularity
     wait_for(lambda: np.allclose(view.session.state.pose.p, (-0.17, -0.17)), what="the move")
-    wait_for(lambda: np.ptp(np.linalg.norm(vel.points[:, 0, :2], axis=1)) > 0.1, what="a stretched ellipse")
+    p = np.array([-0.17, -0.17])
+    wait_for(lambda: np.ptp(np.linalg.norm(vel.points[:, 0, :2] - p, axis=1)) > 0.1, what="a stretched ellipse")
+    assert vel.points[:, 0, :2].mean(axis=0) == pytest.approx(p, abs=1e-6)  # centred on the platform
     assert "nan" not in ex.readout.content.lower()
     client.set_value(ex.ellipses, False)
     wait_for(lambda: not vel.visible, what="ellipses hidden")

@@ -180,6 +180,7 @@ class _LazyViews:
             v.failures.clear()
             v.panel.forget()
             v.scene.forget()
+            v.mechanism.forget()
         return iter(self.views)
 
 

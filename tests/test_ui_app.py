@@ -235,11 +235,31 @@ def test_static_and_dynamic_loads_show_forces_and_the_reference(connect):
 
 
 def test_view_toggles_are_per_tab(connect):
+    """The shared mechanism is one broadcast drawing; a tab hides a family by shadowing its nodes with invisible
+    nodes of its own scope (checked on the messages each tab receives), and the option survives an own copy."""
     client, view = connect()
-    _other_client, other = connect()
+    other_client, other = connect()
+    labels = set(view.scene.shared.family("labels"))
+    assert len(labels) == 7 and all((name, "") in client.nodes for name in labels)  # the broadcast labels
     client.set_value(view.panel.show_toggles["labels"], False)
-    wait_for(lambda: not view.scene.labels[0].visible, what="labels hidden")
-    assert other.scene.labels[0].visible
+    wait_for(lambda: client.shadows() == labels, what="this tab's labels shadowed")
+    assert view.scene.hidden() == labels
+    assert all(label.visible for label in view.scene.shared.labels)  # the shared drawing is untouched
+    time.sleep(0.2)
+    assert other_client.shadows() == set() and other.scene.hidden() == set()
+
+    client.set_value(view.panel.own_copy, True)  # the copy is drawn with this tab's options
+    wait_for(lambda: not view.session.shared, what="own copy")
+    wait_for(lambda: client.shadows() == {"/tpm"}, what="the shared mechanism covered in this tab")
+    assert view.scene.mechanism.root == "/own" and not any(label.visible for label in view.scene.labels)
+    assert ("/own/platform", str(view.client.client_id)) in client.nodes
+    client.set_value(view.panel.show_toggles["labels"], True)
+    wait_for(lambda: all(label.visible for label in view.scene.labels), what="own labels shown")
+
+    client.set_value(view.panel.own_copy, False)  # back: copy removed, shared drawing shown, no shadow left
+    wait_for(lambda: view.session.shared, what="back to shared")
+    wait_for(lambda: client.shadows() == set(), what="nothing hidden any more")
+    assert not any(name.startswith("/own") for name, _ in client.nodes)
 
 
 def test_classroom_shared_then_own_copy_then_back(connect):
@@ -323,3 +343,53 @@ def test_camera_reframes_after_a_large_geometry_change(connect):
     client.click(view.panel.apply)
     wait_for(lambda: _state(view).params.a == pytest.approx(0.9), what="a = 900 mm")
     wait_for(lambda: not np.allclose(view.client.camera.position, before), what="the camera to move")
+
+
+def test_a_class_pulling_the_shared_platform_at_once_is_paced_and_the_latest_drag_wins(app, connect, monkeypatch):
+    """More tabs than INLINE_DRAG_VIEWS on the shared mechanism: drag commits are at least SHARED_DRAG_INTERVAL
+    apart (latest value wins in between), the mechanism is drawn once per commit in the broadcast scope whatever
+    the number of tabs, every tab shows the same state, and no drag is left stranded."""
+    from tpm_viz.ui import client as client_module
+
+    tabs = [connect() for _ in range(client_module.INLINE_DRAG_VIEWS + 3)]
+    hub = app.hub
+    commits: list[tuple[float, bool]] = []
+    original_commit = hub.commit
+
+    def counting_commit(session, state, origin=None, dragging=False):
+        commits.append((time.monotonic(), dragging))
+        return original_commit(session, state, origin, dragging)
+
+    monkeypatch.setattr(hub, "commit", counting_commit)
+    drawn = []
+    original_update = hub.shared.scene.update
+    monkeypatch.setattr(hub.shared.scene, "update", lambda frame: drawn.append(frame) or original_update(frame))
+
+    def drag(k, client, view):
+        rng = np.random.default_rng(k)
+        points = [(*rng.uniform(-0.1, 0.1, 2), 0.09) for _ in range(25)]
+        client.drag(view.scene.gizmo, str(view.client.client_id), points)
+
+    threads = [threading.Thread(target=drag, args=(k, c, v)) for k, (c, v) in enumerate(tabs)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    view = tabs[0][1]
+    _settle(view, quiet=0.5)
+    sends = 25 * len(tabs)
+    assert 2 <= len(commits) < sends  # merged: latest value wins
+    times = [t for t, _ in commits]
+    assert min(np.diff(times)) >= 0.9 * client_module.SHARED_DRAG_INTERVAL
+    assert len({id(f) for f in drawn}) == len(drawn) <= len(commits)  # one broadcast drawing per commit
+    assert not hub.shared.drain_scheduled
+
+    client, last = tabs[-1]  # a drag after the storm: applied, shown everywhere, gizmos written back
+    client.drag(last.scene.gizmo, str(last.client.client_id), [(0.03, -0.02, 0.09)])
+    wait_for(lambda: np.allclose(_state(view).pose.p, (0.03, -0.02)), what="the last drag applied")
+    _settle(view)
+    state = _state(view)
+    np.testing.assert_allclose(hub.shared.scene.platform.position[:2], state.pose.p)
+    for _, v in tabs:
+        assert _state(v) is state
+        wait_for(lambda v=v: np.allclose(v.scene.gizmo.position[:2], state.pose.p), what="every gizmo on the platform")

@@ -32,7 +32,7 @@ from ..readouts import Reference
 from .access import Access, LoginPanel
 from .client import ClientView
 from .guard import guard_executor, guarded, log, report
-from .scene import camera_pose
+from .scene import MechanismScene, camera_pose
 from .session import AppState, Hub
 from .transport import harden
 
@@ -96,7 +96,9 @@ class TpmApp:
     ) -> None:
         self.server = server
         self.access = Access(presenter_token)
-        self.hub = Hub(AppState.initial(params), _reference() if reference == "auto" else reference, self.access)
+        state = AppState.initial(params)
+        shared_scene = MechanismScene(server.scene, state.params, sink=server)  # drawn once for every tab
+        self.hub = Hub(state, _reference() if reference == "auto" else reference, self.access, shared_scene)
         self.hub.evaluate(self.hub.shared.state)  # warm-up: builds the Pinocchio model once
         self.views: dict[int, ClientView] = {}
         self._views_lock = threading.Lock()

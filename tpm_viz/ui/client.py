@@ -11,6 +11,7 @@ transitions themselves are the pure functions of :mod:`.transitions`; every call
 
 from __future__ import annotations
 
+import asyncio
 import functools
 import itertools
 import time
@@ -27,8 +28,9 @@ from . import transitions
 from .frame import Frame
 from .guard import guarded
 from .panels import Panel
-from .scene import MechanismScene, camera_pose
+from .scene import camera_pose
 from .session import AppState, Hub, Session
+from .tabscene import TabScene
 from .teaching import Teaching
 
 __all__ = ["ClientView"]
@@ -48,6 +50,14 @@ INLINE_DRAG_VIEWS = 4
 _DRAGS = ThreadPoolExecutor(max_workers=2, thread_name_prefix="tpm-viz-drag")
 """Where gizmo updates are applied: two threads (they serialise on the hub's lock anyway); a plain executor, not
 ``loop.run_in_executor``, so that finishing a drag does not wake the event loop once more."""
+SHARED_DRAG_INTERVAL = 0.025
+"""Drags of a session shown by more than :data:`INLINE_DRAG_VIEWS` tabs are committed at most once per this many
+seconds (40 Hz; latest value wins in between), however many students pull the shared platform at once: one
+dragger at the browser's 20 Hz is never delayed, thirty keep the server responsive (bench_load.py --mode shared)."""
+WATCH_INTERVAL = 0.05
+"""While another tab drags (or a trajectory plays), this tab's own part of a frame (gizmo, panel, teaching layer)
+is drawn at most once per this many seconds (20 Hz); the mechanism itself is drawn at every commit, once for all
+tabs, and the last frame of a drag is always drawn."""
 
 
 def _internal_error(view: ClientView, exc: Exception) -> None:
@@ -84,9 +94,10 @@ class ClientView:
         self._pending_drags: list[tuple[str, np.ndarray]] = []
         self._last_arrival = -1  # arrival number of this tab's latest gizmo event
         self._notified: tuple[str, float] = ("", 0.0)
+        self._drawn_at = -1.0  # time.monotonic() of this tab's last render
         with hub.lock:
             state = hub.shared.state
-            self.scene = MechanismScene(client.scene, state.params)
+            self.scene = TabScene(client, hub.shared.scene)
             self.teaching = Teaching(self)  # player, explorer, demonstrations (ui/teaching.py)
             self.panel = Panel(client.gui, state, extra_tabs=self.teaching.build_tabs)
             self._wire()
@@ -96,9 +107,14 @@ class ClientView:
 
     # -- drawing -------------------------------------------------------------------------------------------
     def render(self, frame: Frame, *, dragging: bool = False) -> None:
-        """Draw ``frame`` in this tab (called by the hub under its lock) and flush at once."""
+        """Draw this tab's part of ``frame`` (called by the hub under its lock, after the session's mechanism) and
+        flush at once; another tab's intermediate frames at most every :data:`WATCH_INTERVAL`."""
         if self.closed:
             return
+        now = time.monotonic()
+        if frame.in_drag and not dragging and now - self._drawn_at < WATCH_INTERVAL:
+            return
+        self._drawn_at = now
         with self.client.atomic():
             self.scene.update(frame, dragging=dragging)
             self.panel.show(frame)
@@ -119,6 +135,9 @@ class ClientView:
         if resync and self.session.frame is not None:
             self.panel.forget()
             self.scene.forget()
+            if self.session.scene is not None:
+                self.session.scene.update(self.session.frame)  # a private copy written again
+            self._drawn_at = -1.0
             self.render(self.session.frame)
         self.client.flush()
 
@@ -170,16 +189,29 @@ class ClientView:
     @guarded
     async def _on_drag(self, event) -> None:
         """Gizmo events, in arrival order on the event loop: keep a snapshot, then apply the latest one, here if
-        the hub is free and few tabs show this session (a private copy: no thread hop), else in the pool."""
+        the hub is free and few tabs show this session (a private copy: no thread hop), else in the pool, at most
+        every :data:`SHARED_DRAG_INTERVAL` for a session shown by many tabs."""
         self._pending_drags.append((event.phase, np.array(event.target.position, dtype=float)))
         self._last_arrival = next(_ARRIVALS)
         session = getattr(self, "session", None)  # None while this tab is still being built (under the lock)
-        if session is not None and len(session.views) <= INLINE_DRAG_VIEWS and self.hub.lock.acquire(blocking=False):
-            try:
-                self._drain_drags()  # ~1 ms, never blocks (the lock is ours, pushes and flushes are queued)
-            finally:
-                self.hub.lock.release()
-            return
+        if session is not None and len(session.views) <= INLINE_DRAG_VIEWS:
+            if self.hub.lock.acquire(blocking=False):
+                try:
+                    self._drain_drags()  # ~1 ms, never blocks (the lock is ours, pushes and flushes are queued)
+                finally:
+                    self.hub.lock.release()
+                return
+        elif session is not None and self.hub.access.may_change(self, session):
+            if session.drain_scheduled:
+                return  # the scheduled drain takes this drag (latest value wins)
+            session.drain_scheduled = True
+            delay = session.next_drag_at - time.monotonic()
+            if delay > 0:
+                asyncio.get_running_loop().call_later(delay, self._submit_drain)
+                return
+        self._submit_drain()
+
+    def _submit_drain(self) -> None:
         try:
             _DRAGS.submit(self._drain_drags)  # guarded: its errors are logged, never lost in a future
         except RuntimeError:  # the interpreter is shutting down
@@ -193,13 +225,19 @@ class ClientView:
         mechanism are merged into the one commit (30 students pulling the shared platform at once make one
         commit per round, not 30)."""
         with self.hub.lock:
+            session = self.session
+            session.drain_scheduled = False  # first: a drag that arrives from now on schedules the next drain,
+            session.next_drag_at = time.monotonic() + SHARED_DRAG_INTERVAL  # not before this
             if self.closed or not self._pending_drags:
+                other = next((v for v in session.views if v is not self and getattr(v, "_pending_drags", None)), None)
+                if other is not None and not other.closed:
+                    other._drain_drags()  # this tab left (or was merged) with the session's drain: hand it on
                 return
             mover, latest, arrival = self, self._pending_drags[-1], self._last_arrival
             ended = any(entry[0] == "end" for entry in self._pending_drags)
             self._pending_drags.clear()
-            if self.hub.access.may_change(self, self.session):
-                for view in self.session.views:
+            if self.hub.access.may_change(self, session):
+                for view in session.views:
                     pending = getattr(view, "_pending_drags", None)
                     if view is self or not pending or view.closed or not self.hub.access.may_change(view, view.session):
                         continue
@@ -271,7 +309,13 @@ class ClientView:
             return
         old = self.session
         self.hub.leave(self, old)
-        self.session = self.hub.join(self, private=private, session=old)
+        if private:
+            scene = self.scene.open_private(old.state.params)
+            self.session = self.hub.join(self, private=True, session=old, scene=scene)
+        else:
+            self.scene.close_private()
+            self.session = self.hub.join(self, private=False)
+        self._drawn_at = -1.0
         self.teaching.switched(old)
         self.hub.membership_changed()
 
@@ -281,8 +325,9 @@ class ClientView:
             return
         with self.hub.lock:
             self.scene.set_visible(what, bool(self.panel.show_toggles[what].value))
-            if self.session.frame is not None:
-                self.render(self.session.frame)
+            if self.session.scene is not None and self.session.frame is not None:
+                self.session.scene.update(self.session.frame)  # a private copy: the flags apply at its next draw
+            self.client.flush()
 
     @guarded
     def _on_frame(self, event) -> None:

@@ -5,7 +5,8 @@ Maps come from :class:`MapService`, one per hub: a parameter set's map (``worksp
 and its three colourings, ~45 ms) is computed once, in the background :class:`~.worker.Worker`, never inside a
 callback or the hub's lock, and published to every tab showing those parameters when it is ready. Until then
 a tab keeps its previous map hidden and says "computing". The ellipses (an SVD of the 2 x 2 ``J``) are
-recomputed for every frame of the tab; they are hidden at singular poses.
+recomputed for every frame the tab draws (world coordinates, centred on the platform, in the tab's own scope);
+they are hidden at singular poses.
 
 The map kind and the ellipses are a per-tab view setting, like the other *Class & view* toggles.
 """
@@ -36,7 +37,6 @@ ELLIPSE_SCALE = 0.12
 ELLIPSE_CAP = 3.0
 ELLIPSE_Z = meshes.PLATFORM_Z[1] + 0.004
 ELLIPSE_COLOURS = {"velocity": (30, 58, 138), "force": (234, 88, 12)}  # dark blue (not the leg circles' blue)
-REGION_NODE = "/tpm/loci/workspace"
 
 
 class MapService:
@@ -128,6 +128,7 @@ class ExplorerView:
         self.ellipses_on = False
         self._image = None
         self._image_key = None
+        self._map_drawn = None  # (params, kind) the legend and floor last showed: nothing to send while unchanged
         self._ellipses: dict[str, object] = {}
         self._frame: Frame | None = None
         maps.subscribers.add(self)
@@ -194,11 +195,12 @@ class ExplorerView:
     def _draw_map(self, params: Params) -> None:
         scene = self.view.client.scene
         kind = self.kind
+        if self._map_drawn == (params, kind):
+            return
         self.legend.content = colour_bar_html(kind)
-        region = next((h for h in getattr(self.view.scene, "loci", []) if h.name == REGION_NODE), None)
-        if region is not None and region.visible != (kind == "off" and self.view.scene.show["loci"]):
-            region.visible = kind == "off" and self.view.scene.show["loci"]
+        self.view.scene.set_region_hidden(kind != "off")  # the workspace floor would cover the map
         if kind == "off":
+            self._map_drawn = (params, kind)
             self.status.content = ""
             if self._image is not None and self._image.visible:
                 self._image.visible = False
@@ -212,6 +214,7 @@ class ExplorerView:
                 self._image.visible = False
             return
         self.status.content = ""
+        self._map_drawn = (params, kind)
         if self._image_key == (params, kind) and self._image is not None:
             if not self._image.visible:
                 self._image.visible = True
@@ -236,12 +239,13 @@ class ExplorerView:
                     handle.visible = False
                 continue
             pts = getattr(drawing, name)
+            pts = pts + np.asarray(frame.readout.p)  # world coordinates: drawn in the tab's own scope
             segs = np.zeros((len(pts) - 1, 2, 3), dtype=np.float32)
             segs[:, 0, :2], segs[:, 1, :2] = pts[:-1], pts[1:]
             segs[..., 2] = ELLIPSE_Z + (0.001 if name == "force" else 0.0)
             if handle is None:
                 self._ellipses[name] = scene.add_line_segments(
-                    f"/tpm/platform/ellipse_{name}", segs, ELLIPSE_COLOURS[name], thickness=3.0,
+                    f"/explorer/ellipse_{name}", segs, ELLIPSE_COLOURS[name], thickness=3.0,
                     thickness_units="screen",
                 )
             else:

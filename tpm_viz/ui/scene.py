@@ -1,9 +1,13 @@
-"""The 3D mechanism of one browser tab: scene handles built once, then only moved and recoloured.
+"""The 3D drawing of one mechanism: scene handles built once, then only moved and recoloured.
 
-:class:`MechanismScene` adds every node when it is created and re-adds geometry only in :meth:`rebuild` (a
-parameter change). :meth:`update` assigns poses and props, and only those that changed since the last call, so
-a drag sends a handful of small messages. Sliders and the platform are frames: their pins, labels, constraint
-circles and force arrows are children and follow without messages of their own.
+:class:`MechanismScene` adds every node under its ``root`` when it is created and re-adds geometry only in
+:meth:`rebuild` (a parameter change). :meth:`update` assigns poses and props, and only those that changed since the
+last call, so a drag sends a handful of small messages. Sliders and the platform are frames: their pins, labels,
+constraint circles and force arrows are children and follow without messages of their own.
+
+The shared mechanism is drawn ONCE, in viser's broadcast scope (``server.scene``, root ``/tpm``): a commit costs
+one set of messages whatever the number of tabs. A private copy is drawn in its tab's own scope (``client.scene``,
+root ``/own``). What one tab sees of them (its gizmo, its view options) is :mod:`.tabscene`.
 """
 
 from __future__ import annotations
@@ -19,7 +23,7 @@ from ..workspace import direct_singularity_locus, inverse_singularity_loci
 from .frame import Frame
 from .session import AppState
 
-__all__ = ["COLORS", "FORCE_SCALE", "MechanismScene"]
+__all__ = ["COLORS", "FAMILIES", "FORCE_SCALE", "GIZMO_Z", "MechanismScene", "camera_pose"]
 
 COLORS = {
     "base": (226, 232, 240),
@@ -50,6 +54,9 @@ FORCE_MAX = 0.3  # m
 ARROW_Z = meshes.PIN_Z[1] + 0.02  # m, above every part so that no part hides an arrow
 LOCI_Z = 0.0008  # m
 GIZMO_Z = meshes.PLATFORM_Z[1] + 0.02  # m
+FAMILIES = ("labels", "loci", "circles", "forces")
+"""The families of nodes a viewer may hide (*Class & view* tab); ``region`` (the workspace floor) is hidden while
+the explorer shows a map."""
 
 
 def _mesh(scene: viser.SceneApi, name: str, mesh, color, **kwargs):
@@ -66,31 +73,43 @@ def _mesh(scene: viser.SceneApi, name: str, mesh, color, **kwargs):
 
 
 class MechanismScene:
-    """Scene nodes of one mechanism in one scene API (a client's ``client.scene``)."""
+    """Scene nodes of one mechanism under ``root`` in one scene API (``server.scene`` or a ``client.scene``).
 
-    def __init__(self, scene: viser.SceneApi, params: Params) -> None:
+    ``sink`` (the server or the client) groups each :meth:`update` into one atomic message window, sent at once
+    if ``flush`` (a private copy is flushed with the rest of its tab, right after)."""
+
+    def __init__(
+        self, scene: viser.SceneApi, params: Params, root: str = "/tpm", sink=None, flush: bool = True
+    ) -> None:
         self._scene = scene
+        self.root = root
+        self._sink = sink
+        self._flush = flush
         self._sent: dict[str, object] = {}
+        self._drawn = None  # the Frame last drawn (a frame is drawn once, whoever asks)
         self.params: Params | None = None
-        self.show = {"labels": True, "loci": True, "circles": True, "forces": True}
+        self.show = dict.fromkeys((*FAMILIES, "region"), True)
         self.slider_bodies: list = [None, None]
         self.circles: list = [None, None]
         self.loci: list = []
+        self.region = None  # the workspace floor (one of the loci), None if the stroke holds no pose
+        r = root
+        self.root_node = scene.add_frame(r, show_axes=False)
         add_frame = scene.add_frame
-        self.sliders = [add_frame(f"/tpm/slider{i + 1}", show_axes=False) for i in range(2)]
-        self.platform = add_frame("/tpm/platform", show_axes=False)
-        self.ghost = add_frame("/tpm/ghost", show_axes=False)
-        self.labels = [scene.add_label("/tpm/label_O", "O", position=(0.0, 0.0, 0.002), anchor="top-left")]
+        self.sliders = [add_frame(f"{r}/slider{i + 1}", show_axes=False) for i in range(2)]
+        self.platform = add_frame(f"{r}/platform", show_axes=False)
+        self.ghost = add_frame(f"{r}/ghost", show_axes=False)
+        self.labels = [scene.add_label(f"{r}/label_O", "O", position=(0.0, 0.0, 0.002), anchor="top-left")]
         for i in range(2):
-            self.labels.append(scene.add_label(f"/tpm/slider{i + 1}/label", f"A{'₁₂'[i]}", anchor="bottom-right"))
-            self.labels.append(scene.add_label(f"/tpm/platform/label_B{i + 1}", f"B{'₁₂'[i]}", anchor="bottom-right"))
-        self.label_p = scene.add_label("/tpm/platform/label_P", "P", anchor="bottom-left")
+            self.labels.append(scene.add_label(f"{r}/slider{i + 1}/label", f"A{'₁₂'[i]}", anchor="bottom-right"))
+            self.labels.append(scene.add_label(f"{r}/platform/label_B{i + 1}", f"B{'₁₂'[i]}", anchor="bottom-right"))
+        self.label_p = scene.add_label(f"{r}/platform/label_P", "P", anchor="bottom-left")
         self.labels.append(self.label_p)
-        self.ghost_label = scene.add_label("/tpm/ghost/label", "P′ (other assembly mode)", anchor="center-center")
+        self.ghost_label = scene.add_label(f"{r}/ghost/label", "P′ (other assembly mode)", anchor="center-center")
         self.labels.append(self.ghost_label)
         self.forces = [
             scene.add_arrows(
-                f"/tpm/slider{i + 1}/force",
+                f"{r}/slider{i + 1}/force",
                 np.zeros((1, 2, 3)),
                 COLORS["tau_pos"],
                 shaft_radius=0.007,
@@ -101,7 +120,7 @@ class MechanismScene:
             for i in range(2)
         ]
         self.load_arrow = scene.add_arrows(
-            "/tpm/platform/load",
+            f"{r}/platform/load",
             np.zeros((1, 2, 3)),
             COLORS["load"],
             shaft_radius=0.004,
@@ -109,26 +128,36 @@ class MechanismScene:
             head_length=0.022,
             visible=False,
         )
-        self.gizmo = scene.add_transform_controls(
-            "/gizmo",
-            scale=0.16,
-            active_axes=(True, True, False),
-            disable_rotations=True,
-            depth_test=False,
-            position=(0.0, 0.0, GIZMO_Z),
-        )
         self.rebuild(params)
+
+    def family(self, what: str) -> list[str]:
+        """Names of the nodes of a view family (:data:`FAMILIES` or ``region``): what a viewer hides."""
+        r = self.root
+        names = {
+            "labels": [f"{r}/label_O", f"{r}/platform/label_P", f"{r}/ghost/label"]
+            + [f"{r}/slider{i}/label" for i in (1, 2)]
+            + [f"{r}/platform/label_B{i}" for i in (1, 2)],
+            "loci": [f"{r}/loci/{kind}" for kind in ("workspace", "inverse", "direct")],
+            "circles": [f"{r}/slider1/circle", f"{r}/slider2/circle", f"{r}/ghost"],
+            "forces": [f"{r}/slider1/force", f"{r}/slider2/force", f"{r}/platform/load"],
+            "region": [f"{r}/loci/workspace"],
+        }
+        return names[what]
+
+    def remove(self) -> None:
+        """Remove every node of this drawing (a private copy that its tab leaves)."""
+        self.root_node.remove()
 
     def rebuild(self, params: Params) -> None:
         """(Re)add every node whose geometry depends on the parameters."""
-        s = self._scene
+        s, r = self._scene, self.root
         self.params = params
         self._sent.clear()
         lo, hi = meshes.base_extent(params)
-        _mesh(s, "/tpm/base", meshes.base_plate(params), COLORS["base"])
+        _mesh(s, f"{r}/base", meshes.base_plate(params), COLORS["base"])
         size = hi - lo
         s.add_grid(
-            "/tpm/grid",
+            f"{r}/grid",
             size,
             size,
             plane="xy",
@@ -140,15 +169,15 @@ class MechanismScene:
             shadow_opacity=0.0,
         )
         for i in range(2):
-            _mesh(s, f"/tpm/rail{i + 1}", meshes.rail(params, i), COLORS["rail"])
-            _mesh(s, f"/tpm/stops{i + 1}", meshes.end_stops(params, i), COLORS["stop"])
-            self.slider_bodies[i] = _mesh(s, f"/tpm/slider{i + 1}/body", meshes.slider(params, i), COLORS["slider"])
+            _mesh(s, f"{r}/rail{i + 1}", meshes.rail(params, i), COLORS["rail"])
+            _mesh(s, f"{r}/stops{i + 1}", meshes.end_stops(params, i), COLORS["stop"])
+            self.slider_bodies[i] = _mesh(s, f"{r}/slider{i + 1}/body", meshes.slider(params, i), COLORS["slider"])
             offsets = meshes.slider_pin_offsets(params, i)
-            self._pins(f"/tpm/slider{i + 1}/pins", offsets)
+            self._pins(f"{r}/slider{i + 1}/pins", offsets)
             centre = np.zeros(3)
             centre[i] = params.b  # C_i = A_i + b e_i
             self.circles[i] = s.add_line_segments(
-                f"/tpm/slider{i + 1}/circle",
+                f"{r}/slider{i + 1}/circle",
                 meshes.circle_segments(params.l_a, LOCI_Z + 0.001) + centre,
                 COLORS["circle"],
                 thickness=2.0,
@@ -160,7 +189,7 @@ class MechanismScene:
             self.labels[2 + 2 * i].position = tuple(b_label)
         link = meshes.link(params)
         self.links = s.add_batched_meshes_simple(
-            "/tpm/links",
+            f"{r}/links",
             link.vertices,
             link.faces,
             batched_wxyzs=np.tile([1.0, 0.0, 0.0, 0.0], (4, 1)),
@@ -170,11 +199,11 @@ class MechanismScene:
             cast_shadow=False,
             receive_shadow=False,
         )
-        self.platform_body = _mesh(s, "/tpm/platform/body", meshes.platform(params), COLORS["platform"])
-        _mesh(s, "/tpm/platform/marker", meshes.tool_marker(), COLORS["marker"])
-        self._pins("/tpm/platform/pins", meshes.platform_pin_offsets(params))
+        self.platform_body = _mesh(s, f"{r}/platform/body", meshes.platform(params), COLORS["platform"])
+        _mesh(s, f"{r}/platform/marker", meshes.tool_marker(), COLORS["marker"])
+        self._pins(f"{r}/platform/pins", meshes.platform_pin_offsets(params))
         self.label_p.position = (0.0, 0.0, meshes.PLATFORM_Z[1] + 0.01)
-        _mesh(s, "/tpm/ghost/body", meshes.platform(params), COLORS["circle"], opacity=0.22)
+        _mesh(s, f"{r}/ghost/body", meshes.platform(params), COLORS["circle"], opacity=0.22)
         self.ghost_label.position = (0.0, 0.0, meshes.PLATFORM_Z[1])
         self._loci(params)
 
@@ -194,19 +223,21 @@ class MechanismScene:
     def _loci(self, params: Params) -> None:
         """The floor overlay: the workspace inside the stroke (eq. 4), the inverse singularity square (eq. 11)
         and the direct singularity arcs (eq. 12), all in the working mode."""
-        s = self._scene
+        s, r = self._scene, self.root
         ws = cached_map(params, 100)  # once per parameter set for all tabs
         region = meshes.region_mesh(ws.in_stroke, ws.xs, ws.ys, LOCI_Z / 2)
         self.loci = []
+        self.region = None
         if region is not None:
-            self.loci.append(_mesh(s, "/tpm/loci/workspace", region, COLORS["workspace"], opacity=0.45, side="double"))
+            self.region = _mesh(s, f"{r}/loci/workspace", region, COLORS["workspace"], opacity=0.45, side="double")
+            self.loci.append(self.region)
         for kind, curves in (
             ("inverse", inverse_singularity_loci(params)),
             ("direct", direct_singularity_locus(params)),
         ):
             self.loci.append(
                 s.add_line_segments(
-                    f"/tpm/loci/{kind}",
+                    f"{r}/loci/{kind}",
                     meshes.polyline_segments(curves, LOCI_Z),
                     COLORS[f"locus_{kind}"],
                     thickness=2.5,
@@ -214,7 +245,10 @@ class MechanismScene:
                 )
             )
         for handle in self.loci:
-            handle.visible = self.show["loci"]
+            handle.visible = self._locus_visible(handle)
+
+    def _locus_visible(self, handle) -> bool:
+        return self.show["loci"] and (handle is not self.region or self.show["region"])
 
     @staticmethod
     def _leg_colors(near_inverse) -> np.ndarray:
@@ -230,26 +264,41 @@ class MechanismScene:
         self._sent[key] = value
 
     def forget(self) -> None:
-        """Send every pose again at the next :meth:`update` (e.g. to put a refused gizmo drag back)."""
+        """Send every pose again at the next :meth:`update`."""
         self._sent.clear()
+        self._drawn = None
 
     def set_visible(self, what: str, visible: bool) -> None:
-        """Show or hide a family of nodes: ``labels``, ``loci``, ``circles`` or ``forces``."""
+        """Show or hide a family of nodes (:data:`FAMILIES`, or ``region``: the workspace floor) of this drawing."""
         self.show[what] = bool(visible)
         if what == "labels":
             for label in self.labels:
                 label.visible = visible
-        elif what == "loci":
+        elif what in ("loci", "region"):
             for locus in self.loci:
-                locus.visible = visible
+                if locus.visible != self._locus_visible(locus):
+                    locus.visible = self._locus_visible(locus)
         elif what == "circles":
             for circle in self.circles:
                 circle.visible = visible
         for key in [k for k in self._sent if k.endswith("_vis") or k.startswith("force_vis")]:
             del self._sent[key]  # re-evaluated at the next update
+        self._drawn = None
 
-    def update(self, frame: Frame, dragging: bool = False) -> None:
-        """Move every part to the frame's pose and recolour it from its alerts."""
+    def update(self, frame: Frame) -> None:
+        """Move every part to the frame's pose and recolour it from its alerts (nothing if ``frame`` is drawn)."""
+        if frame is self._drawn:
+            return
+        if self._sink is None:
+            self._update(frame)
+        else:
+            with self._sink.atomic():
+                self._update(frame)
+            if self._flush:
+                self._sink.flush()
+        self._drawn = frame
+
+    def _update(self, frame: Frame) -> None:
         state, readout = frame.state, frame.readout
         params = state.params
         if params != self.params:
@@ -277,10 +326,6 @@ class MechanismScene:
             self._set("ghost", self.ghost, "position", np.array([readout.other_p[0], readout.other_p[1], 0.0]))
         self._set("ghost_vis", self.ghost, "visible", ghost_visible)
         self._update_forces(state, readout)
-        if not dragging:
-            self._set("gizmo", self.gizmo, "position", np.array([readout.p[0], readout.p[1], GIZMO_Z]))
-        else:
-            self._sent.pop("gizmo", None)
 
     def _update_forces(self, state: AppState, readout: Readout) -> None:
         tau = readout.forces.tau

@@ -10,6 +10,9 @@ Incoming widget values are untrusted (the browser does not range-check them): th
 (re-exported here: :func:`read_vec2`, :func:`read_number`) check them and raise :class:`~tpm_viz.InputError`.
 With a presenter token (:mod:`.access`) only the presenter's tabs may commit to the shared session.
 A failure while drawing one tab is logged and does not stop the others (:mod:`.guard`).
+
+A session's mechanism is drawn once per commit, in its ``scene`` (for the shared session one broadcast drawing that
+every tab receives; for a private copy its tab's own drawing), then each view draws its own part (gizmo, panel).
 """
 
 from __future__ import annotations
@@ -70,6 +73,13 @@ class AppState:
         return dataclasses.replace(self, version=self.version + 1, **changes)
 
 
+class Drawing(Protocol):
+    """The 3D drawing of a session's mechanism (:class:`~tpm_viz.ui.scene.MechanismScene`)."""
+
+    def update(self, frame) -> None:
+        """Draw ``frame`` (a no-op if it is the frame last drawn)."""
+
+
 class View(Protocol):
     """What a session needs from a browser tab."""
 
@@ -81,12 +91,16 @@ class View(Protocol):
 class Session:
     """One mechanism state and the views that show it (mutated only under the hub's lock)."""
 
-    def __init__(self, state: AppState, shared: bool) -> None:
+    def __init__(self, state: AppState, shared: bool, scene: Drawing | None = None) -> None:
         self.state = state
         self.shared = shared
+        self.scene = scene
+        """Where the mechanism is drawn once per commit, or None (each view draws it)."""
         self.views: list[View] = []
         self.frame = None  # the Frame last drawn (tpm_viz.ui.frame), None until the first draw
         self.play_token = 0  # a playing trajectory stops when this changes
+        self.drain_scheduled = False  # a drag commit is scheduled (ui/client.py: latest value wins)
+        self.next_drag_at = 0.0  # time.monotonic() before which no further drag is committed
 
     @property
     def readout(self) -> Readout | None:
@@ -97,9 +111,15 @@ class Session:
 class Hub:
     """The shared session and the private copies; :meth:`commit` is the only way state changes."""
 
-    def __init__(self, state: AppState, reference: Reference | None = None, access: Access | None = None) -> None:
+    def __init__(
+        self,
+        state: AppState,
+        reference: Reference | None = None,
+        access: Access | None = None,
+        scene: Drawing | None = None,
+    ) -> None:
         self.lock = threading.RLock()
-        self.shared = Session(state, shared=True)
+        self.shared = Session(state, shared=True, scene=scene)
         self.reference = reference
         self.access = access if access is not None else Access()
         """Who may commit to the shared session (everybody unless a presenter token is set)."""
@@ -128,14 +148,17 @@ class Hub:
         """Raise :class:`~tpm_viz.ui.access.AccessDenied` unless ``view`` may change ``session``."""
         self.access.check(view, session)
 
-    def join(self, view: View, private: bool, session: Session | None = None) -> Session:
-        """Attach ``view`` to the shared session, or to a new private copy of ``session``'s state; draws it.
+    def join(
+        self, view: View, private: bool, session: Session | None = None, scene: Drawing | None = None
+    ) -> Session:
+        """Attach ``view`` to the shared session, or to a new private copy of ``session``'s state drawn in
+        ``scene``; draws it.
 
         The caller stores the returned session in the view, then calls :meth:`membership_changed`."""
         with self.lock:
             source = session if session is not None else self.shared
             if private:
-                target = Session(source.state, shared=False)
+                target = Session(source.state, shared=False, scene=scene)
                 target.frame = source.frame  # same state: same drawing
             else:
                 target = self.shared
@@ -165,6 +188,11 @@ class Hub:
     def _draw(self, session: Session, views: list[View], origin: View | None, dragging: bool) -> None:
         if session.frame is None:
             session.frame = self.frame(session.state, dragging)
+        if session.scene is not None:
+            try:
+                session.scene.update(session.frame)  # once for every view of the session
+            except Exception as exc:  # e.g. the only tab of a private copy went away mid-push
+                report(exc, f"drawing {type(session.scene).__name__}")
         if origin in views:
             views.remove(origin)
             views.insert(0, origin)

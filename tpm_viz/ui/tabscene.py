@@ -1,0 +1,155 @@
+"""What one browser tab sees of the mechanism: its gizmo, its view options, and which drawing it shows.
+
+The shared mechanism is one :class:`~.scene.MechanismScene` in viser's broadcast scope, drawn once per commit for
+every tab. A tab changes what *it* sees with viser's scope shadowing (viser 1.1.1: a client-scoped node with the
+name of a broadcast node replaces it for that one client, and the broadcast node comes back when the client's node
+is removed):
+
+- a view option turned off (labels, loci, circles, forces) or the workspace floor under an explorer map: an
+  invisible client-scoped frame over each node of that family (its broadcast children are hidden with it);
+- a private copy: an invisible client-scoped frame over the whole shared root, and the copy drawn under ``/own``
+  in the tab's own scope, where the view options are plain visibility flags.
+
+The gizmo is always the tab's own (each student drags their own handle); it is written back to the platform's pose
+when this tab is not the one dragging.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import viser
+
+from ..params import Params
+from .frame import Frame
+from .scene import FAMILIES, GIZMO_Z, MechanismScene
+
+__all__ = ["PRIVATE_ROOT", "TabScene"]
+
+PRIVATE_ROOT = "/own"
+"""Where a tab draws its private copy (its own scope)."""
+
+
+def _no_echo(gizmo) -> None:
+    """Drop viser's cross-client echo of this gizmo's drags: for a client-scoped gizmo it queues two messages per
+    drag event that are addressed to every client but this one, i.e. to nobody (viser 1.1.1 internals; ~5 % of
+    the server's CPU with 30 tabs dragging, benchmarks/bench_load.py). Harmless if viser changes."""
+    aux = getattr(gizmo, "_impl_aux", None)
+    if aux is not None and hasattr(aux, "sync_cb"):
+        aux.sync_cb = None
+
+
+class TabScene:
+    """The gizmo, view options and shadows of one tab; ``shared`` is the broadcast drawing of the shared mechanism."""
+
+    def __init__(self, client: viser.ClientHandle, shared: MechanismScene) -> None:
+        self._client = client
+        self._api = client.scene
+        self.shared = shared
+        self.private: MechanismScene | None = None
+        self.show = dict.fromkeys(FAMILIES, True)
+        self.region_hidden = False
+        """True while the explorer shows a map on the floor (the workspace region would cover it)."""
+        self._shadows: dict[str, object] = {}  # broadcast node name -> the invisible client frame over it
+        self._cover = None  # the invisible client frame over the shared root while the private copy is shown
+        self._gizmo_at: np.ndarray | None = None
+        self.gizmo = self._api.add_transform_controls(
+            "/gizmo",
+            scale=0.16,
+            active_axes=(True, True, False),
+            disable_rotations=True,
+            depth_test=False,
+            position=(0.0, 0.0, GIZMO_Z),
+        )
+        _no_echo(self.gizmo)
+
+    @property
+    def mechanism(self) -> MechanismScene:
+        """The drawing this tab shows: its private copy, or the shared mechanism."""
+        return self.private if self.private is not None else self.shared
+
+    def __getattr__(self, name: str):
+        """The nodes of the drawing this tab shows (``platform``, ``sliders``, ``links``, ...)."""
+        if name.startswith("_") or name in ("shared", "private"):
+            raise AttributeError(name)
+        return getattr(self.mechanism, name)
+
+    # -- which drawing -------------------------------------------------------------------------------------
+    def open_private(self, params: Params) -> MechanismScene:
+        """Hide the shared mechanism in this tab and draw a private copy (returned: the new session's scene)."""
+        self._set_shadows(set())
+        if self._cover is None:
+            self._cover = self._api.add_frame(self.shared.root, show_axes=False, visible=False)
+        if self.private is None:
+            sink = None
+            self.private = MechanismScene(self._api, params, root=PRIVATE_ROOT, sink=sink, flush=False)
+            for what in FAMILIES:
+                self.private.set_visible(what, self.show[what])
+            self.private.set_visible("region", not self.region_hidden)
+        return self.private
+
+    def close_private(self) -> None:
+        """Remove the private copy: the shared mechanism (in its latest state) shows again."""
+        if self.private is not None:
+            self.private.remove()
+            self.private = None
+        if self._cover is not None:
+            self._cover.remove()
+            self._cover = None
+        self._sync_shadows()
+
+    # -- view options --------------------------------------------------------------------------------------
+    def set_visible(self, what: str, visible: bool) -> None:
+        """Show or hide a family of nodes (:data:`~.scene.FAMILIES`) in this tab only."""
+        self.show[what] = bool(visible)
+        if self.private is not None:
+            self.private.set_visible(what, visible)
+        else:
+            self._sync_shadows()
+
+    def set_region_hidden(self, hidden: bool) -> None:
+        """Hide the workspace floor in this tab (the explorer draws a map there)."""
+        if bool(hidden) == self.region_hidden:
+            return
+        self.region_hidden = bool(hidden)
+        if self.private is not None:
+            self.private.set_visible("region", not self.region_hidden)
+        else:
+            self._sync_shadows()
+
+    def hidden(self) -> set[str]:
+        """Names of the shared mechanism's nodes hidden in this tab (everything under the root for a private copy)."""
+        if self._cover is not None:
+            return {self.shared.root}
+        return set(self._shadows)
+
+    def _sync_shadows(self) -> None:
+        wanted: set[str] = set()
+        for what in FAMILIES:
+            if not self.show[what]:
+                wanted.update(self.shared.family(what))
+        if self.region_hidden:
+            wanted.update(self.shared.family("region"))
+        self._set_shadows(wanted)
+
+    def _set_shadows(self, wanted: set[str]) -> None:
+        for name in [n for n in self._shadows if n not in wanted]:
+            self._shadows.pop(name).remove()
+        for name in sorted(wanted - set(self._shadows)):
+            self._shadows[name] = self._api.add_frame(name, show_axes=False, visible=False)
+
+    # -- per frame -----------------------------------------------------------------------------------------
+    def update(self, frame: Frame, dragging: bool = False) -> None:
+        """Put the gizmo on the platform, unless this tab is dragging it (the browser moves it itself)."""
+        if dragging:
+            self._gizmo_at = None  # written again once the drag is over
+            return
+        at = np.array([frame.readout.p[0], frame.readout.p[1], GIZMO_Z])
+        if self._gizmo_at is None or not np.array_equal(at, self._gizmo_at):
+            self.gizmo.position = at
+            self._gizmo_at = at
+
+    def forget(self) -> None:
+        """Write the gizmo (and a private copy) again at the next :meth:`update` (a refused drag goes back)."""
+        self._gizmo_at = None
+        if self.private is not None:
+            self.private.forget()
