@@ -285,3 +285,19 @@ def test_a_background_thread_that_dies_is_logged(monkeypatch, caplog):
         thread.join()
     assert ACTIVITY.snapshot()[1] == errors + 1
     assert "thread tpm-viz-play failed: ZeroDivisionError" in caplog.text and "Traceback" in caplog.text
+
+
+def test_a_bug_in_a_background_job_is_logged_and_the_worker_carries_on(caplog):
+    """The worker (maps, trajectory runs) logs a job's bug with its traceback through the guard and keeps going."""
+    from tpm_viz.ui.guard import ACTIVITY
+    from tpm_viz.ui.worker import Worker
+
+    worker, results = Worker(), []
+    errors_before = ACTIVITY.snapshot()[1]
+    with caplog.at_level("ERROR", logger="tpm_viz"):
+        worker.submit("bad", lambda: 1 / 0, lambda result, error: results.append(("bad", result, error)))
+        worker.submit("good", lambda: 42, lambda result, error: results.append(("good", result, error)))
+        wait_for(lambda: len(results) == 2 and worker.idle(), what="both jobs done")
+    assert isinstance(results[0][2], ZeroDivisionError) and results[1] == ("good", 42, None)
+    assert ACTIVITY.snapshot()[1] == errors_before + 1
+    assert any("background job failed: ZeroDivisionError" in r.getMessage() and r.exc_info for r in caplog.records)

@@ -25,6 +25,7 @@ from .. import meshes
 from ..overlays import MAP_KINDS, cached_map, colour_scale, ellipse_polylines, map_rgba
 from ..params import Params
 from .frame import Frame
+from .guard import guarded
 from .text import num
 from .worker import Worker
 
@@ -161,6 +162,7 @@ class ExplorerView:
         if self._frame is not None:
             self.render(self._frame)
 
+    @guarded
     def _on_kind(self, event) -> None:
         if getattr(event, "client", None) is None:
             return
@@ -169,6 +171,7 @@ class ExplorerView:
             self.set(kind=kinds.get(self.map_kind.value, "off"))
             self.view.client.flush()
 
+    @guarded
     def _on_ellipses(self, event) -> None:
         if getattr(event, "client", None) is None:
             return

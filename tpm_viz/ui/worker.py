@@ -10,11 +10,11 @@ wins). The thread starts on demand and ends when the queue is empty, so idle app
 from __future__ import annotations
 
 import threading
-import traceback
 from collections import OrderedDict
 from collections.abc import Callable, Hashable
 
 from ..errors import TpmVizError
+from .guard import report
 
 __all__ = ["Worker"]
 
@@ -57,14 +57,14 @@ class Worker:
                 result = fn()
             except TpmVizError as exc:
                 error = exc
-            except Exception as exc:  # a bug: report it, keep the worker alive
-                traceback.print_exception(exc)
+            except Exception as exc:  # a bug: log it with its traceback, keep the worker alive
+                report(exc, "background job")
                 error = exc
             try:
                 if done is not None:
                     done(result, error)
             except Exception as exc:  # pragma: no cover - a bug in a publisher
-                traceback.print_exception(exc)
+                report(exc, "publishing a background result")
             finally:
                 with self._cond:
                     self._busy = False
