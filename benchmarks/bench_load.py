@@ -17,7 +17,7 @@ latency is the presenter's send -> the update reaching them) and ``shared`` (no 
 shared mechanism at once: the worst case).
 
 Run: ``python benchmarks/bench_load.py`` (about a minute); ``--quick`` for 4 s per N. Target: p95 < 50 ms at N = 30
-(private). Bounded: every loop has a count and a time limit; the servers stop by themselves (their own pid).
+(every mode). Bounded: every loop has a count and a time limit; the servers stop by themselves (their own pid).
 """
 
 from __future__ import annotations
