@@ -146,12 +146,12 @@ def _scene_values(view):
 
 @pytest.fixture
 def two_tabs(app, connect, monkeypatch):
-    """The actor and the observer; exceptions printed by the background worker or escaping a thread fail the test
+    """The actor and the observer; exceptions reported by the background worker or escaping a thread fail the test
     (they would be lines in the server log)."""
     import tpm_viz.ui.worker as worker_module
 
     crashes: list[BaseException] = []
-    monkeypatch.setattr(worker_module.traceback, "print_exception", lambda exc, *a, **k: crashes.append(exc))
+    monkeypatch.setattr(worker_module, "report", lambda exc, *a, **k: crashes.append(exc))
     monkeypatch.setattr(threading, "excepthook", lambda args: crashes.append(args.exc_value))
     actor, view = connect()
     _observer, other = connect()
