@@ -11,7 +11,7 @@ from timing import median_seconds, report
 
 import tpm_viz as tv
 from tpm_viz import multibody
-from tpm_viz.replay import replay
+from tpm_viz.multibody.replay import replay
 
 
 def main() -> None:

@@ -30,12 +30,12 @@ sys.path.insert(0, str(ROOT / "tests"))
 from conftest import ProtocolClient, wait_for  # noqa: E402
 from timing import median_seconds, report  # noqa: E402
 
-from tpm_viz import Params  # noqa: E402
-from tpm_viz.multibody import inverse_dynamics as pinocchio  # noqa: E402
-from tpm_viz.playback import Source, build_run  # noqa: E402
-from tpm_viz.ui import explorer as explorer_module  # noqa: E402
-from tpm_viz.ui.app import TpmApp, build_server  # noqa: E402
-from tpm_viz.ui.transitions import apply_params  # noqa: E402
+from tpm_viz import Params
+from tpm_viz.app.runs import Source, build_run
+from tpm_viz.app.transitions import apply_params
+from tpm_viz.multibody.model import inverse_dynamics as pinocchio
+from tpm_viz.ui.app import TpmApp, build_server
+from tpm_viz.ui.teaching import explorer as explorer_module
 
 P = Params.paper()
 
@@ -80,14 +80,30 @@ def bench_compute(repeat: int) -> None:
     print("1. Computation (median of fresh parameter sets)")
     service = explorer_module.MapService(worker=None)
     sets = iter(P.replace(l_a=0.25 + 1e-5 * k) for k in range(10_000))
-    report("floor map: workspace_map 200 x 200 + 3 colourings", median_seconds(lambda: service._compute(next(sets)),
-           repeat=repeat), 50e-3, "ms", 1e3)
+    report(
+        "floor map: workspace_map 200 x 200 + 3 colourings",
+        median_seconds(lambda: service._compute(next(sets)), repeat=repeat),
+        50e-3,
+        "ms",
+        1e3,
+    )
     for kind, duration in (("line", 0.2), ("circle", 0.5)):
-        report(f"trajectory run, {kind}: 401 samples, closed form + Pinocchio",
-               median_seconds(lambda kind=kind, d=duration: build_run(P, Source.paper(kind, d), pinocchio),
-                              repeat=max(3, repeat // 3)), None, "ms", 1e3)
-    report("trajectory run, circle: closed form only",
-           median_seconds(lambda: build_run(P, Source.paper("circle")), repeat=repeat), None, "ms", 1e3)
+        report(
+            f"trajectory run, {kind}: 401 samples, closed form + Pinocchio",
+            median_seconds(
+                lambda kind=kind, d=duration: build_run(P, Source.paper(kind, d), pinocchio), repeat=max(3, repeat // 3)
+            ),
+            None,
+            "ms",
+            1e3,
+        )
+    report(
+        "trajectory run, circle: closed form only",
+        median_seconds(lambda: build_run(P, Source.paper("circle")), repeat=repeat),
+        None,
+        "ms",
+        1e3,
+    )
 
 
 def _drag_during_param_changes(samples: int, mode: str) -> list[float]:
@@ -165,8 +181,9 @@ def _playback(tabs: int, seconds: float) -> None:
     view = views[0]
     runs = view.teaching.services.runs
     runs.load(view.session, Source.paper("circle"))
-    wait_for(lambda: runs.of(view.session).run is not None and view.session.state.trajectory.kind == "circle",
-             what="the run")
+    wait_for(
+        lambda: runs.of(view.session).run is not None and view.session.state.trajectory.kind == "circle", what="the run"
+    )
     commit_times: list[float] = []
     original = view.hub.commit
 

@@ -29,7 +29,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 from conftest import CHROMIUM, CHROMIUM_ARGS, WORKER_LOG_JS, ProtocolClient, wait_for  # noqa: E402
 
-from tpm_viz.ui.app import TpmApp, build_server  # noqa: E402
+from tpm_viz.ui.app import TpmApp, build_server
 
 
 def _stats(name: str, seconds) -> None:

@@ -65,12 +65,14 @@ def minimal_coordinate_forces(params, p, dp, ddp, f_ext=(0.0, 0.0), h=1e-5):
     p, dp, ddp = (np.asarray(x, float) for x in (p, dp, ddp))
 
     def dT_ddp(q, v):
-        return np.array([(_kinetic_quadratic(params, q, v + h * e) - _kinetic_quadratic(params, q, v - h * e)) / (2 * h)
-                         for e in E])
+        return np.array(
+            [(_kinetic_quadratic(params, q, v + h * e) - _kinetic_quadratic(params, q, v - h * e)) / (2 * h) for e in E]
+        )
 
     def dT_dp(q, v):
-        return np.array([(_kinetic_quadratic(params, q + h * e, v) - _kinetic_quadratic(params, q - h * e, v)) / (2 * h)
-                         for e in E])
+        return np.array(
+            [(_kinetic_quadratic(params, q + h * e, v) - _kinetic_quadratic(params, q - h * e, v)) / (2 * h) for e in E]
+        )
 
     dt = 1e-5
     ahead = dT_ddp(p + dp * dt + 0.5 * ddp * dt**2, dp + ddp * dt)

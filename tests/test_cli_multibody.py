@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import tpm_viz as tv
-from tpm_viz import cli_multibody
+from tpm_viz.cli import multibody as cli_multibody
 
 P = tv.Params.paper()
 

@@ -1,17 +1,18 @@
-"""The guided demonstrations (tpm_viz.demos): every scene is valid, and the effect each one states is true."""
+"""The guided demonstrations (tpm_viz.app.lessons): every scene is valid, and the effect each one states is true."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from tpm_viz import InputError, Params, forward_kinematics_both, jacobians, meshes
-from tpm_viz.demos import DEMOS, demo_by_key, demo_params, demo_pose, demo_source, effect
-from tpm_viz.ellipses import manipulability_ellipses
-from tpm_viz.interaction import OK, check
-from tpm_viz.overlays import MAP_KINDS, cached_map
-from tpm_viz.playback import Source, build_run
-from tpm_viz.workspace import workspace_area
+from tpm_viz import InputError, Params, forward_kinematics_both, meshes
+from tpm_viz.app.lessons import DEMOS, demo_by_key, demo_params, demo_pose, demo_source, effect
+from tpm_viz.app.moves import OK, check
+from tpm_viz.app.overlays import MAP_KINDS, cached_map
+from tpm_viz.app.runs import Source, build_run
+from tpm_viz.paper.ellipses import manipulability_ellipses
+from tpm_viz.paper.jacobians import jacobians
+from tpm_viz.paper.workspace import workspace_area
 
 P = Params.paper()
 
@@ -73,7 +74,7 @@ def test_the_circle_peak_at_two_speeds_goes_as_one_over_t_squared():
 
 
 def test_paper_and_pinocchio_really_agree_on_the_agreement_demo():
-    from tpm_viz.multibody import inverse_dynamics as pinocchio
+    from tpm_viz.multibody.model import inverse_dynamics as pinocchio
 
     demo = demo_by_key("agreement")
     run = build_run(P, demo_source(demo), pinocchio)
@@ -88,7 +89,7 @@ def test_the_two_assembly_modes_exist_mirror_each_other_and_are_both_valid():
     np.testing.assert_allclose(pose.p, sol.plus)
     dets = [float(jacobians(P, q, demo.d).det_jx) for q in (sol.plus, sol.minus)]
     assert dets[0] > 0.2 and dets[1] < -0.2  # opposite signs of det J_x, clear of the arc
-    from tpm_viz.interaction import Pose
+    from tpm_viz.app.moves import Pose
 
     assert check(P, Pose(sol.minus, demo.d)) == OK
     np.testing.assert_allclose(sol.plus, sol.plus[::-1])  # both on the diagonal, mirrored across the arc

@@ -8,8 +8,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from strategies import params_sets, regular_states
 
-from tpm_viz import Params, SingularConfigurationError, jacobians
-from tpm_viz.ellipses import ellipse_outline, manipulability_ellipses
+from tpm_viz import Params, SingularConfigurationError
+from tpm_viz.paper.ellipses import ellipse_outline, manipulability_ellipses
+from tpm_viz.paper.jacobians import jacobians
 
 
 @settings(max_examples=100, deadline=None, derandomize=True)

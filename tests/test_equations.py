@@ -8,8 +8,9 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from tpm_viz import Params, inverse_dynamics_detail, jacobians
-from tpm_viz.equations import ERRATA_HTML, procedure_html
+from tpm_viz import Params, inverse_dynamics_detail
+from tpm_viz.app.equations import ERRATA_HTML, procedure_html
+from tpm_viz.paper.jacobians import jacobians
 
 P = Params.paper()
 NON_FINITE = re.compile(r"\b(nan|inf|infinity)\b", re.IGNORECASE)

@@ -1,4 +1,4 @@
-"""The explorer's overlays (tpm_viz.overlays, workspace_area) against the formulas: map pixels against eqs.
+"""The explorer's overlays (tpm_viz.app.overlays, workspace_area) against the formulas: map pixels against eqs.
 (4), (10), (12) at their grid points, orientation, transparency where nothing exists, no NaN in any image, the
 ellipses against J. No viser."""
 
@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tpm_viz import InputError, Params, jacobians
-from tpm_viz.overlays import (
+from tpm_viz import InputError, Params
+from tpm_viz.app.overlays import (
     _DIVERGING,
     _SEQUENTIAL,
     ALPHA,
@@ -19,7 +19,8 @@ from tpm_viz.overlays import (
     ellipse_polylines,
     map_rgba,
 )
-from tpm_viz.workspace import workspace_area, workspace_map
+from tpm_viz.paper.jacobians import jacobians
+from tpm_viz.paper.workspace import workspace_area, workspace_map
 
 P = Params.paper()
 

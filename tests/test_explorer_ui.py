@@ -10,8 +10,8 @@ import pytest
 from conftest import wait_for
 
 from tpm_viz import Params
-from tpm_viz.overlays import MAP_KINDS
-from tpm_viz.ui import explorer as explorer_module
+from tpm_viz.app.overlays import MAP_KINDS
+from tpm_viz.ui.teaching import explorer as explorer_module
 
 P = Params.paper()
 
@@ -66,8 +66,10 @@ def test_a_parameter_change_regenerates_the_map_once_for_all_tabs(connect, monke
     wait_for(lambda: view.panel.params["l_a"].value == 220.0, what="the input")
     client.click(view.panel.apply)
     wait_for(
-        lambda: all(_image(v) is not None and v.teaching.explorer._image_key[0].l_a == pytest.approx(0.22)
-                    for v in (view, other)),
+        lambda: all(
+            _image(v) is not None and v.teaching.explorer._image_key[0].l_a == pytest.approx(0.22)
+            for v in (view, other)
+        ),
         what="the new map in both tabs",
     )
     assert _image(view).render_width == pytest.approx(0.44 * 200 / 199)

@@ -17,7 +17,7 @@ from conftest import ProtocolClient, wait_for
 from test_reliability_app import assert_valid
 
 from tpm_viz import Params
-from tpm_viz.ui import transitions
+from tpm_viz.app import transitions
 from tpm_viz.ui.guard import ACTIVITY, guarded
 
 P = Params.paper()

@@ -1,4 +1,4 @@
-"""Clamped drags and drives, assembly-mode switches and placements (tpm_viz.interaction)."""
+"""Clamped drags and drives, assembly-mode switches and placements (tpm_viz.app.moves)."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tpm_viz import InputError, Params, forward_kinematics_both, inverse_kinematics, jacobians
-from tpm_viz.interaction import (
+from tpm_viz import InputError, Params, forward_kinematics_both, inverse_kinematics
+from tpm_viz.app.moves import (
     DIRECT,
     INVERSE,
     OK,
@@ -23,6 +23,7 @@ from tpm_viz.interaction import (
     pose_codes,
     switch_mode,
 )
+from tpm_viz.paper.jacobians import jacobians
 
 P = Params.paper()
 HOME = Pose.working(P, (0.0, 0.0))

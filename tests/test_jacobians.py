@@ -25,11 +25,11 @@ from tpm_viz import (
     classify,
     condition_number,
     inverse_kinematics,
-    jacobians,
     leg_angles,
     platform_force_from_actuator_forces,
     platform_velocity,
 )
+from tpm_viz.paper.jacobians import jacobians
 
 P = Params.paper()
 
@@ -68,8 +68,12 @@ def _eq14_as_printed(params, p, dp, ddp):
     th = leg_angles(params, p)
     th_dot = dp[::-1] / (params.l_a * np.cos(th))
     jx = np.array([[np.cos(th[0]), np.sin(th[0])], [np.sin(th[1]), np.cos(th[1])]])
-    jx_dot = np.array([[-np.sin(th[0]) * th_dot[0], np.cos(th[0]) * th_dot[0]],
-                       [np.cos(th[1]) * th_dot[1], -np.sin(th[1]) * th_dot[1]]])
+    jx_dot = np.array(
+        [
+            [-np.sin(th[0]) * th_dot[0], np.cos(th[0]) * th_dot[0]],
+            [np.cos(th[1]) * th_dot[1], -np.sin(th[1]) * th_dot[1]],
+        ]
+    )
     jq = np.diag(np.cos(th))
     jq_dot_printed = np.diag(np.sin(th) * th_dot)
     dd = np.linalg.solve(jq, jx @ dp)

@@ -21,10 +21,10 @@ from tpm_viz import (
     forward_kinematics_both,
     forward_kinematics_nearest,
     inverse_kinematics,
-    jacobians,
     leg_angles,
     mechanism_pose,
 )
+from tpm_viz.paper.jacobians import jacobians
 
 P = Params.paper()
 

@@ -22,8 +22,8 @@ from reference import rod_kinetic_energy
 from strategies import params_sets, regular_states
 
 import tpm_viz as tv
+from tpm_viz.multibody.model import PART_NAMES, MultibodyModel
 from tpm_viz import multibody
-from tpm_viz.multibody import PART_NAMES, MultibodyModel
 
 P = tv.Params.paper()
 MB = multibody.model_for(P)

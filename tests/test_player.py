@@ -1,4 +1,4 @@
-"""Trajectory runs (tpm_viz.playback) against the library they are built from, the CSV upload's checks, the
+"""Trajectory runs (tpm_viz.app.runs) against the library they are built from, the CSV upload's checks, the
 CSV export and the force-plot PNG. No viser."""
 
 from __future__ import annotations
@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 
 from tpm_viz import InputError, Params, actuator_acceleration, actuator_velocity, inverse_dynamics
+from tpm_viz.app.inputs import read_upload
+from tpm_viz.app.runs import RUN_SAMPLES, Source, build_run, check_path
 from tpm_viz.csvio import format_columns, parse_columns
 from tpm_viz.figures import force_plot_png
-from tpm_viz.playback import RUN_SAMPLES, Source, build_run, check_path
-from tpm_viz.trajectories import circle_state, line_state
-from tpm_viz.ui.validate import read_upload
+from tpm_viz.paper.trajectories import circle_state, line_state
 
 P = Params.paper()
 
@@ -55,7 +55,7 @@ def test_state_at_is_exact_between_samples_and_index_at_is_the_nearest_sample():
 
 
 def test_the_pinocchio_forces_are_computed_once_per_run_and_agree():
-    from tpm_viz.multibody import inverse_dynamics as pinocchio
+    from tpm_viz.multibody.model import inverse_dynamics as pinocchio
 
     calls = []
 
@@ -156,9 +156,9 @@ def test_the_force_plot_is_a_png_with_or_without_the_reference():
 
 
 def test_trace_segments_and_the_summary_never_show_nan():
-    from tpm_viz.ui.player_text import summary_html
-    from tpm_viz.ui.runs import PlayerSession
-    from tpm_viz.ui.trace import segments
+    from tpm_viz.ui.teaching.player_text import summary_html
+    from tpm_viz.ui.teaching.playing import PlayerSession
+    from tpm_viz.ui.teaching.trace import segments
 
     p = np.stack([np.linspace(0, 0.1, 1001), np.zeros(1001)], -1)
     segs = segments(p, 0.08, 150)

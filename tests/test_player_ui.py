@@ -12,9 +12,9 @@ import pytest
 from conftest import wait_for
 
 from tpm_viz import Params
-from tpm_viz.demos import DEMOS
-from tpm_viz.trajectories import circle_state, line_state
-from tpm_viz.ui.charts import CHART_POINTS
+from tpm_viz.app.lessons import DEMOS
+from tpm_viz.paper.trajectories import circle_state, line_state
+from tpm_viz.ui.teaching.charts import CHART_POINTS
 
 P = Params.paper()
 
@@ -50,12 +50,18 @@ def _csv_upload(client, view, name: str, content: bytes) -> None:
     uid = view.teaching.player.upload._impl.uuid
     parts = [content[i : i + 65536] for i in range(0, len(content), 65536)] or []
     client.send(
-        type="FileTransferStartUpload", source_component_uuid=uid, transfer_uuid=transfer, filename=name,
-        mime_type="text/csv", part_count=len(parts), size_bytes=len(content),
+        type="FileTransferStartUpload",
+        source_component_uuid=uid,
+        transfer_uuid=transfer,
+        filename=name,
+        mime_type="text/csv",
+        part_count=len(parts),
+        size_bytes=len(content),
     )
     for k, part in enumerate(parts):
-        client.send(type="FileTransferPart", source_component_uuid=uid, transfer_uuid=transfer, part_index=k,
-                    content=part)
+        client.send(
+            type="FileTransferPart", source_component_uuid=uid, transfer_uuid=transfer, part_index=k, content=part
+        )
 
 
 def test_choosing_the_circle_loads_it_with_its_default_duration_and_both_models(connect):
@@ -246,7 +252,7 @@ def test_demos_set_mechanism_trajectory_camera_and_explorer(connect):
 
 
 def test_presenter_mode_refuses_player_inputs_from_students(app, connect):
-    from tpm_viz.ui.access import Access
+    from tpm_viz.app.access import Access
 
     client, view = connect()
     app.hub.access = Access("secret")

@@ -1,13 +1,14 @@
-"""Home, settle-after-parameter-change and demonstration poses (tpm_viz.poses)."""
+"""Home, settle-after-parameter-change and demonstration poses (tpm_viz.app.poses)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from tpm_viz import InputError, InvalidParametersError, Params, SingularityThresholds, jacobians
-from tpm_viz.interaction import OK, Limits, Pose, check
-from tpm_viz.poses import DEMO_KINDS, demo_pose, home_pose, settle
+from tpm_viz import InputError, InvalidParametersError, Params, SingularityThresholds
+from tpm_viz.app.moves import OK, Limits, Pose, check
+from tpm_viz.app.poses import DEMO_KINDS, demo_pose, home_pose, settle
+from tpm_viz.paper.jacobians import jacobians
 
 P = Params.paper()
 

@@ -1,4 +1,4 @@
-"""The displayed quantities of a pose (tpm_viz.readouts), against independent routes."""
+"""The displayed quantities of a pose (tpm_viz.app.readouts), against independent routes."""
 
 from __future__ import annotations
 
@@ -15,9 +15,9 @@ from tpm_viz import (
     inverse_dynamics,
     leg_angles,
 )
-from tpm_viz.interaction import Pose, drive_to
-from tpm_viz.poses import demo_pose
-from tpm_viz.readouts import Load, evaluate
+from tpm_viz.app.moves import Pose, drive_to
+from tpm_viz.app.poses import demo_pose
+from tpm_viz.app.readouts import Load, evaluate
 
 P = Params.paper()
 POSE = Pose.working(P, (0.04, -0.03))

@@ -27,11 +27,11 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from tpm_viz import InputError, Params, TpmVizError
-from tpm_viz.interaction import OK, check, ik_branch
+from tpm_viz.app import transitions as T
+from tpm_viz.app.inputs import MAX_UPLOAD_BYTES, read_choice, read_flag, read_number, read_upload, read_vec2
+from tpm_viz.app.moves import OK, check, ik_branch
 from tpm_viz.params import PARAM_INFO
-from tpm_viz.ui import transitions as T
 from tpm_viz.ui.session import AppState, Hub
-from tpm_viz.ui.validate import MAX_UPLOAD_BYTES, read_choice, read_flag, read_number, read_upload, read_vec2
 
 P = Params.paper()
 BAD_TEXT = re.compile(r"\bnan\b|\binf\b|infinity", re.IGNORECASE)

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import tpm_viz as tv
-from tpm_viz.replay import MAX_STEPS, ReplayResult, replay
+from tpm_viz.multibody.replay import MAX_STEPS, ReplayResult, replay
 
 P = tv.Params.paper()
 

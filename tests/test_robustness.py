@@ -13,8 +13,10 @@ from hypothesis import strategies as st
 
 import tpm_viz as tv
 
-ANY = st.floats(allow_nan=True, allow_infinity=True, width=64) | st.floats(-0.3, 0.3) | st.sampled_from(
-    [0.0, -0.0, 1e-300, -1e-300, 1e300, 0.26, -0.26, 0.2599999999999]
+ANY = (
+    st.floats(allow_nan=True, allow_infinity=True, width=64)
+    | st.floats(-0.3, 0.3)
+    | st.sampled_from([0.0, -0.0, 1e-300, -1e-300, 1e300, 0.26, -0.26, 0.2599999999999])
 )
 VEC = st.tuples(ANY, ANY)
 SETTINGS = settings(max_examples=3400, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])

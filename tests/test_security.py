@@ -23,10 +23,10 @@ from conftest import ProtocolClient, wait_for
 
 import tpm_viz.ui.app as app_module
 from tpm_viz import InputError
-from tpm_viz.ui.access import LOCKOUT_SECONDS, MAX_FAILURES, Access, AccessDenied
+from tpm_viz.app.access import LOCKOUT_SECONDS, MAX_FAILURES, Access, AccessDenied
+from tpm_viz.app.inputs import MAX_UPLOAD_BYTES
 from tpm_viz.ui.guard import ACTIVITY
 from tpm_viz.ui.session import Session
-from tpm_viz.ui.validate import MAX_UPLOAD_BYTES
 
 TOKEN = "s3cret-Token"
 UI = Path(__file__).resolve().parents[1] / "tpm_viz" / "ui"

@@ -15,7 +15,7 @@ from tpm_viz import (
     parse_trajectory_csv,
     trajectory_from_samples,
 )
-from tpm_viz.spline import CubicSpline
+from tpm_viz.paper.spline import CubicSpline
 
 
 @pytest.mark.parametrize("kind", ["line", "circle"])

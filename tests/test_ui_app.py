@@ -310,7 +310,7 @@ def test_simultaneous_drags_are_serialised_and_never_corrupt_state(app, connect)
     view = clients[0][1]
     _settle(view)
     state = _state(view)
-    from tpm_viz.interaction import OK, check
+    from tpm_viz.app.moves import OK, check
 
     assert check(state.params, state.pose) == OK
     np.testing.assert_allclose(state.pose.d, inverse_kinematics(P, state.pose.p))

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from tpm_viz import InputError, Params
-from tpm_viz.interaction import Pose
+from tpm_viz.app.moves import Pose
 from tpm_viz.ui.session import AppState, Hub, read_number, read_vec2
 
 P = Params.paper()
@@ -102,8 +102,9 @@ def test_live_frames_show_the_pinocchio_forces_beside_the_closed_form():
     """Issue 3: both numbers side by side on every displayed frame, intermediate drag frames included."""
     import dataclasses
 
-    from tpm_viz import inverse_dynamics, multibody
-    from tpm_viz.readouts import Load
+    from tpm_viz import inverse_dynamics
+    from tpm_viz.app.readouts import Load
+    from tpm_viz import multibody
 
     hub = Hub(AppState.initial(Params.paper()), reference=multibody.inverse_dynamics)
     state = hub.shared.state

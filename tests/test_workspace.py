@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tpm_viz import Params, inverse_kinematics, jacobians, workspace_map
-from tpm_viz.workspace import direct_singularity_locus, inverse_singularity_loci, stroke_limit_loci
+from tpm_viz import Params, inverse_kinematics, workspace_map
+from tpm_viz.paper.jacobians import jacobians
+from tpm_viz.paper.workspace import direct_singularity_locus, inverse_singularity_loci, stroke_limit_loci
 
 P = Params.paper()
 

@@ -5,15 +5,15 @@ The top level is pure numpy: importing :mod:`tpm_viz` loads neither viser nor pi
 Shapes: positions, velocities, accelerations and forces are arrays of shape ``(..., 2)`` in SI units.
 """
 
-from .dynamics import DynamicsResult, inverse_dynamics, inverse_dynamics_detail, kinetic_energy
-from .errors import (
+from tpm_viz.errors import (
     InputError,
     InvalidParametersError,
     SingularConfigurationError,
     TpmVizError,
     UnreachablePoseError,
 )
-from .jacobians import (
+from tpm_viz.paper.dynamics import DynamicsResult, inverse_dynamics, inverse_dynamics_detail, kinetic_energy
+from tpm_viz.paper.jacobians import (
     STATUS_LABELS,
     Jacobians,
     SingularityThresholds,
@@ -27,7 +27,7 @@ from .jacobians import (
     platform_velocity,
     theta_dot,
 )
-from .kinematics import (
+from tpm_viz.paper.kinematics import (
     FK_STATUS,
     FkSolutions,
     MechanismPose,
@@ -40,8 +40,7 @@ from .kinematics import (
     mechanism_pose,
     reachable,
 )
-from .params import PARAM_INFO, Params
-from .trajectories import (
+from tpm_viz.paper.trajectories import (
     DEFAULT_DURATIONS,
     Trajectory,
     circle_state,
@@ -50,7 +49,8 @@ from .trajectories import (
     parse_trajectory_csv,
     trajectory_from_samples,
 )
-from .workspace import WorkspaceMap, direct_singularity_locus, workspace_map
+from tpm_viz.paper.workspace import WorkspaceMap, direct_singularity_locus, workspace_map
+from tpm_viz.params import PARAM_INFO, Params
 
 __version__ = "0.1.0"
 

@@ -1,5 +1,5 @@
 """``python -m tpm_viz``: the same as the ``tpm-viz`` command."""
 
-from .cli import main
+from tpm_viz.cli import main
 
 raise SystemExit(main())

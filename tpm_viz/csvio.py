@@ -16,7 +16,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from .errors import InputError
+from tpm_viz.errors import InputError
 
 __all__ = ["OPTIONAL_COLUMNS", "parse_columns", "read_columns", "read_text", "write_columns"]
 

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import pathlib
 
-from .crosscheck import ForceComparison, compare_forces
-from .params import Params
+from tpm_viz.multibody.crosscheck import ForceComparison, compare_forces
+from tpm_viz.params import Params
 
 __all__ = ["TITLES", "force_plot_png", "plot_forces", "write_paper_figures"]
 

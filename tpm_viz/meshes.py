@@ -15,8 +15,8 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
-from .kinematics import MechanismPose
-from .params import Params
+from tpm_viz.paper.kinematics import MechanismPose
+from tpm_viz.params import Params
 
 __all__ = [
     "LINK_Z",

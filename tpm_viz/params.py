@@ -12,7 +12,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
-from .errors import InvalidParametersError
+from tpm_viz.errors import InvalidParametersError
 
 __all__ = ["PARAM_INFO", "Params"]
 
@@ -60,9 +60,7 @@ class Params:
             if not math.isfinite(value):
                 raise InvalidParametersError(f"parameter {f.name} must be finite, got {value}")
             if value <= 0.0:
-                raise InvalidParametersError(
-                    f"parameter {f.name} must be positive, got {value:g} {f.metadata['unit']}"
-                )
+                raise InvalidParametersError(f"parameter {f.name} must be positive, got {value:g} {f.metadata['unit']}")
             low, high = _RANGES[f.metadata["unit"]]
             if not low <= value <= high:
                 raise InvalidParametersError(
@@ -97,9 +95,7 @@ class Params:
         """A validated copy with some fields changed (SI units)."""
         unknown = set(changes) - set(PARAM_INFO)
         if unknown:
-            raise InvalidParametersError(
-                f"unknown parameter {sorted(unknown)[0]!r}; known: {', '.join(PARAM_INFO)}"
-            )
+            raise InvalidParametersError(f"unknown parameter {sorted(unknown)[0]!r}; known: {', '.join(PARAM_INFO)}")
         return dataclasses.replace(self, **changes)
 
     def with_overrides(self, overrides: Mapping[str, str | float]) -> Params:
@@ -107,9 +103,7 @@ class Params:
         changes: dict[str, float] = {}
         for name, raw in overrides.items():
             if name not in PARAM_INFO:
-                raise InvalidParametersError(
-                    f"unknown parameter {name!r}; known: {', '.join(PARAM_INFO)}"
-                )
+                raise InvalidParametersError(f"unknown parameter {name!r}; known: {', '.join(PARAM_INFO)}")
             try:
                 changes[name] = float(raw)
             except (TypeError, ValueError):

@@ -26,15 +26,15 @@ import warnings
 
 import viser
 
-from ..errors import TpmVizError
-from ..params import Params
-from ..readouts import Reference
-from .access import Access, LoginPanel
-from .client import ClientView
-from .guard import guard_executor, guarded, log, report
-from .scene import MechanismScene, camera_pose
-from .session import AppState, Hub
-from .transport import harden
+from tpm_viz.app.access import Access, LoginPanel
+from tpm_viz.app.readouts import Reference
+from tpm_viz.errors import TpmVizError
+from tpm_viz.params import Params
+from tpm_viz.ui.client import ClientView
+from tpm_viz.ui.guard import guard_executor, guarded, log, report
+from tpm_viz.ui.scene import MechanismScene, camera_pose
+from tpm_viz.ui.session import AppState, Hub
+from tpm_viz.ui.transport import harden
 
 __all__ = ["TpmApp", "build_server", "main"]
 
@@ -47,9 +47,9 @@ def _no_share_url(*_args, **_kwargs) -> None:
 
 
 def _reference() -> Reference | None:
-    """The Pinocchio model's inverse dynamics, if :mod:`tpm_viz.multibody` can be imported."""
+    """The Pinocchio model's inverse dynamics, if :mod:`tpm_viz.multibody.model` can be imported."""
     try:
-        from .. import multibody
+        from tpm_viz import multibody
     except ImportError:  # pragma: no cover - pinocchio is a declared dependency
         return None
     return multibody.inverse_dynamics

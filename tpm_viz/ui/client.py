@@ -1,7 +1,7 @@
 """One browser tab: its scene and panel, and the callbacks that turn its inputs into state changes.
 
 Every callback has the same shape: under the hub's lock, read the widget's *current* value, validate it, call a
-pure library function (:mod:`tpm_viz.interaction`, :mod:`tpm_viz.poses`, ``Params.replace``, trajectories),
+pure library function (:mod:`tpm_viz.app.moves`, :mod:`tpm_viz.app.poses`, ``Params.replace``, trajectories),
 and commit the new state, which redraws every view of the session. Events that the server caused itself (a
 value written by :meth:`Panel.show`, which viser echoes synchronously with ``client=None``) are ignored.
 A refused input is reported to this tab only, its widgets are re-synced and the last good state stays. The state
@@ -20,18 +20,18 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import viser
 
-from .. import meshes
-from ..errors import TpmVizError
-from ..params import Params
-from ..poses import DEMO_KINDS
-from . import transitions
-from .frame import Frame
-from .guard import guarded
-from .panels import Panel
-from .scene import camera_pose
-from .session import AppState, Hub, Session
-from .tabscene import TabScene
-from .teaching import Teaching
+from tpm_viz import meshes
+from tpm_viz.app import transitions
+from tpm_viz.app.poses import DEMO_KINDS
+from tpm_viz.errors import TpmVizError
+from tpm_viz.params import Params
+from tpm_viz.ui.guard import guarded
+from tpm_viz.ui.panels import Panel
+from tpm_viz.ui.scene import camera_pose
+from tpm_viz.ui.session import AppState, Hub, Session
+from tpm_viz.ui.snapshot import Frame
+from tpm_viz.ui.tabscene import TabScene
+from tpm_viz.ui.teaching.tabs import Teaching
 
 __all__ = ["ClientView"]
 

@@ -1,6 +1,6 @@
 """The control panel of one browser tab: GUI handles built once, values written by :meth:`Panel.show`.
 
-No maths here: the numbers come from a :class:`~tpm_viz.readouts.Readout`, formatted by :mod:`.text`.
+No maths here: the numbers come from a :class:`~tpm_viz.app.readouts.Readout`, formatted by :mod:`.text`.
 Units in labels: mm, N, kg, s, degrees (SI inside; the scale factors come from ``PARAM_INFO``).
 """
 
@@ -10,12 +10,12 @@ import time
 
 import viser
 
-from ..params import PARAM_INFO, Params
-from ..poses import DEMO_KINDS
-from ..readouts import LOAD_MODES
-from .frame import Frame
-from .session import AppState
-from .text import legend_html
+from tpm_viz.app.poses import DEMO_KINDS
+from tpm_viz.app.readouts import LOAD_MODES
+from tpm_viz.params import PARAM_INFO, Params
+from tpm_viz.ui.session import AppState
+from tpm_viz.ui.snapshot import Frame
+from tpm_viz.ui.text import legend_html
 
 __all__ = ["PARAM_LABELS", "Panel"]
 

@@ -15,13 +15,13 @@ from __future__ import annotations
 import numpy as np
 import viser
 
-from .. import meshes
-from ..overlays import cached_map
-from ..params import Params
-from ..readouts import Readout
-from ..workspace import direct_singularity_locus, inverse_singularity_loci
-from .frame import Frame
-from .session import AppState
+from tpm_viz import meshes
+from tpm_viz.app.overlays import cached_map
+from tpm_viz.app.readouts import Readout
+from tpm_viz.paper.workspace import direct_singularity_locus, inverse_singularity_loci
+from tpm_viz.params import Params
+from tpm_viz.ui.session import AppState
+from tpm_viz.ui.snapshot import Frame
 
 __all__ = ["COLORS", "FAMILIES", "FORCE_SCALE", "GIZMO_Z", "MechanismScene", "camera_pose"]
 

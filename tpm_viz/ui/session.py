@@ -25,14 +25,14 @@ from typing import Protocol
 
 import numpy as np
 
-from ..errors import InputError
-from ..interaction import Pose
-from ..params import Params
-from ..poses import home_pose
-from ..readouts import Load, Readout, Reference, evaluate
-from .access import Access
-from .guard import report
-from .validate import read_number, read_vec2
+from tpm_viz.app.access import Access
+from tpm_viz.app.inputs import read_number, read_vec2
+from tpm_viz.app.moves import Pose
+from tpm_viz.app.poses import home_pose
+from tpm_viz.app.readouts import Load, Readout, Reference, evaluate
+from tpm_viz.errors import InputError
+from tpm_viz.params import Params
+from tpm_viz.ui.guard import report
 
 __all__ = ["TRAJECTORY_KINDS", "AppState", "Hub", "Session", "View", "read_number", "read_vec2"]
 
@@ -84,7 +84,7 @@ class View(Protocol):
     """What a session needs from a browser tab."""
 
     def render(self, frame, *, dragging: bool) -> None:
-        """Draw ``frame`` (a :class:`~tpm_viz.ui.frame.Frame`); ``dragging`` is True while this tab's own gizmo
+        """Draw ``frame`` (a :class:`~tpm_viz.ui.snapshot.Frame`); ``dragging`` is True while this tab's own gizmo
         is being dragged."""
 
 
@@ -97,7 +97,7 @@ class Session:
         self.scene = scene
         """Where the mechanism is drawn once per commit, or None (each view draws it)."""
         self.views: list[View] = []
-        self.frame = None  # the Frame last drawn (tpm_viz.ui.frame), None until the first draw
+        self.frame = None  # the Frame last drawn (tpm_viz.ui.snapshot), None until the first draw
         self.play_token = 0  # a playing trajectory stops when this changes
         self.drain_scheduled = False  # a drag commit is scheduled (ui/client.py: latest value wins)
         self.next_drag_at = 0.0  # time.monotonic() before which no further drag is committed
@@ -132,9 +132,9 @@ class Hub:
         return evaluate(state.params, state.pose, state.load, None if live else self.reference)
 
     def frame(self, state: AppState, dragging: bool = False):
-        """The :class:`~tpm_viz.ui.frame.Frame` of ``state`` with the data every view draws, computed and checked
+        """The :class:`~tpm_viz.ui.snapshot.Frame` of ``state`` with the data every view draws, computed and checked
         before anything changes: raises :class:`~tpm_viz.InputError` if a drawn number is not finite."""
-        from .frame import Frame  # viser-free, but keeps this module free of trimesh
+        from tpm_viz.ui.snapshot import Frame
 
         frame = Frame(state, self.evaluate(state, live=dragging), in_drag=dragging)
         if dragging and self.reference is not None:
@@ -145,12 +145,10 @@ class Hub:
         return frame  # its texts print a dash for any non-finite number (tpm_viz.ui.text.num)
 
     def authorize(self, view: View, session: Session) -> None:
-        """Raise :class:`~tpm_viz.ui.access.AccessDenied` unless ``view`` may change ``session``."""
+        """Raise :class:`~tpm_viz.app.access.AccessDenied` unless ``view`` may change ``session``."""
         self.access.check(view, session)
 
-    def join(
-        self, view: View, private: bool, session: Session | None = None, scene: Drawing | None = None
-    ) -> Session:
+    def join(self, view: View, private: bool, session: Session | None = None, scene: Drawing | None = None) -> Session:
         """Attach ``view`` to the shared session, or to a new private copy of ``session``'s state drawn in
         ``scene``; draws it.
 

@@ -19,9 +19,9 @@ from __future__ import annotations
 import numpy as np
 import viser
 
-from ..params import Params
-from .frame import Frame
-from .scene import FAMILIES, GIZMO_Z, MechanismScene
+from tpm_viz.params import Params
+from tpm_viz.ui.scene import FAMILIES, GIZMO_Z, MechanismScene
+from tpm_viz.ui.snapshot import Frame
 
 __all__ = ["PRIVATE_ROOT", "TabScene"]
 

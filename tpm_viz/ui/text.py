@@ -1,4 +1,4 @@
-"""Text and HTML of the panel, from a :class:`~tpm_viz.readouts.Readout`: formatting only, no maths.
+"""Text and HTML of the panel, from a :class:`~tpm_viz.app.readouts.Readout`: formatting only, no maths.
 
 UI units: mm, N, degrees (the readout is in SI). Every number goes through :func:`num`, which prints a dash for
 ``None``, NaN or infinity, so that no ``nan`` or ``inf`` ever reaches the page. Values carry ``data-q`` attributes
@@ -12,8 +12,8 @@ import math
 
 import numpy as np
 
-from ..readouts import Readout
-from .session import AppState
+from tpm_viz.app.readouts import Readout
+from tpm_viz.ui.session import AppState
 
 __all__ = ["COLORS_CSS", "banner_level", "dashboard_html", "force_scale", "legend_html", "num"]
 

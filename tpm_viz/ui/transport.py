@@ -24,8 +24,8 @@ import time
 
 import viser
 
-from .guard import log
-from .validate import MAX_UPLOAD_BYTES
+from tpm_viz.app.inputs import MAX_UPLOAD_BYTES
+from tpm_viz.ui.guard import log
 
 __all__ = ["harden", "update_problem"]
 

@@ -13,8 +13,8 @@ import threading
 from collections import OrderedDict
 from collections.abc import Callable, Hashable
 
-from ..errors import TpmVizError
-from .guard import report
+from tpm_viz.errors import TpmVizError
+from tpm_viz.ui.guard import report
 
 __all__ = ["Worker"]
 

@@ -1,0 +1,150 @@
+"""Validation of everything a browser sends: widget values and uploaded files. Pure Python + numpy, no viser.
+
+The browser is not trusted: viser does not range-check GUI values, casts strings such as ``"nan"`` or ``"1e999"``
+to floats on the server, and a hand-written client can send anything the protocol allows. Every reader here
+either returns a clean value in SI units or raises :class:`~tpm_viz.InputError` with a one-line message meant
+for the user who sent it. Out-of-range numbers that are merely *too large* are clipped (a slider dragged past its
+end); values that are not numbers at all (NaN, inf, text, wrong length) are refused.
+
+The CSV trajectory upload goes through :func:`read_upload` only (size, encoding, row count, finiteness, timing),
+whichever widget receives it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+
+import numpy as np
+
+from tpm_viz.errors import InputError, TpmVizError
+from tpm_viz.paper.trajectories import Trajectory, parse_trajectory_csv
+from tpm_viz.params import PARAM_INFO, Params
+
+__all__ = [
+    "MAX_UPLOAD_BYTES",
+    "MAX_UPLOAD_ROWS",
+    "read_choice",
+    "read_flag",
+    "read_number",
+    "read_params",
+    "read_upload",
+    "read_vec2",
+]
+
+MAX_UPLOAD_BYTES = 1 << 20
+"""Largest accepted upload [bytes] (1 MiB, ~20 000 rows of ``t,p1,p2``); larger transfers are dropped."""
+MAX_UPLOAD_ROWS = 20_000
+"""Most data rows in an uploaded trajectory."""
+MAX_UPLOAD_SECONDS = 3600.0
+"""Longest accepted trajectory duration [s]."""
+MAX_UPLOAD_POSITION = 10.0
+"""Largest accepted ``|p_i|`` in an upload [m] (reachability is checked by whoever plays it)."""
+_MAX_NAME = 80
+
+
+def read_number(value, name: str, scale: float = 1.0, lo: float = -math.inf, hi: float = math.inf) -> float:
+    """A finite number from a widget, times ``scale`` (UI unit -> SI), clipped to ``[lo, hi]`` (SI)."""
+    if isinstance(value, bool):
+        raise InputError(f"{name} must be a number, got {_show(value)}")
+    try:
+        x = float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(f"{name} must be a number, got {_show(value)}") from None
+    if not math.isfinite(x):
+        raise InputError(f"{name} must be finite, got {_show(value)}")
+    scaled = x * scale
+    if not math.isfinite(scaled):  # e.g. 1e308 mm -> m is fine, but 1e308 * 1e3 is not
+        raise InputError(f"{name} is too large, got {_show(value)}")
+    return float(np.clip(scaled, lo, hi))
+
+
+def read_vec2(value, name: str, scale: float = 1.0, bound: float = math.inf) -> np.ndarray:
+    """Two finite numbers from a widget, times ``scale`` (UI unit -> SI), each clipped to ``[-bound, bound]``."""
+    if isinstance(value, (str, bytes, Mapping)):
+        raise InputError(f"{name} must be two numbers, got {_show(value)}")
+    try:
+        items = list(value)
+    except TypeError:
+        raise InputError(f"{name} must be two numbers, got {_show(value)}") from None
+    if len(items) != 2:
+        raise InputError(f"{name} must be two numbers, got {_show(value)}")
+    return np.array([read_number(v, name, scale, -bound, bound) for v in items])
+
+
+def read_choice(value, name: str, choices: Iterable[str]) -> str:
+    """One of ``choices`` (a dropdown value), else :class:`~tpm_viz.InputError`."""
+    choices = tuple(choices)
+    if not isinstance(value, str) or value not in choices:
+        raise InputError(f"{name} must be one of {', '.join(choices)}, got {_show(value)}")
+    return value
+
+
+def read_flag(value, name: str) -> bool:
+    """A checkbox value: a real boolean (``0``/``1`` accepted), else :class:`~tpm_viz.InputError`."""
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, (int, float)) and value in (0, 1):
+        return bool(value)
+    raise InputError(f"{name} must be on or off, got {_show(value)}")
+
+
+def read_params(params: Params, raw: Mapping[str, object]) -> Params:
+    """A new parameter set from the panel's inputs (UI units: mm, kg); ``Params`` checks the geometry."""
+    changes = {}
+    for name, value in raw.items():
+        if name not in PARAM_INFO:
+            raise InputError(f"unknown parameter {_show(name)}")
+        changes[name] = read_number(value, name, scale=1.0 / PARAM_INFO[name]["ui_scale"])
+    return params.replace(**changes)
+
+
+def read_upload(content, filename: str = "upload.csv", max_bytes: int = MAX_UPLOAD_BYTES) -> Trajectory:
+    """A trajectory from an uploaded CSV file (columns ``t,p1,p2`` in s, m, m), checked from the bytes up.
+
+    Refused with a one-line :class:`~tpm_viz.InputError`: not bytes, larger than ``max_bytes``, not UTF-8,
+    binary (NUL bytes), more than :data:`MAX_UPLOAD_ROWS` rows, anything :func:`~tpm_viz.parse_trajectory_csv`
+    refuses (missing columns, text or NaN cells, fewer than 4 rows, times not increasing), positions beyond
+    :data:`MAX_UPLOAD_POSITION`, a duration beyond :data:`MAX_UPLOAD_SECONDS`, or non-finite derivatives
+    (samples too close in time). Reachability for the current parameters is the player's check.
+    """
+    if not isinstance(content, (bytes, bytearray, memoryview)):
+        raise InputError("the upload is not a file")
+    content = bytes(content)
+    if len(content) > max_bytes:
+        raise InputError(f"the file is too large ({len(content)} bytes; at most {max_bytes} bytes)")
+    if b"\x00" in content:
+        raise InputError("the file is not a text CSV file (binary content)")
+    try:
+        text = content.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise InputError("the file is not UTF-8 text") from None
+    name = _clean_name(filename)
+    try:
+        with np.errstate(all="ignore"):
+            traj = parse_trajectory_csv(text, name=name, max_rows=MAX_UPLOAD_ROWS)
+    except TpmVizError:
+        raise
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:  # defensive: a parser gap
+        raise InputError(f"the trajectory CSV could not be read: {exc}") from None
+    if np.max(np.abs(traj.p)) > MAX_UPLOAD_POSITION:
+        raise InputError(f"a position in the file is beyond {MAX_UPLOAD_POSITION:g} m (the file is in metres)")
+    if not float(traj.t[-1]) <= MAX_UPLOAD_SECONDS:
+        raise InputError(f"the trajectory lasts {float(traj.t[-1]):g} s (at most {MAX_UPLOAD_SECONDS:g} s)")
+    if not (np.all(np.isfinite(traj.dp)) and np.all(np.isfinite(traj.ddp))):
+        raise InputError("samples too close in time: the velocities or accelerations are not finite")
+    return traj
+
+
+def _clean_name(filename) -> str:
+    """A short printable trajectory name from an uploaded file name (never a path)."""
+    text = filename if isinstance(filename, str) else "upload.csv"
+    text = text.replace("\\", "/").rsplit("/", 1)[-1]
+    text = "".join(ch for ch in text if ch.isprintable())[:_MAX_NAME]
+    return text or "upload.csv"
+
+
+def _show(value) -> str:
+    """A short, printable rendering of an untrusted value for a message (never the whole of a huge string)."""
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."

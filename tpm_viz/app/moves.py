@@ -1,0 +1,321 @@
+"""Interactive moves of the 2-PPa TPM: drags and drives that stop at the nearest valid pose.
+
+Pure numpy, no browser: the app calls these functions and only draws what they return.
+
+A :class:`Pose` is a platform position ``p`` with actuator positions ``d`` [m]. ``d`` fixes the branch of each
+leg, the sign of ``c_i = p_i - d_i + a - b = l_a cos θ_i`` (eq. 23; ``+1`` is the working mode of eq. 4), and
+the pair fixes the assembly mode, the sign of ``det J_x = cos(θ1 + θ2)`` (eq. 12). A pose is *valid* when
+
+- both actuators are inside the stroke, ``0 <= d_i <= Δd``;
+- both legs keep clear of the inverse singularity, ``|cos θ_i| >= min_cos`` (eq. 11);
+- the mechanism keeps clear of the direct singularity, ``|cos(θ1 + θ2)| >= min_det`` (eq. 12).
+
+Continuous moves (:func:`drag_to` moves the platform by inverse kinematics, :func:`drive_to` moves the
+actuators by forward kinematics) keep each leg's branch and the assembly mode. When the request leaves the
+valid set, the pose stops at the last valid point of the straight segment from the current pose towards the
+request (a drag also slides along the boundary when that gets nearer to the request) and the reason comes
+back as one line of text. Deliberate jumps are separate: :func:`switch_mode` (the other assembly mode),
+:func:`place` (a trajectory sample). Special poses (home, after a parameter change, near each kind of
+singularity) are in :mod:`tpm_viz.app.poses`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+
+from tpm_viz.errors import InputError
+from tpm_viz.paper.kinematics import forward_kinematics_both, inverse_kinematics
+from tpm_viz.params import Params
+
+__all__ = [
+    "Limits",
+    "Move",
+    "Pose",
+    "check",
+    "drag_to",
+    "drive_to",
+    "ik_branch",
+    "margins",
+    "place",
+    "pose_codes",
+    "switch_mode",
+]
+
+OK, UNREACHABLE, STROKE, INVERSE, DIRECT = 0, 1, 2, 3, 4
+"""Codes of :func:`pose_codes` (why a pose is not valid)."""
+
+_STROKE_TOL = 1e-9  # m
+_SAMPLES = 48  # samples per refinement round of a segment
+_ROUNDS = 3  # resolution 1 / 48**3 of the segment
+
+
+class Limits(NamedTuple):
+    """Hard margins of the valid set (dimensionless). Moves stop here, before the quantities vanish."""
+
+    min_cos: float = 0.03
+    """Smallest allowed ``|cos θ_i|`` (inverse singularity, eq. 11)."""
+    min_det: float = 0.03
+    """Smallest allowed ``|cos(θ1 + θ2)|`` (direct singularity, eq. 12)."""
+
+
+@dataclass(frozen=True)
+class Pose:
+    """One assembled configuration: platform position ``p`` [m] and actuator positions ``d`` [m], shape (2,)."""
+
+    p: np.ndarray
+    d: np.ndarray
+
+    def __post_init__(self) -> None:
+        for name in ("p", "d"):
+            arr = np.array(getattr(self, name), dtype=float).reshape(-1)
+            if arr.shape != (2,) or not np.all(np.isfinite(arr)):
+                raise InputError(f"pose {name} must be two finite numbers, got {getattr(self, name)!r}")
+            arr.setflags(write=False)
+            object.__setattr__(self, name, arr)
+
+    def branch(self, params: Params) -> np.ndarray:
+        """Sign of ``c_i = l_a cos θ_i`` per leg (``+1`` is the working mode of eq. 4), shape (2,)."""
+        return np.where(self.p - self.d + (params.a - params.b) >= 0.0, 1.0, -1.0)
+
+    def mode(self, params: Params) -> int:
+        """Assembly mode: the sign of ``det J_x = cos(θ1 + θ2)`` (eq. 12), ``+1`` or ``-1``."""
+        c = self.p - self.d + (params.a - params.b)
+        return 1 if c[0] * c[1] - self.p[0] * self.p[1] >= 0.0 else -1
+
+    @classmethod
+    def working(cls, params: Params, p) -> Pose:
+        """The working-mode pose at ``p`` (eq. 4); raises :class:`~tpm_viz.UnreachablePoseError`."""
+        return cls(p, inverse_kinematics(params, p))
+
+
+class Move(NamedTuple):
+    """Result of a move: the new pose, whether it stopped short of the request, and why (one line)."""
+
+    pose: Pose
+    clamped: bool = False
+    reason: str = ""
+
+
+def ik_branch(params: Params, p, branch) -> np.ndarray:
+    """Inverse kinematics on a given branch: ``d_i = p_i + a - b - σ_i sqrt(l_a² - p_j²)`` [m] (eq. 3).
+
+    ``σ_i = +1`` is eq. (4). NaN where ``|p_j| > l_a``. Shapes ``(..., 2)``.
+    """
+    p = np.asarray(p, dtype=float)
+    with np.errstate(invalid="ignore"):
+        root = np.sqrt(params.l_a**2 - p[..., ::-1] ** 2)
+    return p + (params.a - params.b) - np.asarray(branch, dtype=float) * root
+
+
+def margins(params: Params, p, d, mode: int, limits: Limits = Limits()) -> np.ndarray:
+    """Signed distances to the edges of the valid set, shape ``(..., 5)``; the pose is valid iff all are >= 0.
+
+    Columns: the stroke of each actuator ``min(d_i, Δd - d_i)`` [m] (2 columns), ``|cos θ_i| - min_cos``
+    (2 columns, eq. 11) and ``mode cos(θ1 + θ2) - min_det`` (eq. 12). NaN where ``p`` or ``d`` is not finite.
+    """
+    p = np.asarray(p, dtype=float)
+    d = np.asarray(d, dtype=float)
+    cos = (p - d + (params.a - params.b)) / params.l_a
+    sin = p[..., ::-1] / params.l_a
+    det = cos[..., 0] * cos[..., 1] - sin[..., 0] * sin[..., 1]
+    stroke = np.minimum(d, params.stroke - d)
+    return np.concatenate([stroke, np.abs(cos) - limits.min_cos, (mode * det - limits.min_det)[..., None]], axis=-1)
+
+
+_CODE_OF_COLUMN = np.array([STROKE, STROKE, INVERSE, INVERSE, DIRECT])
+
+
+def pose_codes(params: Params, p, d, mode: int, branch=None, limits: Limits = Limits()) -> np.ndarray:
+    """Validity code per pose (``OK`` or the first failing rule: stroke, inverse, direct), shape ``(...)``.
+
+    ``mode`` is the required sign of ``det J_x``; ``branch`` (optional) the required sign of each ``c_i``.
+    Non-finite ``p`` or ``d`` count as ``UNREACHABLE``.
+    """
+    m = margins(params, p, d, mode, limits)
+    m[..., :2] += _STROKE_TOL
+    finite = np.all(np.isfinite(m), axis=-1)
+    bad = m < 0.0
+    if branch is not None:
+        cos_sign = np.sign(np.asarray(p, dtype=float) - np.asarray(d, dtype=float) + (params.a - params.b))
+        bad[..., 2:4] |= cos_sign != np.asarray(branch)
+    first = np.argmax(bad, axis=-1)
+    code = np.where(np.any(bad, axis=-1), _CODE_OF_COLUMN[first], OK)
+    return np.where(finite, code, UNREACHABLE)
+
+
+def check(params: Params, pose: Pose, limits: Limits = Limits()) -> int:
+    """Validity code of one pose in its own branch and mode (``OK`` = 0 when valid)."""
+    return int(pose_codes(params, pose.p, pose.d, pose.mode(params), pose.branch(params), limits))
+
+
+def _reason(params: Params, code: int, p: np.ndarray, d: np.ndarray, drive: bool) -> str:
+    """One line saying why the pose ``(p, d)`` is not valid."""
+    if code == STROKE:
+        i = int(np.argmax(np.maximum(-d, d - params.stroke)))
+        end = 0.0 if d[i] < 0 else params.stroke
+        return f"actuator {i + 1} reached the end of its stroke (d{i + 1} = {end * 1e3:.1f} mm)"
+    if code == INVERSE:
+        cos = np.abs(p - d + (params.a - params.b)) / params.l_a
+        i = int(np.argmin(cos))
+        return f"leg {i + 1} reached the inverse singularity (cos θ{i + 1} → 0, eq. 11)"
+    if code == DIRECT:
+        c = p - d + (params.a - params.b)
+        dot = c[0] * p[1] + p[0] * c[1]  # l_a² s_1 · s_2
+        kind = "the leg circles coincide" if dot > 0 else "the two assembly modes merge"
+        return f"direct singularity ahead (cos(θ1+θ2) → 0, eq. 12): {kind}"
+    if drive:
+        return "the leg circles no longer meet: the mechanism cannot be assembled there"
+    return f"the platform must stay within |p1|, |p2| < l_a = {params.l_a * 1e3:.1f} mm"
+
+
+def _clamp(codes_of, x0: np.ndarray, x1: np.ndarray) -> tuple[np.ndarray, int]:
+    """Last valid point of the segment ``x0 -> x1`` and the code that stopped it (``OK`` if none)."""
+    t_ok, t_end = 0.0, 1.0
+    stop = OK
+    for _ in range(_ROUNDS):
+        ts = np.linspace(t_ok, t_end, _SAMPLES + 1)[1:]
+        codes = codes_of(x0 + ts[:, None] * (x1 - x0))
+        bad = np.flatnonzero(codes != OK)
+        if bad.size == 0:
+            return (x1, stop) if stop == OK else (x0 + t_ok * (x1 - x0), stop)
+        k = int(bad[0])
+        stop = int(codes[k])
+        t_ok, t_end = (ts[k - 1] if k > 0 else t_ok), ts[k]
+    return x0 + t_ok * (x1 - x0), stop
+
+
+def _drag_codes(params: Params, branch: np.ndarray, mode: int, limits: Limits):
+    def codes_of(p: np.ndarray) -> np.ndarray:
+        d = ik_branch(params, p, branch)
+        return pose_codes(params, p, d, mode, branch, limits)
+
+    return codes_of
+
+
+def drag_to(params: Params, pose: Pose, p_req, limits: Limits = Limits()) -> Move:
+    """Move the platform towards ``p_req`` [m] by inverse kinematics, in the pose's branch and mode.
+
+    Stops at the last valid pose on the way (see the module docstring). When stopped, it then slides along
+    the edge that stopped it, towards the point of that edge nearest ``p_req``, if that ends nearer.
+    """
+    p_req = np.asarray(p_req, dtype=float).reshape(-1)
+    if p_req.shape != (2,) or not np.all(np.isfinite(p_req)):
+        raise InputError(f"requested platform position must be two finite numbers, got {p_req!r}")
+    branch, mode = pose.branch(params), pose.mode(params)
+    codes_of = _drag_codes(params, branch, mode, limits)
+    p0 = pose.p.astype(float)
+    best, stop = _clamp(codes_of, p0, p_req)
+    if stop == OK:
+        return Move(Pose(best, ik_branch(params, best, branch)))
+    blocked = _first_bad(codes_of, p0, p_req)
+
+    def margins_of(p: np.ndarray) -> np.ndarray:
+        return margins(params, p, ik_branch(params, p, branch), mode, limits)
+
+    edge = _project_on_edge(margins_of, np.clip(p_req, -0.999 * params.l_a, 0.999 * params.l_a), blocked)
+    if edge is not None:
+        slid, _ = _clamp(codes_of, best, edge)
+        if np.linalg.norm(slid - p_req) < np.linalg.norm(best - p_req) - 1e-12:
+            best = slid
+    new = Pose(best, ik_branch(params, best, branch))
+    return Move(new, True, "stopped: " + _reason(params, stop, blocked, ik_branch(params, blocked, branch), False))
+
+
+def _project_on_edge(margins_of, start: np.ndarray, blocked: np.ndarray) -> np.ndarray | None:
+    """The point of the edge that stopped a drag (the margin most violated just past the stop, at ``blocked``)
+    nearest ``start`` (the request), by Gauss-Newton projection; slightly inside the valid set. None if it fails."""
+    m_blocked = margins_of(blocked[None])[0]
+    if not np.all(np.isfinite(m_blocked)):
+        return None
+    k = int(np.argmin(m_blocked))
+    target = start.astype(float)
+    x = target.copy()
+    h = 1e-7
+    for _ in range(10):
+        g = margins_of(x + np.array([[0.0, 0.0], [h, 0.0], [0.0, h]]))[:, k]
+        if not np.all(np.isfinite(g)):
+            return None
+        grad = (g[1:] - g[0]) / h
+        norm2 = float(grad @ grad)
+        if norm2 == 0.0:
+            return None
+        # Nearest point to the target on the linearised edge g(x) + grad.(y - x) = 1e-9 (just inside).
+        x_new = target - (g[0] - 1e-9 + grad @ (target - x)) / norm2 * grad
+        if np.linalg.norm(x_new - x) < 1e-12:
+            break
+        x = x_new
+    return x
+
+
+def _first_bad(codes_of, x0: np.ndarray, x1: np.ndarray) -> np.ndarray:
+    """A point just past the last valid one on ``x0 -> x1`` (for the wording of the reason)."""
+    ts = np.linspace(0.0, 1.0, 4 * _SAMPLES + 1)[1:]
+    pts = x0 + ts[:, None] * (x1 - x0)
+    bad = np.flatnonzero(codes_of(pts) != OK)
+    return pts[int(bad[0])] if bad.size else x1
+
+
+def _fk(params: Params, d: np.ndarray, mode: int) -> np.ndarray:
+    with np.errstate(invalid="ignore", divide="ignore"):
+        sol = forward_kinematics_both(params, d)
+    p = sol.plus if mode > 0 else sol.minus
+    return np.where(sol.exists[..., None], p, np.nan)
+
+
+def drive_to(params: Params, pose: Pose, d_req, limits: Limits = Limits()) -> Move:
+    """Move the actuators towards ``d_req`` [m]; the platform follows by forward kinematics in the pose's mode.
+
+    Stops at the last valid pose on the way: at a stroke end, before an inverse singularity, or before the
+    direct singularity where the two leg circles become tangent and the assembly modes merge.
+    """
+    d_req = np.asarray(d_req, dtype=float).reshape(-1)
+    if d_req.shape != (2,) or not np.all(np.isfinite(d_req)):
+        raise InputError(f"requested actuator positions must be two finite numbers, got {d_req!r}")
+    branch, mode = pose.branch(params), pose.mode(params)
+
+    def codes_of(d: np.ndarray) -> np.ndarray:
+        return pose_codes(params, _fk(params, d, mode), d, mode, branch, limits)
+
+    d0 = pose.d.astype(float)
+    d_box = np.clip(d_req, 0.0, params.stroke)  # the stroke is a box in d: clipping the request is exact
+    d_new, stop = _clamp(codes_of, d0, d_box)
+    if stop == OK and not np.array_equal(d_box, d_req):
+        stop = STROKE
+    p_new = _fk(params, d_new, mode)
+    new = Pose(p_new, d_new) if np.all(np.isfinite(p_new)) else pose
+    if stop == OK:
+        return Move(new)
+    d_bad = _first_bad(codes_of, d0, d_req)
+    p_bad = _fk(params, d_bad, mode)
+    return Move(new, True, "stopped: " + _reason(params, stop, p_bad, d_bad, True))
+
+
+def switch_mode(params: Params, pose: Pose, limits: Limits = Limits()) -> Move:
+    """Jump to the other assembly mode at the same actuator positions (the other circle intersection)."""
+    other = _fk(params, pose.d, -pose.mode(params))
+    if not np.all(np.isfinite(other)):
+        return Move(pose, True, "no other assembly mode here: " + _reason(params, UNREACHABLE, pose.p, pose.d, True))
+    code = int(pose_codes(params, other, pose.d, -pose.mode(params), None, limits))
+    if code != OK:
+        return Move(
+            pose, True, "the other assembly mode is not usable here: " + _reason(params, code, other, pose.d, True)
+        )
+    return Move(Pose(other, pose.d))
+
+
+def place(params: Params, pose: Pose, p, limits: Limits = Limits()) -> Move:
+    """Jump to ``p`` [m] in the working mode (eq. 4), e.g. a trajectory sample; refused if not valid there."""
+    p = np.asarray(p, dtype=float).reshape(-1)
+    if p.shape != (2,) or not np.all(np.isfinite(p)):
+        raise InputError(f"platform position must be two finite numbers, got {p!r}")
+    d = ik_branch(params, p, (1.0, 1.0))
+    if not np.all(np.isfinite(d)):
+        return Move(pose, True, "refused: " + _reason(params, UNREACHABLE, p, d, False))
+    new = Pose(p, d)
+    code = check(params, new, limits)
+    if code != OK:
+        return Move(pose, True, "refused: " + _reason(params, code, p, d, False))
+    return Move(new)

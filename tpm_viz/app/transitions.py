@@ -1,0 +1,113 @@
+"""The app's state transitions: raw widget values in, the next :class:`~.session.AppState` out. No viser.
+
+One function per control of the panel. Each validates its raw inputs (:mod:`.validate`), calls a pure library
+function (:mod:`tpm_viz.app.moves`, :mod:`tpm_viz.app.poses`, ``Params``, the trajectories) and returns a new
+state; a refused input raises :class:`~tpm_viz.TpmVizError` with a one-line message and changes nothing. The
+callbacks of :mod:`.client` are these functions plus a commit (the trajectory player's are in :mod:`.runs`), so
+the property tests (``tests/test_reliability_app.py``) drive exactly the path a browser drives, without a browser.
+
+Invariant (tested with generated inputs): from a valid state every function returns a valid state (finite pose
+on the pose's branch, inside the stroke, clear of both singularities) or raises a ``TpmVizError``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tpm_viz.app.inputs import read_choice, read_number, read_params, read_vec2
+from tpm_viz.app.moves import Move, drag_to, drive_to, switch_mode
+from tpm_viz.app.poses import DEMO_KINDS, demo_pose, home_pose, settle
+from tpm_viz.app.readouts import LOAD_MODES, Load
+from tpm_viz.params import Params
+from tpm_viz.ui.session import AppState, TrajectorySample
+
+__all__ = [
+    "MAX_ACCEL",
+    "MAX_FORCE",
+    "MAX_POSITION",
+    "MAX_SPEED",
+    "apply_params",
+    "demo",
+    "drag",
+    "drive",
+    "home",
+    "move",
+    "paper_params",
+    "set_load",
+    "switch",
+]
+
+MAX_POSITION = 10.0  # m, bound on typed positions (any pose beyond l_a is unreachable anyway)
+MAX_FORCE = 1e5  # N, bound on typed forces
+MAX_SPEED = 100.0  # m/s
+MAX_ACCEL = 1e5  # m/s²
+
+
+def _moved(state: AppState, move: Move) -> AppState:
+    """``state`` at the move's pose, with its reason; a manual move leaves trajectory playback."""
+    sample = TrajectorySample("none", state.trajectory.duration, 0.0)
+    return state.replace(pose=move.pose, note=move.reason, trajectory=sample)
+
+
+def drag(state: AppState, position) -> AppState:
+    """The gizmo at ``position`` (x, y[, z]) [m]: clamped inverse kinematics (z is ignored)."""
+    try:
+        xy = list(position)[:2]
+    except TypeError:
+        xy = position
+    p_req = read_vec2(xy, "platform position", bound=MAX_POSITION)
+    return _moved(state, drag_to(state.params, state.pose, p_req))
+
+
+def move(state: AppState, p_mm) -> AppState:
+    """The typed platform position ``p`` [mm]: clamped inverse kinematics."""
+    p_req = read_vec2(p_mm, "platform position p", scale=1e-3, bound=MAX_POSITION)
+    return _moved(state, drag_to(state.params, state.pose, p_req))
+
+
+def drive(state: AppState, i: int, d_mm) -> AppState:
+    """Actuator ``i`` (0 or 1) to ``d_mm`` [mm]: forward kinematics in the current assembly mode, clamped."""
+    d_req = np.array(state.pose.d, dtype=float)
+    d_req[i] = read_number(d_mm, f"d{i + 1}", scale=1e-3, lo=-MAX_POSITION, hi=MAX_POSITION)
+    return _moved(state, drive_to(state.params, state.pose, d_req))
+
+
+def switch(state: AppState) -> AppState:
+    """The other assembly mode at the same actuator positions (or the reason why not)."""
+    return _moved(state, switch_mode(state.params, state.pose))
+
+
+def home(state: AppState) -> AppState:
+    """The home pose ``p = 0`` (or the nearest valid pose)."""
+    return _moved(state, Move(home_pose(state.params)))
+
+
+def demo(state: AppState, kind) -> AppState:
+    """A pose near an inverse singularity, the direct singularity or a stroke end (``DEMO_KINDS``)."""
+    kind = read_choice(kind, "demo", DEMO_KINDS)
+    return _moved(state, demo_pose(state.params, kind, near=state.pose.p))
+
+
+def set_load(state: AppState, mode, f_ext, dp, ddp) -> AppState:
+    """The load inputs; the same state object if nothing changed."""
+    load = Load(
+        mode=read_choice(mode, "load", LOAD_MODES),
+        f_ext=tuple(read_vec2(f_ext, "f_ext", bound=MAX_FORCE)),
+        dp=tuple(read_vec2(dp, "platform velocity", bound=MAX_SPEED)),
+        ddp=tuple(read_vec2(ddp, "platform acceleration", bound=MAX_ACCEL)),
+    )
+    return state if load == state.load else state.replace(load=load, note="")
+
+
+def apply_params(state: AppState, raw) -> AppState:
+    """The parameter inputs (mm, kg): a new mechanism and the nearest valid pose on it."""
+    params = read_params(state.params, raw)
+    move = settle(params, state.pose)
+    return state.replace(params=params, pose=move.pose, note=move.reason)
+
+
+def paper_params(state: AppState) -> AppState:
+    """The paper's Tables 1-2 and the nearest valid pose on them."""
+    params = Params.paper()
+    move = settle(params, state.pose)
+    return state.replace(params=params, pose=move.pose, note=move.reason)

@@ -1,0 +1,46 @@
+"""The ``tpm-viz`` command line: CSV in, CSV out, SI units. Bad input exits with status 2 and one line on stderr.
+
+One module per family of subcommands, each with a ``register(subparsers, common)``:
+
+- :mod:`.paper`: ``kinematics``, ``dynamics``, ``trajectory`` (the paper's closed form);
+- :mod:`.multibody`: ``replay``, ``crosscheck``, ``figures`` (the Pinocchio model);
+- :mod:`.serve`: ``serve`` (the browser app).
+
+Import rule (checked by ``tests/test_layering.py``): the command line may import every layer and nothing imports
+it (except ``__main__``).
+"""
+
+from __future__ import annotations
+
+import sys
+
+from tpm_viz.cli import multibody, paper, serve
+from tpm_viz.cli.common import Parser, common_parent, params_from_args
+from tpm_viz.errors import TpmVizError
+
+__all__ = ["build_parser", "main", "params_from_args"]
+
+
+def build_parser() -> Parser:
+    """The ``tpm-viz`` argument parser with every subcommand."""
+    parser = Parser(prog="tpm-viz", description=(__doc__ or "").splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
+    common = common_parent()
+    for family in (paper, serve, multibody):
+        family.register(sub, common)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``tpm-viz``; returns the exit status (2 for bad input)."""
+    try:
+        args = build_parser().parse_args(argv)
+        return int(args.func(args) or 0)
+    except TpmVizError as exc:
+        print(f"tpm-viz: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:
+        print(f"tpm-viz: error: {exc.strerror or exc}: {exc.filename or ''}".rstrip(": "), file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130

@@ -1,0 +1,14 @@
+"""The independent closed-loop multibody model in Pinocchio: the only package of tpm-viz that imports pinocchio.
+
+- :mod:`.model`: the model built from :class:`~tpm_viz.Params`, its constrained inverse and forward dynamics;
+- :mod:`.rank`: rank-revealing SVD helpers for the over-constrained closures;
+- :mod:`.replay`: the paper's forces applied to the model and integrated (does the platform follow the path?);
+- :mod:`.crosscheck`: closed form against the model, on random states and on the paper's trajectories.
+
+Import rule (checked by ``tests/test_layering.py``): pinocchio, numpy, the base modules and :mod:`tpm_viz.paper`.
+Pinocchio pitfalls met on the way: ``docs/pinocchio.md``.
+"""
+
+from tpm_viz.multibody.model import PART_NAMES, MultibodyModel, inverse_dynamics, model_for
+
+__all__ = ["PART_NAMES", "MultibodyModel", "inverse_dynamics", "model_for"]

@@ -1,0 +1,528 @@
+"""An independent closed-loop multibody model of the 2-PPa TPM in Pinocchio (the role ADAMS played).
+
+This is the only module of tpm-viz that imports :mod:`pinocchio`. The model is built from a
+:class:`~tpm_viz.Params` (no model file), zero gravity (the paper's ``U = 0``), SI units.
+
+Tree, in the depth-first order Pinocchio needs (``crba`` silently assumes every subtree is
+contiguous in ``v``), so ``q = (d_1, φ_10, φ_p, φ_11, d_2, φ_20, φ_21)`` (see
+:attr:`MultibodyModel.index`)::
+
+    universe ─PX─ slider1 (origin A_1 = (d_1 - a) e_1) ─RZ─ link1_0 (pivot A_1) ─RZ─ platform (pivot B_1)
+                                                      └RZ─ link1_1 (pivot A_1 + s e_2)
+    universe ─PY─ slider2 (origin A_2 = (d_2 - a) e_2) ─RZ─ link2_0 (pivot A_2)
+                                                      └RZ─ link2_1 (pivot A_2 + s e_1)
+
+``s`` is the pivot spacing; each link frame has its x axis along the link, so ``φ_1k = θ_1``,
+``φ_2k = -θ_2`` (conventions.md) and ``φ_p = -θ_1`` keeps the platform translating. Loop closures:
+three ``RigidConstraintModel(CONTACT_3D, LOCAL_WORLD_ALIGNED)`` joining the tips of link1_1,
+link2_0 and link2_1 to ``B_1 + s e_2``, ``B_2 = P - b e_2`` and ``B_2 + s e_1`` on the platform.
+Masses (conventions.md): sliders ``m_a`` and platform ``m_p`` as point masses (the platform never
+rotates, so its rotational inertia does not enter), each link a uniform slender rod of mass
+``m_b / 2`` along its x axis: ``I_xx = 0``, ``I_yy = I_zz = m l_a² / 12`` about its centre.
+
+Over-constraint. The 9 closure rows have rank 5: the 3 out-of-plane rows vanish identically and
+one in-plane row is redundant (both parallelograms fix the platform's orientation, the paper's
+"overlapped rotational constraints"). Nothing here picks rows; the solves use SVDs that reveal
+the rank (:mod:`tpm_viz.multibody.rank`). Inverse dynamics: the prescribed platform motion gives
+``A = [J_c; J_P]`` (rank 7 checked), ``v``, ``a`` and ``N = A⁺ [0; I]``, whose columns span the
+null space of ``J_c`` (the 2 admissible motions, checked). Then
+``rnea(q, v, a) - J_Pᵀ f_ext = Sᵀ τ + J_cᵀ λ`` is solved in the least-squares sense by projecting on
+``N``: ``Nᵀ Sᵀ τ = Nᵀ (rnea - J_Pᵀ f_ext)`` (``Nᵀ Sᵀ`` is the paper's ``Jᵀ``). Only ``J_cᵀ λ`` is
+defined, not the redundant part of ``λ``; since the null space is the same for every maximal
+independent subset of rows, ``τ`` does not depend on which redundant row one would keep (the tests
+solve the square system for every such subset). Forward dynamics
+(:meth:`MultibodyModel.forward_dynamics`) is our own KKT solve on the null space from the SVD of
+``J_c`` (Gauss's principle) with Pinocchio's ``crba``, ``nle`` and constraint Jacobian; its docstring
+says why not ``pinocchio.constraintDynamics``.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import threading
+
+import numpy as np
+import pinocchio as pin
+
+from tpm_viz.errors import InputError, SingularConfigurationError, UnreachablePoseError
+from tpm_viz.multibody.rank import ranked_svd
+from tpm_viz.paper.kinematics import as_xy
+from tpm_viz.params import Params
+
+__all__ = ["PART_NAMES", "MultibodyModel", "inverse_dynamics", "model_for"]
+
+PART_NAMES = ("slider1", "slider2", "link1_0", "link1_1", "link2_0", "link2_1", "platform")
+"""Keys of :meth:`MultibodyModel.placements`, also the Pinocchio joint names (and frame names)."""
+
+_DOF = 2
+_NEWTON_TOL = 1e-12  # m: accepted residual of the closure and platform/actuator equations ...
+_NEWTON_FLOOR = 1e-15  # m: ... but Newton polishes down to this or until it stops improving
+_NEWTON_MAX_ITER = 40
+_MAX_ANGLE_STEP = 0.5  # rad, Newton step limit on the revolute coordinates
+_SINGULAR_RTOL = 1e-9
+
+
+def _se3(xyz, angle: float = 0.0) -> pin.SE3:
+    c, s = np.cos(angle), np.sin(angle)
+    return pin.SE3(np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]), np.asarray(xyz, dtype=float))
+
+
+def _rod(mass: float, length: float) -> pin.Inertia:
+    """Uniform slender rod along local x from the origin: COM at ``l/2``, ``I = m l²/12`` (y, z)."""
+    i_t = mass * length**2 / 12.0
+    return pin.Inertia(mass, np.array([length / 2.0, 0.0, 0.0]), np.diag([0.0, i_t, i_t]))
+
+
+def _point_mass(mass: float, xyz=(0.0, 0.0, 0.0)) -> pin.Inertia:
+    return pin.Inertia(mass, np.asarray(xyz, dtype=float), np.zeros((3, 3)))
+
+
+def _build(params: Params):
+    """The Pinocchio model, its constraint models (LOCAL_WORLD_ALIGNED) and the part frame ids."""
+    a, b, la, sp = params.a, params.b, params.l_a, params.pivot_spacing
+    model = pin.Model()
+    model.gravity = pin.Motion.Zero()  # horizontal mechanism, U = 0
+    e = np.eye(3)
+    rod, leg2 = _rod(params.m_b / 2.0, la), np.pi / 2  # leg 2's link frames: x along e_2 at φ = 0
+    # Depth-first order (Pinocchio's crba needs every subtree contiguous in v):
+    # (name, parent, joint, placement in parent, body inertia).
+    tree = [
+        ("slider1", "universe", pin.JointModelPX(), _se3(-a * e[0]), _point_mass(params.m_a)),
+        ("link1_0", "slider1", pin.JointModelRZ(), _se3([0, 0, 0]), rod),
+        ("platform", "link1_0", pin.JointModelRZ(), _se3([la, 0, 0]), _point_mass(params.m_p, [b, 0, 0])),
+        ("link1_1", "slider1", pin.JointModelRZ(), _se3(sp * e[1]), rod),
+        ("slider2", "universe", pin.JointModelPY(), _se3(-a * e[1]), _point_mass(params.m_a)),
+        ("link2_0", "slider2", pin.JointModelRZ(), _se3([0, 0, 0], leg2), rod),
+        ("link2_1", "slider2", pin.JointModelRZ(), _se3(sp * e[0], leg2), rod),
+    ]
+    joints = {"universe": 0}
+    for name, parent, joint, placement, inertia in tree:
+        joints[name] = model.addJoint(joints[parent], joint, placement, name)
+        model.appendBodyToJoint(joints[name], inertia, pin.SE3.Identity())
+    del joints["universe"]
+    frames = {}
+    for name, jid in joints.items():
+        origin = [b, 0, 0] if name == "platform" else [0, 0, 0]  # platform frame at P = B_1 + b e_1
+        frames[name] = model.addFrame(pin.Frame(name, jid, _se3(origin), pin.FrameType.OP_FRAME), False)
+    tip = _se3([la, 0, 0])
+    on_platform = {"link1_1": [0, sp, 0], "link2_0": [b, -b, 0], "link2_1": [b + sp, -b, 0]}  # from B_1
+    closures = [
+        pin.RigidConstraintModel(
+            pin.ContactType.CONTACT_3D,
+            model,
+            joints[link],
+            tip,
+            joints["platform"],
+            _se3(xyz),
+            pin.ReferenceFrame.LOCAL_WORLD_ALIGNED,
+        )
+        for link, xyz in on_platform.items()
+    ]
+    return model, closures, frames
+
+
+def _locked(method):
+    @functools.wraps(method)
+    def wrapper(self, *args, **kwargs):
+        with self._lock:
+            return method(self, *args, **kwargs)
+
+    return wrapper
+
+
+class MultibodyModel:
+    """The closed-loop Pinocchio model of one parameter set (see the module docstring).
+
+    Public methods take platform quantities as ``(2,)`` (or ``(..., 2)`` where stated) arrays in SI
+    units and raise :mod:`tpm_viz.errors` exceptions with one-line messages. Methods are serialised
+    by a lock (Pinocchio's ``Data`` is shared scratch memory).
+    """
+
+    def __init__(self, params: Params):
+        if not isinstance(params, Params):
+            raise InputError(f"MultibodyModel needs a tpm_viz.Params, got {type(params).__name__}")
+        self.params = params
+        self.model, self.constraint_models, self._frames = _build(params)
+        """``pinocchio.Model`` and the three ``RigidConstraintModel`` loop closures (LOCAL_WORLD_ALIGNED)."""
+        self.data = self.model.createData()
+        self._cmodel_vec = pin.StdVec_RigidConstraintModel()
+        self._cdatas = pin.StdVec_RigidConstraintData()  # holds references: calc() updates these
+        for c in self.constraint_models:
+            self._cmodel_vec.append(c)
+            self._cdatas.append(c.createData())
+        self._lock = threading.RLock()
+        self.index = {n: self.model.joints[self.model.getJointId(n)].idx_q for n in PART_NAMES}
+        """Position of each joint coordinate in ``q`` (and ``v``): Pinocchio's depth-first order."""
+        self._slider_idx = np.array([self.index["slider1"], self.index["slider2"]])
+        self._angle_idx = np.array([self.index[n] for n in PART_NAMES[2:]])  # φ_10, φ_11, φ_20, φ_21, φ_p
+        self._s_t = np.zeros((self.model.nv, _DOF))  # Sᵀ: actuator forces -> generalised forces
+        self._s_t[self._slider_idx, [0, 1]] = 1.0
+        self._select_platform = np.zeros((len(self.constraint_models) * 3 + _DOF, _DOF))  # [0; I]
+        self._select_platform[-_DOF:] = np.eye(_DOF)
+        self._last: tuple[np.ndarray, np.ndarray, np.ndarray | None] | None = None  # warm start (p, q, ∂q/∂p)
+
+    # ----------------------------------------------------------------- Pinocchio evaluations
+    def _closure_terms(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """World closure residual ``Φ(q)`` (9,) [m] and its Jacobian ``J_c`` (9, 7).
+
+        Order matters (pinocchio-notes.md): joint Jacobians and placements at ``q`` first, then
+        ``calc`` of each constraint, then the constraint Jacobian (all three in one call).
+        """
+        m, d = self.model, self.data
+        pin.computeJointJacobians(m, d, q)  # also runs forwardKinematics(q)
+        res = np.empty(3 * len(self._cdatas))
+        for k, (cm, cd) in enumerate(zip(self.constraint_models, self._cdatas, strict=True)):
+            cm.calc(m, d, cd)
+            res[3 * k : 3 * k + 3] = cd.oMc1.translation - cd.oMc2.translation
+        return res, pin.getConstraintsJacobian(m, d, self._cmodel_vec, self._cdatas)
+
+    def _platform_jacobian(self) -> np.ndarray:
+        """In-plane translational Jacobian ``J_P`` (2, 7) of P (after :meth:`_closure_terms`)."""
+        j = pin.getFrameJacobian(self.model, self.data, self._frames["platform"], pin.LOCAL_WORLD_ALIGNED)
+        return j[:2]
+
+    def _drifts(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``γ_c = J̇_c v`` (9,) and ``J̇_P v`` (2,): classical accelerations at ``a = 0`` [m/s²]."""
+        m, d = self.model, self.data
+        pin.forwardKinematics(m, d, q, v, np.zeros(m.nv))
+        lwa = pin.LOCAL_WORLD_ALIGNED
+        gamma = [
+            pin.getFrameClassicalAcceleration(m, d, c.joint1_id, c.joint1_placement, lwa).linear
+            - pin.getFrameClassicalAcceleration(m, d, c.joint2_id, c.joint2_placement, lwa).linear
+            for c in self.constraint_models
+        ]
+        fp = m.frames[self._frames["platform"]]
+        acc_p = pin.getFrameClassicalAcceleration(m, d, fp.parentJoint, fp.placement, lwa).linear
+        return np.concatenate(gamma), acc_p[:2]
+
+    def _closure_svd(self, jc: np.ndarray):
+        """Rank-revealing SVD of ``J_c``; its null space is the 2 admissible motions (rank 5 expected)."""
+        svd = ranked_svd(jc)
+        if self.model.nv - svd.rank != _DOF:
+            raise SingularConfigurationError(
+                f"singular configuration: the closure Jacobian has rank {svd.rank}, not {self.model.nv - _DOF} "
+                "(a parallelogram is folded, cos θ_i = 0, eq. 11)"
+            )
+        return svd
+
+    # ----------------------------------------------------------------- closed-loop kinematics
+    def _newton(self, q: np.ndarray, target: np.ndarray, driven: str):
+        """Gauss-Newton on ``[Φ(q); x(q) - target] = 0``, ``x`` = platform P or actuators d.
+
+        ``[J_c; J_x]`` has full column rank away from singularities, so the normal equations give the
+        step. Returns ``(q, converged, J_c, J_x)`` with the Jacobians at the returned ``q``.
+        """
+        q, previous, nc = q.copy(), np.inf, 3 * len(self._cdatas)
+        a, r = np.empty((nc + _DOF, self.model.nv)), np.empty(nc + _DOF)
+        for _ in range(_NEWTON_MAX_ITER):
+            r[:nc], a[:nc] = self._closure_terms(q)
+            if driven == "platform":
+                r[nc:], a[nc:] = self._platform_position_now() - target, self._platform_jacobian()
+            else:
+                r[nc:], a[nc:] = q[self._slider_idx] - target, self._s_t.T
+            err = abs(r).max()
+            if err < _NEWTON_FLOOR or (err < _NEWTON_TOL and err > 0.5 * previous):  # at the rounding floor
+                return q, True, a[:nc].copy(), a[nc:].copy()
+            previous = err
+            try:
+                dq = -np.linalg.solve(a.T @ a, a.T @ r)
+            except np.linalg.LinAlgError:
+                break
+            big = abs(dq[self._angle_idx]).max()
+            if big > _MAX_ANGLE_STEP:
+                dq *= _MAX_ANGLE_STEP / big
+            q += dq
+        return q, False, a[:nc].copy(), a[nc:].copy()
+
+    def _platform_position_now(self) -> np.ndarray:
+        return pin.updateFramePlacement(self.model, self.data, self._frames["platform"]).translation[:2].copy()
+
+    def _is_parallelogram(self, q: np.ndarray) -> bool:
+        """Both links of each leg parallel and the platform translating (``φ_p = -φ_10``)."""
+        f10, f11, f20, f21, fp = q[self._angle_idx].tolist()
+        return all(abs(math.remainder(x, 2 * math.pi)) < 1e-6 for x in (f11 - f10, f21 - f20, fp + f10))
+
+    def _wrap(self, q: np.ndarray) -> np.ndarray:
+        """``q`` with every angle in ``[-π, π]``."""
+        q = q.copy()
+        q[self._angle_idx] = [math.remainder(x, 2 * math.pi) for x in q[self._angle_idx].tolist()]
+        return q
+
+    def _pack(self, d, phi1: float, phi2: float) -> np.ndarray:
+        """``q`` from actuator positions and the link angles ``φ_1 = θ_1``, ``φ_2 = -θ_2`` of a parallelogram."""
+        q = np.empty(self.model.nq)
+        q[self._slider_idx] = d
+        q[self._angle_idx] = [phi1, phi1, phi2, phi2, -phi1]
+        return q
+
+    def _link_angles(self, q: np.ndarray) -> tuple[float, float]:
+        """``(φ_10, φ_20) = (θ_1, -θ_2)``."""
+        return float(q[self.index["link1_0"]]), float(q[self.index["link2_0"]])
+
+    def _guess_from_platform(self, p: np.ndarray, d: np.ndarray | None) -> np.ndarray:
+        """Starting point: the working mode with leg angles ``sin θ_1 = p_2 / l_a``, ``sin θ_2 = p_1 / l_a``
+        (conventions.md), or links pointing at the platform pivots from given actuator positions ``d``.
+        Only a guess: Newton accepts it only once Pinocchio's own closure residual is at the rounding floor."""
+        if d is not None:
+            return self._guess_from_both(p, d)
+        la, k = self.params.l_a, self.params.a - self.params.b
+        theta = (math.asin(float(p[1]) / la), math.asin(float(p[0]) / la))
+        d = (p[0] + k - la * math.cos(theta[0]), p[1] + k - la * math.cos(theta[1]))
+        return self._pack(d, theta[0], -theta[1])
+
+    def _guess_from_both(self, p: np.ndarray, d: np.ndarray) -> np.ndarray:
+        """Links pointing from the slider joints ``A_i`` towards the platform pivots ``B_i``."""
+        a, b = self.params.a, self.params.b
+        u1 = (p[0] - b) - (d[0] - a), p[1]  # B_1 - A_1
+        u2 = p[0], (p[1] - b) - (d[1] - a)  # B_2 - A_2
+        t1 = np.arctan2(u1[1], u1[0])
+        t2 = np.arctan2(-u2[0], u2[1])  # link frame of leg 2 is rotated by +90 deg
+        return self._pack(d, t1, t2)
+
+    @_locked
+    def configuration(self, p, d=None) -> np.ndarray:
+        """Full configuration ``q`` (7,) for platform position ``p`` (2,) [m], by Newton on Pinocchio's
+        closure residual. Working mode (eq. 4: ``cos θ_i > 0``) unless actuator positions ``d`` (2,)
+        are given: they are the starting point and so select the branch."""
+        p = self._one(p, "p")
+        return self._configure(p, None if d is None else self._one(d, "d"))[0]
+
+    def _configure(self, p: np.ndarray, d: np.ndarray | None):
+        """``(q, J_c, J_P)`` at the closed-loop configuration of platform position ``p``."""
+        la, (p1, p2) = self.params.l_a, p.tolist()
+        if max(abs(p1), abs(p2)) >= la:
+            raise UnreachablePoseError(
+                f"platform position ({p1 * 1e3:.1f}, {p2 * 1e3:.1f}) mm is unreachable: "
+                f"each |p_j| must be below l_a = {la * 1e3:.1f} mm"
+            )
+        starts = [lambda: self._guess_from_platform(p, d)]
+        if d is None and self._last is not None:  # fallback: continuation from the last pose, tangent predictor
+            p_last, q_last, dq_dp = self._last
+            starts.append(lambda: q_last if dq_dp is None else q_last + dq_dp @ (p - p_last))
+        for start in starts:
+            q, ok, jc, jp = self._newton(start(), p, "platform")
+            working = min(math.cos(x) for x in self._link_angles(q)) > 0  # c_i = l_a cos θ_i > 0 (eq. 4)
+            if ok and self._is_parallelogram(q) and (d is not None or working):
+                q = self._wrap(q)
+                if d is None:
+                    self._last = (p.copy(), q, None)
+                return q, jc, jp
+        raise SingularConfigurationError(
+            f"no closed-loop configuration found at ({p1 * 1e3:.1f}, {p2 * 1e3:.1f}) mm "
+            "(too close to cos θ_i = 0, eq. 11)"
+        )
+
+    @_locked
+    def configuration_from_actuators(self, d, mode: int = +1) -> np.ndarray:
+        """Full configuration ``q`` (7,) for actuator positions ``d`` (2,) [m] in assembly ``mode``
+        (+1: ``cos(θ1 + θ2) > 0``, the home mode; -1: the other), by Newton on the closures."""
+        if mode not in (1, -1):
+            raise InputError(f"assembly mode must be +1 or -1, got {mode!r}")
+        d = self._one(d, "d")
+        k, la = self.params.a - self.params.b, self.params.l_a
+        c1, c2 = np.array([d[0] - k, 0.0]), np.array([0.0, d[1] - k])  # leg circle centres
+        gap = math.hypot(float(d[0] - k), float(d[1] - k))  # |C_2 - C_1|, no overflow for huge d
+        if not gap < 2 * la or gap == 0:
+            raise UnreachablePoseError(
+                "actuator positions cannot be assembled: the leg circles are more than 2 l_a apart"
+            )
+        normal = np.array([c1[1] - c2[1], c2[0] - c1[0]]) / gap
+        found = []
+        for side in (1.0, -1.0):  # a guess on each side of the line of centres
+            p0 = (c1 + c2) / 2 + side * (la / np.sqrt(2.0)) * normal
+            q, ok, _, _ = self._newton(self._guess_from_both(p0, d), d, "actuators")
+            if ok and self._is_parallelogram(q):
+                found.append(self._wrap(q))
+        for q in found:
+            if np.sign(np.cos(np.subtract(*self._link_angles(q)))) == mode:  # det J_x = cos(θ1 + θ2), eq. 12
+                return q
+        raise SingularConfigurationError(f"assembly mode {mode:+d} not found: d is at or near the direct singularity")
+
+    @_locked
+    def platform_position(self, q) -> np.ndarray:
+        """Platform position ``P`` (2,) [m] of configuration ``q``."""
+        pin.forwardKinematics(self.model, self.data, self._as_q(q))
+        return self._platform_position_now()
+
+    @_locked
+    def closure_terms(self, q) -> tuple[np.ndarray, np.ndarray]:
+        """Loop-closure residual ``Φ(q)`` (9,) [m] (world, 3 rows per closure) and Jacobian ``J_c`` (9, 7)."""
+        phi, jc = self._closure_terms(self._as_q(q))
+        return phi.copy(), jc.copy()
+
+    @_locked
+    def constraint_violation(self, q) -> float:
+        """Largest loop-closure gap [m] (distance between the two sides of a closure) at ``q``."""
+        phi, _ = self._closure_terms(self._as_q(q))
+        return float(np.max(np.linalg.norm(phi.reshape(-1, 3), axis=1)))
+
+    @_locked
+    def placements(self, q) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """``{part: (position (3,) [m], quaternion wxyz (4,))}`` for :data:`PART_NAMES`.
+
+        Sliders: at ``A_i``; links: at their slider-side pivot, local x along the link (length
+        ``l_a``); platform: at ``P``. Every part lies in the plane ``z = 0``.
+        """
+        m, d = self.model, self.data
+        pin.forwardKinematics(m, d, self._as_q(q))
+        out = {}
+        for name in PART_NAMES:
+            placement = pin.updateFramePlacement(m, d, self._frames[name])
+            x, y, z, w = pin.Quaternion(placement.rotation).coeffs()
+            out[name] = (placement.translation.copy(), np.array([w, x, y, z]))
+        return out
+
+    def _as_q(self, q) -> np.ndarray:
+        q = np.asarray(q, dtype=float)
+        if q.shape != (self.model.nq,) or not np.all(np.isfinite(q)):
+            raise InputError(f"q must be a finite array of shape ({self.model.nq},), got shape {q.shape}")
+        return q
+
+    # ----------------------------------------------------------------- dynamics
+    def _motion(self, p: np.ndarray, dp: np.ndarray, ddp: np.ndarray):
+        """``(q, v, a, N, J_P)`` for a prescribed platform motion, with ``J_c v = 0``, ``J_c a + γ = 0``.
+
+        ``A = [J_c; J_P]`` (11, 7) must have full column rank (else eq. 11). ``N = A⁺ [0; I]`` (7, 2)
+        maps platform velocities to joint velocities; its columns span the null space of ``J_c``
+        (checked: this is where a lost closure rank would show).
+        """
+        q, jc, jp = self._configure(p, None)
+        svd = ranked_svd(np.vstack([jc, jp]))
+        if svd.rank < self.model.nv:
+            raise SingularConfigurationError("singular configuration: cos θ1 cos θ2 = 0 (eq. 11)")
+        n = svd.solve(self._select_platform)
+        if np.abs(jc @ n).max() > _SINGULAR_RTOL * np.abs(n).max():
+            raise SingularConfigurationError("singular configuration: the closures allow a platform-free motion")
+        self._last = (p.copy(), q, n)
+        v = n @ dp
+        gamma, jp_dot_v = self._drifts(q, v)
+        a = svd.solve(np.concatenate([-gamma, ddp - jp_dot_v]))
+        return q, v, a, n, jp
+
+    def _tau(self, q, v, a, n, jp, f_ext) -> tuple[np.ndarray, np.ndarray]:
+        """``τ`` from ``(Nᵀ Sᵀ) τ = Nᵀ (rnea(q, v, a) - J_Pᵀ f_ext)`` (λ eliminated); also the right side.
+
+        ``Nᵀ Sᵀ`` is the paper's ``Jᵀ`` (eq. 10, ``ḋ = J ṗ``): singular at ``cos(θ1 + θ2) = 0`` (eq. 12).
+        """
+        rhs = pin.rnea(self.model, self.data, q, v, a) - jp.T @ f_ext
+        (g11, g12), (g21, g22) = n[self._slider_idx].T.tolist()  # Nᵀ Sᵀ (2 x 2)
+        det = g11 * g22 - g12 * g21
+        # |det| / (product of row norms) = |sin| of the angle between the rows; 0 when singular.
+        if abs(det) < _SINGULAR_RTOL * math.hypot(g11, g12) * math.hypot(g21, g22):
+            raise SingularConfigurationError("singular configuration: cos(θ1 + θ2) = 0 (eq. 12)")
+        b1, b2 = (n.T @ rhs).tolist()
+        return np.array([g22 * b1 - g12 * b2, g11 * b2 - g21 * b1]) / det, rhs
+
+    @_locked
+    def constrained_motion(self, p, dp, ddp) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Joint ``(q, v, a)`` (7,) each, consistent with the closures, for one platform state (2,) each."""
+        p, dp, ddp = (self._one(x, n) for x, n in ((p, "p"), (dp, "dp"), (ddp, "ddp")))
+        return self._motion(p, dp, ddp)[:3]
+
+    @_locked
+    def inverse_dynamics(self, p, dp, ddp, f_ext=None) -> np.ndarray:
+        """Actuator forces ``τ`` [N], shape ``(..., 2)``, for platform ``p, ṗ, p̈`` [m, m/s, m/s²].
+
+        ``f_ext`` [N] is a force applied to the platform (as in eq. 28), broadcastable to ``(..., 2)``.
+        Batches are solved one state at a time (each Newton solve warm-starts from the previous).
+        """
+        p, dp, ddp = as_xy(p), as_xy(dp, "dp"), as_xy(ddp, "ddp")
+        f = np.zeros(2) if f_ext is None else as_xy(f_ext, "f_ext")
+        try:
+            p, dp, ddp, f = np.broadcast_arrays(p, dp, ddp, f)
+        except ValueError:
+            raise InputError("p, dp, ddp and f_ext have incompatible shapes") from None
+        flat = [x.reshape(-1, 2) for x in (p, dp, ddp, f)]
+        tau = np.empty((flat[0].shape[0], 2))
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # huge inputs: checked below
+            for k, (pk, dpk, ddpk, fk) in enumerate(zip(*flat, strict=True)):
+                tau[k] = self._tau(*self._motion(pk, dpk, ddpk), fk)[0]
+        if not np.all(np.isfinite(tau)):
+            raise InputError("the actuator forces overflowed: the inputs are too large for finite results")
+        return tau.reshape(p.shape)
+
+    @_locked
+    def generalized_forces(self, p, dp, ddp, f_ext=None) -> dict[str, np.ndarray]:
+        """Every term of ``rnea - J_Pᵀ f_ext = Sᵀ τ + J_cᵀ λ`` at one state (for checks and teaching):
+        ``q, v, a, tau, rhs`` (the left side), ``S_T`` (7, 2), ``J_c`` (9, 7), ``lam`` (minimum-norm λ)."""
+        p, dp, ddp = (self._one(x, n) for x, n in ((p, "p"), (dp, "dp"), (ddp, "ddp")))
+        f = np.zeros(2) if f_ext is None else self._one(f_ext, "f_ext")
+        q, v, a, n, jp = self._motion(p, dp, ddp)
+        tau, rhs = self._tau(q, v, a, n, jp, f)
+        jc = self._closure_terms(q)[1]
+        lam = np.linalg.lstsq(jc.T, rhs - self._s_t @ tau, rcond=None)[0]
+        return {"q": q, "v": v, "a": a, "tau": tau, "rhs": rhs, "S_T": self._s_t.copy(), "J_c": jc, "lam": lam}
+
+    @_locked
+    def forward_dynamics(self, q, v, tau) -> np.ndarray:
+        """Joint accelerations ``a`` (7,) [m/s², rad/s²] under actuator forces ``τ`` (2,) [N].
+
+        Our own KKT solve (Gauss's principle) on the rank-revealed null space ``N`` of ``J_c``:
+        ``a = a_c + N z`` with ``a_c = -J_c⁺ γ`` and ``(Nᵀ M N) z = Nᵀ (Sᵀ τ - nle - M a_c)``, ``M`` from
+        ``crba`` and ``nle`` from Pinocchio. It is direct and exact with the redundant rows. The proximal
+        ``pinocchio.constraintDynamics`` returns the same ``a`` (the tests check it), but with these
+        redundant rows its reported residual never converges and it often runs to ``max_iter``, so it
+        cannot tell a good step from a bad one.
+        """
+        q, v = self._as_q(q), self._as_q(v)
+        m, d = self.model, self.data
+        svd = self._closure_svd(self._closure_terms(q)[1])
+        n = svd.null_space
+        gamma, _ = self._drifts(q, v)
+        mass = pin.crba(m, d, q)
+        mass = np.triu(mass) + np.triu(mass, 1).T  # C++ crba fills the upper triangle only
+        a_c = -svd.solve(gamma)
+        rhs = self._s_t @ self._one(tau, "tau") - pin.nle(m, d, q, v) - mass @ a_c
+        return a_c + n @ np.linalg.solve(n.T @ mass @ n, n.T @ rhs)
+
+    @_locked
+    def project(self, q, v) -> tuple[np.ndarray, np.ndarray]:
+        """Constraint stabilisation: the nearest ``q`` on the closures (minimum-norm Newton steps)
+        and ``v`` projected on the admissible motions ``N Nᵀ v``."""
+        q, v, previous = self._as_q(q).copy(), self._as_q(v), np.inf
+        for _ in range(_NEWTON_MAX_ITER):
+            phi, jc = self._closure_terms(q)
+            err = np.max(np.abs(phi))
+            if err < _NEWTON_FLOOR or (err < _NEWTON_TOL and err > 0.5 * previous):
+                break
+            previous = err
+            # Off the closures the redundant row is not exactly redundant (rank 6, σ_6 ~ the gap):
+            # step on the 5 dominant directions only, the rank the constraints have on the closures.
+            q -= ranked_svd(jc)._replace(rank=self.model.nv - _DOF).solve(phi)
+        else:
+            raise SingularConfigurationError("the closures cannot be re-assembled (constraint drift too large)")
+        n = self._closure_svd(jc).null_space
+        return q, n @ (n.T @ v)
+
+    @_locked
+    def platform_velocity(self, q, v) -> np.ndarray:
+        """Platform velocity ``J_P v`` (2,) [m/s]."""
+        self._closure_terms(self._as_q(q))
+        return self._platform_jacobian() @ self._as_q(v)
+
+    @_locked
+    def kinetic_energy(self, q, v) -> float:
+        """Total kinetic energy [J] of the tree at ``(q, v)`` (Pinocchio)."""
+        return float(pin.computeKineticEnergy(self.model, self.data, self._as_q(q), self._as_q(v)))
+
+    @staticmethod
+    def _one(x, name: str) -> np.ndarray:
+        x = as_xy(x, name)
+        if x.shape != (2,):
+            raise InputError(f"{name} must have shape (2,), got {x.shape}")
+        return x
+
+
+@functools.lru_cache(maxsize=16)
+def model_for(params: Params) -> MultibodyModel:
+    """The cached :class:`MultibodyModel` of a parameter set (``Params`` is frozen and hashable)."""
+    return MultibodyModel(params)
+
+
+def inverse_dynamics(params: Params, p, dp, ddp, f_ext=None) -> np.ndarray:
+    """Actuator forces ``τ`` [N], shape ``(..., 2)``, from the Pinocchio model (see
+    :meth:`MultibodyModel.inverse_dynamics`); one cached model per ``params``."""
+    if not isinstance(params, Params):
+        raise InputError(f"inverse_dynamics needs a tpm_viz.Params, got {type(params).__name__}")
+    return model_for(params).inverse_dynamics(p, dp, ddp, f_ext)

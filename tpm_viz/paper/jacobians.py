@@ -1,0 +1,213 @@
+"""Jacobians, singularities, statics, velocities and accelerations of the 2-PPa TPM (eqs. 6-15).
+
+All functions broadcast over leading axes: ``p`` and ``d`` have shape ``(..., 2)`` [m],
+matrices have shape ``(..., 2, 2)``. ``d`` (the branch) defaults to the working-mode
+inverse kinematics (eq. 4).
+
+Velocity relation (eqs. 6-10): ``J_x ṗ = J_q ḋ`` with
+``J_x = [[cos θ1, sin θ1], [sin θ2, cos θ2]]``, ``J_q = diag(cos θ1, cos θ2)`` and
+``J = J_q^{-1} J_x = [[1, tan θ1], [tan θ2, 1]]``.
+
+Erratum (eq. 15): the paper prints ``J̇_q = diag(+sin θ_i θ̇_i)``; the time derivative of
+``cos θ_i`` is ``-sin θ_i θ̇_i``. :func:`actuator_acceleration` uses the corrected sign; the
+test suite shows the printed sign disagrees with finite differences of eq. (4).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from tpm_viz.errors import SingularConfigurationError
+from tpm_viz.paper.kinematics import as_xy, finite_result, in_stroke, inverse_kinematics, leg_components, reachable
+from tpm_viz.params import Params
+
+__all__ = [
+    "STATUS_LABELS",
+    "Jacobians",
+    "SingularityThresholds",
+    "actuator_acceleration",
+    "actuator_forces_from_platform_force",
+    "actuator_velocity",
+    "classify",
+    "condition_number",
+    "eq14_row",
+    "jacobians",
+    "platform_force_from_actuator_forces",
+    "platform_velocity",
+    "theta_dot",
+]
+
+
+class Jacobians(NamedTuple):
+    """``J_x``, ``J_q`` (eq. 8), ``J`` (eq. 10) and the two singularity measures (eqs. 11-12)."""
+
+    jx: np.ndarray  # (..., 2, 2)
+    jq: np.ndarray  # (..., 2, 2)
+    j: np.ndarray  # (..., 2, 2)  d_dot = J p_dot
+    det_jx: np.ndarray  # (...,) cos(θ1 + θ2), direct singularity at 0
+    det_jq: np.ndarray  # (...,) cos θ1 cos θ2, inverse singularity at 0
+
+
+def _cos_sin(params: Params, p, d):
+    p = as_xy(p)
+    d = inverse_kinematics(params, p) if d is None else as_xy(d, "d")
+    c, s = leg_components(params, p, d)
+    return p, d, c / params.l_a, s / params.l_a
+
+
+def jacobians(params: Params, p, d=None) -> Jacobians:
+    """The Jacobian matrices of eqs. (8) and (10) at ``p`` [m] (dimensionless)."""
+    _, _, cos, sin = _cos_sin(params, p, d)
+    jx = np.stack([np.stack([cos[..., 0], sin[..., 0]], -1), np.stack([sin[..., 1], cos[..., 1]], -1)], -2)
+    zero = np.zeros_like(cos[..., 0])
+    jq = np.stack([np.stack([cos[..., 0], zero], -1), np.stack([zero, cos[..., 1]], -1)], -2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tan = sin / cos
+    one = np.ones_like(zero)
+    j = np.stack([np.stack([one, tan[..., 0]], -1), np.stack([tan[..., 1], one], -1)], -2)
+    det_jx = cos[..., 0] * cos[..., 1] - sin[..., 0] * sin[..., 1]
+    det_jq = cos[..., 0] * cos[..., 1]
+    return Jacobians(jx, jq, j, det_jx, det_jq)
+
+
+def condition_number(params: Params, p, d=None) -> np.ndarray:
+    """2-norm condition number of ``J`` (eq. 10); ``inf`` at a singularity (shape ``(...)``)."""
+    j = jacobians(params, p, d).j
+    bad = ~np.all(np.isfinite(j), axis=(-2, -1))
+    sv = np.linalg.svd(np.where(bad[..., None, None], 0.0, j), compute_uv=False)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cond = sv[..., 0] / sv[..., -1]
+    return np.where(bad | ~np.isfinite(cond), np.inf, cond)
+
+
+class SingularityThresholds(NamedTuple):
+    """When a pose counts as *near* a singularity (dimensionless, on eqs. 11-12)."""
+
+    inverse: float = 0.2
+    """Near an inverse singularity when ``min_i |cos θ_i|`` is below this."""
+    direct: float = 0.2
+    """Near the direct singularity when ``|cos(θ1 + θ2)|`` is below this."""
+
+
+STATUS_LABELS = {
+    0: "regular",
+    1: "near inverse singularity",
+    2: "near direct singularity",
+    3: "out of stroke",
+    4: "unreachable",
+}
+"""Status codes of :func:`classify`, most severe last."""
+
+
+def classify(params: Params, p, thresholds: SingularityThresholds = SingularityThresholds()) -> np.ndarray:
+    """Status code per pose (see :data:`STATUS_LABELS`); the most severe condition wins.
+
+    Working-mode inverse kinematics (eq. 4). Non-finite poses count as unreachable.
+    """
+    p = np.asarray(p, dtype=float)
+    ok = reachable(params, p)
+    safe = np.where(ok[..., None], p, 0.0)
+    d = inverse_kinematics(params, safe)
+    jac = jacobians(params, safe, d)
+    cos = np.stack([jac.jq[..., 0, 0], jac.jq[..., 1, 1]], -1)
+    status = np.zeros(ok.shape, dtype=int)
+    status = np.where(np.min(np.abs(cos), axis=-1) < thresholds.inverse, 1, status)
+    status = np.where(np.abs(jac.det_jx) < thresholds.direct, 2, status)
+    status = np.where(~in_stroke(params, d), 3, status)
+    return np.where(ok, status, 4)
+
+
+def _check_regular(jac: Jacobians, which: str) -> None:
+    det = jac.det_jq if which == "inverse" else jac.det_jx
+    if np.any(np.abs(det) < 1e-12):
+        eq = "cos θ1 cos θ2 = 0 (eq. 11)" if which == "inverse" else "cos(θ1 + θ2) = 0 (eq. 12)"
+        raise SingularConfigurationError(f"singular configuration: {eq}")
+
+
+def actuator_velocity(params: Params, p, dp, d=None) -> np.ndarray:
+    """Actuator velocities ``ḋ = J ṗ`` [m/s], eq. (9)."""
+    jac = jacobians(params, p, d)
+    _check_regular(jac, "inverse")
+    with np.errstate(over="ignore", invalid="ignore"):
+        return finite_result(np.einsum("...ij,...j->...i", jac.j, as_xy(dp, "dp")), "the actuator velocities")
+
+
+def platform_velocity(params: Params, p, dd, d=None) -> np.ndarray:
+    """Platform velocity ``ṗ = J^{-1} ḋ`` [m/s] (inverse of eq. 9; needs ``det J_x != 0``)."""
+    jac = jacobians(params, p, d)
+    _check_regular(jac, "direct")
+    with np.errstate(over="ignore", invalid="ignore"):
+        rhs = np.einsum("...ij,...j->...i", jac.jq, as_xy(dd, "dd"))
+        return finite_result(np.linalg.solve(jac.jx, rhs[..., None])[..., 0], "the platform velocity")
+
+
+def theta_dot(params: Params, p, dp, d=None) -> np.ndarray:
+    """Leg angular rates ``θ̇_i = ṗ_j / (l_a cos θ_i)`` [rad/s], eq. (24)."""
+    _, _, cos, _ = _cos_sin(params, p, d)
+    if np.any(np.abs(cos) < 1e-12):
+        raise SingularConfigurationError("singular configuration: cos θ1 cos θ2 = 0 (eq. 11)")
+    with np.errstate(over="ignore", invalid="ignore"):
+        return finite_result(as_xy(dp, "dp")[..., ::-1] / (params.l_a * cos), "the leg angular rates")
+
+
+def eq14_row(pi, pj, dpi, dpj, ddpi, ddpj, ci, ddi):
+    """Row ``i`` of eq. (14) with the corrected eq. (15), for floats or arrays [m/s²].
+
+    With ``cos θ_i = c_i / l_a``, ``sin θ_i = p_j / l_a`` and ``θ̇_i = ṗ_j / c_i`` (eq. 24),
+    ``d̈_i = [(J̇_x ṗ)_i + (J_x p̈)_i - (J̇_q ḋ)_i] / cos θ_i`` becomes
+    ``θ̇_i (ṗ_j - t_i ṗ_i) + p̈_i + t_i p̈_j + t_i θ̇_i ḋ_i`` where ``t_i = tan θ_i = p_j / c_i``.
+    The last term carries the corrected sign of ``J̇_q``.
+    """
+    ti = pj / ci
+    thi = dpj / ci
+    return thi * (dpj - ti * dpi) + ddpi + ti * ddpj + ti * thi * ddi
+
+
+def actuator_acceleration(params: Params, p, dp, ddp, d=None, dd=None) -> np.ndarray:
+    """Actuator accelerations [m/s²], eq. (14) with the corrected eq. (15).
+
+    ``d̈ = J_q^{-1} (J̇_x ṗ + J_x p̈ - J̇_q ḋ)`` with
+    ``J̇_x = [[-sin θ1 θ̇1, cos θ1 θ̇1], [cos θ2 θ̇2, -sin θ2 θ̇2]]`` and
+    ``J̇_q = diag(-sin θ1 θ̇1, -sin θ2 θ̇2)`` (the paper prints ``+sin``: erratum). See :func:`eq14_row`.
+    """
+    p, d, cos, _ = _cos_sin(params, p, d)
+    dp, ddp = as_xy(dp, "dp"), as_xy(ddp, "ddp")
+    if np.any(np.abs(cos) < 1e-12):
+        raise SingularConfigurationError("singular configuration: cos θ1 cos θ2 = 0 (eq. 11)")
+    if dd is None:
+        dd = actuator_velocity(params, p, dp, d)
+    c = cos * params.l_a
+    with np.errstate(over="ignore", invalid="ignore"):
+        rows = [
+            eq14_row(p[..., i], p[..., j], dp[..., i], dp[..., j], ddp[..., i], ddp[..., j], c[..., i], dd[..., i])
+            for i, j in ((0, 1), (1, 0))
+        ]
+    return finite_result(np.stack(rows, -1), "the actuator accelerations")
+
+
+def actuator_forces_from_platform_force(params: Params, p, f, d=None) -> np.ndarray:
+    """Actuator forces ``τ = J^{-T} f`` [N] for a platform force ``f`` [N], eq. (13).
+
+    ``f`` is the force the platform exerts on its surroundings (eq. 13: ``f = J^T τ``). To
+    hold an external load ``f_ext`` applied *to* the platform at rest, pass ``f = -f_ext``
+    (this is what :func:`tpm_viz.inverse_dynamics` does with zero velocity and acceleration).
+    Computed as ``τ = J_q J_x^{-T} f`` (``J_q`` is diagonal), which stays finite at an inverse
+    singularity (eq. 11: the leg carries the load with no actuator force along it); raises only
+    at the direct singularity (eq. 12).
+    """
+    jac = jacobians(params, p, d)
+    _check_regular(jac, "direct")
+    jxt = np.swapaxes(jac.jx, -1, -2)
+    with np.errstate(over="ignore", invalid="ignore"):
+        g = np.linalg.solve(jxt, as_xy(f, "f")[..., None])[..., 0]
+        return finite_result(np.einsum("...ij,...j->...i", jac.jq, g), "the actuator forces")
+
+
+def platform_force_from_actuator_forces(params: Params, p, tau, d=None) -> np.ndarray:
+    """Platform force ``f = J^T τ`` [N] for actuator forces ``τ`` [N], eq. (13)."""
+    jac = jacobians(params, p, d)
+    _check_regular(jac, "inverse")
+    with np.errstate(over="ignore", invalid="ignore"):
+        return finite_result(np.einsum("...ji,...j->...i", jac.j, as_xy(tau, "tau")), "the platform force")

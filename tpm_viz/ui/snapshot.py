@@ -1,0 +1,71 @@
+"""One committed state as every view draws it, with the drawing data computed once for all views.
+
+A shared mechanism may be on many tabs: the readout (all the numbers), the joint positions, the link transforms
+and the dashboard HTML are the same for all of them, so they are computed at most once per commit.
+"""
+
+from __future__ import annotations
+
+import html
+from collections.abc import Callable
+from functools import cached_property
+
+import numpy as np
+
+from tpm_viz import meshes
+from tpm_viz.app.equations import ERRATA_HTML, procedure_html
+from tpm_viz.app.readouts import Readout
+from tpm_viz.errors import TpmVizError
+from tpm_viz.paper.dynamics import inverse_dynamics_detail
+from tpm_viz.paper.jacobians import jacobians
+from tpm_viz.paper.kinematics import MechanismPose, mechanism_pose
+from tpm_viz.ui.session import AppState
+from tpm_viz.ui.text import dashboard_html
+
+__all__ = ["Frame"]
+
+
+class Frame:
+    """``state`` and its ``readout``; derived drawing data are cached properties."""
+
+    def __init__(self, state: AppState, readout: Readout, in_drag: bool = False) -> None:
+        self.state = state
+        self.readout = readout
+        self.in_drag = in_drag
+        """True for the intermediate frames of a gizmo drag (views may skip costly, non-essential parts)."""
+        self.complete_readout: Callable[[], Readout] | None = None
+        """For a live frame whose ``readout`` lacks the reference forces: computes the readout with them."""
+
+    @cached_property
+    def displayed_readout(self) -> Readout:
+        """The readout the dashboard shows: always with the reference (Pinocchio) forces beside the closed form."""
+        return self.readout if self.complete_readout is None else self.complete_readout()
+
+    @cached_property
+    def mechanism(self) -> MechanismPose:
+        """Every joint of the pose [m] (``A_i``, ``B_i``, the four links)."""
+        return mechanism_pose(self.state.params, self.readout.p, self.readout.d)
+
+    @cached_property
+    def links(self) -> tuple[np.ndarray, np.ndarray]:
+        """World positions (4, 3) and orientations (4, 4) of the links, as float32 for the batched mesh."""
+        positions, wxyzs = meshes.link_instances(self.mechanism)
+        return positions.astype(np.float32), wxyzs.astype(np.float32)
+
+    @cached_property
+    def equations(self) -> str:
+        """The paper's procedure (a)-(e) with this state's numbers (MathML), and the errata."""
+        state = self.state
+        dp, ddp, f_ext = state.load.motion()
+        try:
+            res = inverse_dynamics_detail(state.params, state.pose.p, dp, ddp, f_ext, d=state.pose.d)
+            jac = jacobians(state.params, state.pose.p, state.pose.d)
+            body = procedure_html(state.params, res, jac, f_ext)
+        except TpmVizError as exc:
+            body = f"<p>{html.escape(str(exc))}</p>"
+        return body + ERRATA_HTML
+
+    @cached_property
+    def dashboard(self) -> str:
+        """The HTML of the always-visible top of the panel."""
+        return dashboard_html(self.state, self.displayed_readout)

@@ -1,0 +1,155 @@
+"""The guided demonstrations of one tab: choose a scene (or step with Previous / Next), read its paragraph,
+play its motion.
+
+A demonstration (:data:`tpm_viz.app.lessons.DEMOS`, pure data) sets the session's mechanism (parameters, pose and
+its trajectory, loaded into the player), this tab's camera and this tab's explorer settings (map, ellipses).
+The numbers that back its claim (:func:`tpm_viz.app.lessons.effect`) are computed when it is applied, outside the
+hub's lock, and shown under the paragraph.
+"""
+
+from __future__ import annotations
+
+import html
+
+import numpy as np
+import viser
+
+from tpm_viz.app.lessons import DEMOS, Demo, demo_params, demo_pose, demo_source, effect
+from tpm_viz.app.readouts import Load
+from tpm_viz.errors import TpmVizError
+from tpm_viz.ui.guard import guarded
+from tpm_viz.ui.session import TrajectorySample
+from tpm_viz.ui.snapshot import Frame
+from tpm_viz.ui.teaching.playing import RunHub
+
+__all__ = ["DemosView"]
+
+TITLES = tuple(d.title for d in DEMOS)
+PANEL_SHIFT = 0.25
+"""Sideways shift of a demo's camera per metre of viewing distance: the control panel covers the right of the
+canvas, so the camera looks a little right of the subject (as :func:`.scene.camera_pose` does)."""
+
+
+def beside_panel(position, look_at) -> tuple[np.ndarray, np.ndarray]:
+    """``position`` and ``look_at`` [m] shifted along +x by :data:`PANEL_SHIFT` x their distance."""
+    position, look_at = np.asarray(position, dtype=float), np.asarray(look_at, dtype=float)
+    shift = np.array([PANEL_SHIFT * float(np.linalg.norm(position - look_at)), 0.0, 0.0])
+    return position + shift, look_at + shift
+
+
+def _internal_error(owner, exc: Exception) -> None:
+    owner.view.refuse(f"internal error ({type(exc).__name__}), logged on the server", resync=False)
+
+
+def demo_html(demo: Demo, facts: str) -> str:
+    """The paragraph of a demonstration and the line of numbers that backs it."""
+    esc = html.escape
+    return (
+        f'<div data-q="demo" style="font-size:0.85em;color:#1e293b;line-height:1.45">'
+        f"<p style='margin:0 0 6px 0'>{esc(demo.text)}</p>"
+        f'<div data-q="demo-effect" style="background:#f1f5f9;border-left:3px solid #0d9488;padding:4px 6px;'
+        f'border-radius:3px;font-variant-numeric:tabular-nums">{esc(facts)}</div></div>'
+    )
+
+
+class DemosView:
+    """Demonstration widgets of one tab."""
+
+    def __init__(self, view, runs: RunHub, explorer) -> None:
+        self.view = view
+        self.runs = runs
+        self.explorer = explorer
+        self.index = 0
+        self._written = None
+
+    def build(self, gui: viser.GuiApi) -> None:
+        """The *Demos* tab's widgets (inside the tab's context)."""
+        gui.add_markdown(
+            "A guided tour for a lecture. Each scene sets the mechanism (shared with the class unless you work on "
+            "your own copy), your camera and your floor map; *Play the motion* runs its trajectory in the Player."
+        )
+        self.choice = gui.add_dropdown("Demonstration", TITLES, initial_value=TITLES[0])
+        self.steps = gui.add_button_group("Step", ("Previous", "Show this one", "Next"))
+        self.play = gui.add_button("Play the motion", icon=viser.Icon.PLAYER_PLAY)
+        self.text = gui.add_html(demo_html(DEMOS[0], "Press 'Show this one' to set up the scene."))
+        self.choice.on_update(self._on_choice)
+        self.steps.on_click(self._on_step)
+        self.play.on_click(self._on_play)
+
+    def _refuse(self, exc: Exception) -> None:
+        with self.view.hub.lock:
+            self.view.refuse(str(exc))
+
+    def _user(self, event) -> bool:
+        return getattr(event, "client", None) is not None and not getattr(self.view, "closed", False)
+
+    @guarded(on_error=_internal_error)
+    def _on_choice(self, event) -> None:
+        if not self._user(event) or self.choice.value == self._written:
+            return
+        if self.choice.value in TITLES:
+            self.show(TITLES.index(self.choice.value))
+
+    @guarded(on_error=_internal_error)
+    def _on_step(self, event) -> None:
+        if not self._user(event):
+            return
+        step = {"Previous": -1, "Show this one": 0, "Next": 1}.get(self.steps.value, 0)
+        self.show((self.index + step) % len(DEMOS))
+
+    @guarded(on_error=_internal_error)
+    def _on_play(self, event) -> None:
+        if not self._user(event):
+            return
+        try:
+            self.runs.play(self.view.session, self.view.teaching.player.speed_value(), origin=self.view)
+        except TpmVizError as exc:
+            self._refuse(exc)
+
+    def show(self, index: int) -> None:
+        """Apply demonstration ``index``: mechanism, trajectory, camera, explorer; explain it."""
+        demo = DEMOS[index]
+        try:
+            params = demo_params(demo)
+            pose = demo_pose(demo, params)
+            source = demo_source(demo)
+            facts = effect(demo)
+        except TpmVizError as exc:  # pragma: no cover - the demos are tested
+            self._refuse(exc)
+            return
+        view = self.view
+        with view.hub.lock:
+            self.index = index
+            self._written = demo.title
+            self.choice.value = demo.title
+            self.text.content = demo_html(demo, facts)
+            self.play.disabled = source is None
+            session = view.session
+            state = session.state
+            sample = TrajectorySample("none", state.trajectory.duration, 0.0)
+            new = state.replace(params=params, pose=pose, load=Load(), trajectory=sample, note="")
+            try:
+                view.hub.authorize(view, session)
+                if source is not None:
+                    self.runs.of(session).extra = source
+                else:  # a still scene: no trajectory (the previous one may not fit the new parameters)
+                    self.runs.unload(session)
+                view.panel.tell("")
+                session.play_token += 1
+                view.hub.commit(session, new, origin=view)
+            except TpmVizError as exc:
+                view.refuse(str(exc))
+                return
+            position, look_at = beside_panel(demo.camera.position, demo.camera.look_at)
+            view.client.camera.position = position
+            view.client.camera.look_at = look_at
+            self.explorer.set(kind=demo.map_kind, ellipses=demo.ellipses)
+            view.client.flush()
+        if source is not None:
+            try:
+                self.runs.load(session, source, origin=view)
+            except TpmVizError as exc:
+                self._refuse(exc)
+
+    def render(self, frame: Frame) -> None:
+        """Nothing per frame: the paragraph changes only when a demonstration is applied."""

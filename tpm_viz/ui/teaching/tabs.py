@@ -1,0 +1,91 @@
+"""The teaching layer of one tab, in one object: the trajectory player, the singularity explorer and the guided
+demonstrations, and the per-hub services they share (background worker, map cache, trajectory runs).
+
+:class:`~.client.ClientView` needs four calls: :meth:`Teaching.build_tabs` while its panel builds the tab group,
+:meth:`Teaching.attach` once it has joined a session, :meth:`Teaching.render` for every frame (under the hub's
+lock) and :meth:`Teaching.close`; :meth:`Teaching.switched` when the tab moves to another session.
+"""
+
+from __future__ import annotations
+
+import threading
+import weakref
+from dataclasses import dataclass
+
+import viser
+
+from tpm_viz.ui.session import Hub, Session
+from tpm_viz.ui.snapshot import Frame
+from tpm_viz.ui.teaching.explorer import ExplorerView, MapService
+from tpm_viz.ui.teaching.lessons import DemosView
+from tpm_viz.ui.teaching.player import PlayerView
+from tpm_viz.ui.teaching.playing import RunHub
+from tpm_viz.ui.worker import Worker
+
+__all__ = ["Services", "Teaching", "services_for"]
+
+
+@dataclass
+class Services:
+    """What the tabs of one hub share."""
+
+    worker: Worker
+    maps: MapService
+    runs: RunHub
+
+
+_SERVICES: weakref.WeakKeyDictionary[Hub, Services] = weakref.WeakKeyDictionary()
+_SERVICES_LOCK = threading.Lock()
+
+
+def services_for(hub: Hub) -> Services:
+    """The services of ``hub`` (created at first use)."""
+    with _SERVICES_LOCK:
+        services = _SERVICES.get(hub)
+        if services is None:
+            worker = Worker()
+            services = _SERVICES[hub] = Services(worker, MapService(worker), RunHub(hub, worker))
+        return services
+
+
+class Teaching:
+    """Player, explorer and demonstrations of one tab (``view`` is its :class:`~.client.ClientView`)."""
+
+    def __init__(self, view) -> None:
+        self.view = view
+        self.services = services_for(view.hub)
+        self.player = PlayerView(view, self.services.runs)
+        self.explorer = ExplorerView(view, self.services.maps)
+        self.demos = DemosView(view, self.services.runs, self.explorer)
+
+    def build_tabs(self, tabs: viser.GuiTabGroupHandle) -> None:
+        """Add the *Player*, *Explorer* and *Demos* tabs to the panel's tab group."""
+        gui = self.view.client.gui
+        with tabs.add_tab("Player", icon=viser.Icon.PLAYER_PLAY):
+            self.player.build(gui)
+        with tabs.add_tab("Explorer", icon=viser.Icon.MAP):
+            self.explorer.build(gui)
+        with tabs.add_tab("Demos", icon=viser.Icon.SCHOOL):
+            self.demos.build(gui)
+
+    def attach(self) -> None:
+        """The tab has joined its session: draw the session's run (the first render came before that)."""
+        with self.view.hub.lock:
+            self.player.refresh()
+
+    def switched(self, old: Session) -> None:
+        """The tab moved from ``old`` to its current session (own copy on / off)."""
+        with self.view.hub.lock:
+            self.services.runs.adopt(self.view.session, old)
+            self.player.refresh()
+
+    def render(self, frame: Frame) -> None:
+        """Draw the teaching layer's part of ``frame`` (under the hub's lock)."""
+        self.player.render(frame)
+        self.explorer.render(frame)
+        self.demos.render(frame)
+
+    def close(self) -> None:
+        """The tab went away."""
+        self.player.close()
+        self.explorer.close()
