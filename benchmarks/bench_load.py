@@ -32,9 +32,9 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository root: tests.support
 
-from wsclient import ServerProcess, Tab, machine_busy_seconds
+from tests.support.protocol import ServerProcess, Tab, machine_busy_seconds
 
 TOKEN = "bench-presenter-token"
 

@@ -22,9 +22,9 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository root: tests.support
 
-from wsclient import ServerProcess, Tab
+from tests.support.protocol import ServerProcess, Tab
 
 WARM_UP = 200  # tabs before the reference memory reading
 

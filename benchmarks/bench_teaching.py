@@ -25,11 +25,11 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(ROOT))  # the repository root: tests.support
 
-from conftest import ProtocolClient, wait_for  # noqa: E402
-from timing import median_seconds, report  # noqa: E402
+from timing import median_seconds, report
 
+from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz import Params
 from tpm_viz.app.runs import Source, build_run
 from tpm_viz.app.transitions import apply_params

@@ -25,10 +25,10 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(ROOT))  # the repository root: tests.support
 
-from conftest import CHROMIUM, CHROMIUM_ARGS, WORKER_LOG_JS, ProtocolClient, wait_for  # noqa: E402
-
+from tests.support.browser import CHROMIUM, CHROMIUM_ARGS, WORKER_LOG_JS
+from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz.ui.app import TpmApp, build_server
 
 

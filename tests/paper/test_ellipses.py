@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from strategies import params_sets, regular_states
 
+from tests.support.strategies import params_sets, regular_states
 from tpm_viz import Params, SingularConfigurationError
 from tpm_viz.paper.ellipses import ellipse_outline, manipulability_ellipses
 from tpm_viz.paper.jacobians import jacobians

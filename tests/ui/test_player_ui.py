@@ -9,8 +9,8 @@ import time
 
 import numpy as np
 import pytest
-from conftest import wait_for
 
+from tests.support.protocol import wait_for
 from tpm_viz import Params
 from tpm_viz.app.lessons import DEMOS
 from tpm_viz.paper.trajectories import circle_state, line_state

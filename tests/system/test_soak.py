@@ -18,9 +18,9 @@ import threading
 import time
 from pathlib import Path
 
-from conftest import ProtocolClient, wait_for
 from test_reliability_app import assert_valid
 
+from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz.ui.guard import ACTIVITY
 
 WARM_UP, CYCLES, BATCH = 30, 240, 4

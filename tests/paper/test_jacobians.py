@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from reference import ik_quadratic, jacobian_fd
-from strategies import params_sets, regular_states
 
+from tests.support.reference import ik_quadratic, jacobian_fd
+from tests.support.strategies import params_sets, regular_states
 from tpm_viz import (
     STATUS_LABELS,
     Params,

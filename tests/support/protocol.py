@@ -1,4 +1,7 @@
-"""Helpers of the load and soak benchmarks: the app in a child process, and asyncio tabs that speak viser's protocol.
+"""The one protocol-level test client, shared by the tests and the benchmarks: browser tabs without a browser.
+
+:class:`ProtocolClient` is a synchronous tab for tests against an in-process app (it sends what a browser sends and
+records the scene nodes it was sent); :class:`Tab` is an asyncio tab for the load and soak benchmarks.
 
 :class:`ServerProcess` starts ``python app.py --port 0`` on 127.0.0.1 (optionally with a presenter token), reads the
 port from its one printed line, measures its CPU time and resident memory from ``/proc/<pid>``, keeps its stderr
@@ -18,6 +21,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -25,12 +29,26 @@ import msgspec
 import viser
 import zstandard
 from websockets.asyncio.client import connect
+from websockets.sync.client import connect as connect_sync
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 CLK_TCK = os.sysconf("SC_CLK_TCK")
 GIZMO_Z = 0.09
 PLATFORM_NODES = ("/tpm/platform", "/own/platform")
 """The shared platform (broadcast, owner "") and a private copy's (this tab's own scope)."""
+CAMERA = dict(
+    type="ViewerCameraMessage",
+    wxyz=(1.0, 0.0, 0.0, 0.0),
+    position=(0.0, -1.0, 1.0),
+    fov=1.0,
+    near=0.01,
+    far=100.0,
+    image_height=720,
+    image_width=1280,
+    look_at=(0.0, 0.0, 0.0),
+    up_direction=(0.0, 0.0, 1.0),
+)
+"""The first message of every tab: viser registers a client when its camera arrives."""
 
 
 class ServerProcess:
@@ -128,18 +146,7 @@ class Tab:
             open_timeout=timeout,
         )
         self._reader = asyncio.create_task(self._read())
-        await self.send(
-            type="ViewerCameraMessage",
-            wxyz=(1.0, 0.0, 0.0, 0.0),
-            position=(0.0, -1.0, 1.0),
-            fov=1.0,
-            near=0.01,
-            far=100.0,
-            image_height=720,
-            image_width=1280,
-            look_at=(0.0, 0.0, 0.0),
-            up_direction=(0.0, 0.0, 1.0),
-        )
+        await self.send(**CAMERA)
         await asyncio.wait_for(self.ready.wait(), timeout)
 
     async def send(self, **message) -> None:
@@ -199,3 +206,89 @@ class Tab:
             await self.ws.close()
         if self._reader is not None:
             await asyncio.wait([self._reader], timeout=5.0)
+
+
+def wait_for(predicate, timeout: float = 10.0, interval: float = 0.01, what: str = "condition"):
+    """Poll ``predicate`` until it returns a truthy value (returned) or fail after ``timeout`` seconds."""
+    deadline = time.monotonic() + timeout
+    while True:
+        value = predicate()
+        if value:
+            return value
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+        time.sleep(interval)
+
+
+class ProtocolClient:
+    """A browser stand-in at the websocket level (see the module docstring)."""
+
+    def __init__(self, port: int) -> None:
+        self.ws = connect_sync(
+            f"ws://127.0.0.1:{port}", subprotocols=[f"viser-v{viser.__version__}"], max_size=None, compression=None
+        )
+        self.received = 0
+        self.nodes: dict[tuple[str, str], dict] = {}
+        """Scene nodes this tab was sent, ``(name, owner) -> message`` (owner "" = the broadcast scope)."""
+        self._stop = threading.Event()
+        self._reader = threading.Thread(target=self._drain, daemon=True)
+        self._reader.start()
+        self.send(**CAMERA)
+
+    def _drain(self) -> None:
+        while not self._stop.is_set():
+            try:
+                raw = self.ws.recv(timeout=0.2)
+                self.received += 1
+            except TimeoutError:
+                continue
+            except Exception:  # connection closed
+                return
+            for m in decode_batch(raw):
+                if "owner" in m and "name" in m:  # a scene-node message (viser 1.1.1: stamped with its scope)
+                    self._record(m)
+
+    def _record(self, m: dict) -> None:
+        key = (m["name"], m["owner"])
+        if m["type"] == "RemoveSceneNodeMessage":
+            self.nodes.pop(key, None)
+        elif "props" in m:  # a node created (or re-created); its visibility follows in its own message
+            self.nodes[key] = {"type": m["type"], "visible": True, "virtual": m.get("virtual", False)}
+        elif m["type"] == "SetSceneNodeVisibilityMessage" and key in self.nodes:
+            self.nodes[key]["visible"] = m["visible"]
+
+    def shadows(self) -> set[str]:
+        """Names this tab hides with an invisible node of its own over a broadcast node (viser's scope shadowing)."""
+        own = {name for (name, owner), n in self.nodes.items() if owner != "" and not n["visible"] and not n["virtual"]}
+        return {name for name in own if (name, "") in self.nodes} | {n for n in own if n == "/tpm"}
+
+    def send(self, **message) -> None:
+        """Send one message (a dict with its ``type``), msgpack-encoded like viser's client does."""
+        self.ws.send(_encode(message))
+
+    def set_value(self, handle, value) -> None:
+        """What the browser sends when the user changes a GUI input (or clicks a button: ``value=True``)."""
+        self.send(type="GuiUpdateMessage", uuid=handle._impl.uuid, updates={"value": value})
+
+    def click(self, button) -> None:
+        self.set_value(button, True)
+
+    def drag(self, gizmo, owner: str, positions, end: bool = True) -> None:
+        """A gizmo drag through ``positions`` (x, y, z) [m], as start, updates and (optionally) end."""
+        name = gizmo.name
+        self.send(type="TransformControlsDragStartMessage", name=name, owner=owner)
+        for pos in positions:
+            self.send(
+                type="TransformControlsUpdateMessage",
+                name=name,
+                wxyz=(1.0, 0.0, 0.0, 0.0),
+                position=tuple(float(v) for v in pos),
+                owner=owner,
+            )
+        if end:
+            self.send(type="TransformControlsDragEndMessage", name=name, owner=owner)
+
+    def close(self) -> None:
+        self._stop.set()
+        self.ws.close()
+        self._reader.join(timeout=2.0)

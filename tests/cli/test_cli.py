@@ -9,8 +9,8 @@ import sys
 
 import numpy as np
 import pytest
-from reference import ik_quadratic, minimal_coordinate_forces
 
+from tests.support.reference import ik_quadratic, minimal_coordinate_forces
 from tpm_viz import Params
 
 P = Params.paper()

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from reference import ik_quadratic
-from strategies import params_sets, regular_states
 
+from tests.support.reference import ik_quadratic
+from tests.support.strategies import params_sets, regular_states
 from tpm_viz import (
     FK_STATUS,
     InputError,

@@ -102,9 +102,8 @@ def test_live_frames_show_the_pinocchio_forces_beside_the_closed_form():
     """Issue 3: both numbers side by side on every displayed frame, intermediate drag frames included."""
     import dataclasses
 
-    from tpm_viz import inverse_dynamics
+    from tpm_viz import inverse_dynamics, multibody
     from tpm_viz.app.readouts import Load
-    from tpm_viz import multibody
 
     hub = Hub(AppState.initial(Params.paper()), reference=multibody.inverse_dynamics)
     state = hub.shared.state

@@ -19,9 +19,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import ProtocolClient, wait_for
 
 import tpm_viz.ui.app as app_module
+from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz import InputError
 from tpm_viz.app.access import LOCKOUT_SECONDS, MAX_FAILURES, Access, AccessDenied
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES
@@ -29,7 +29,7 @@ from tpm_viz.ui.guard import ACTIVITY
 from tpm_viz.ui.session import Session
 
 TOKEN = "s3cret-Token"
-UI = Path(__file__).resolve().parents[1] / "tpm_viz" / "ui"
+UI = Path(__file__).resolve().parents[2] / "tpm_viz" / "ui"
 
 
 def _state(view):
@@ -102,7 +102,7 @@ def test_command_lines_default_to_loopback_and_pass_the_token(monkeypatch):
     for argv, host in ((["app.py", "--port", "0"], "127.0.0.1"), (["app.py", "--host", "10.0.0.5"], "10.0.0.5")):
         monkeypatch.setattr("sys.argv", argv)
         with pytest.raises(SystemExit) as exit_:
-            runpy.run_path(str(Path(__file__).resolve().parents[1] / "app.py"), run_name="__main__")
+            runpy.run_path(str(Path(__file__).resolve().parents[2] / "app.py"), run_name="__main__")
         assert exit_.value.code == 0 and calls[-1]["host"] == host
 
 

@@ -22,12 +22,12 @@ import uuid
 
 import numpy as np
 import pytest
-from conftest import ProtocolClient, wait_for
-from fake_viser import assert_clean
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from test_reliability_app import CSV_TEXT, GOOD_ROWS, NASTY_FLOAT, _timed, assert_valid
 
+from tests.support.fake_viser import assert_clean
+from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz.ui.guard import ACTIVITY
 
 INT64 = st.integers(-(2**62), 2**62)

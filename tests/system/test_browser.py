@@ -14,7 +14,9 @@ import time
 
 import numpy as np
 import pytest
-from conftest import WORKER_LOG_JS, wait_for
+
+from tests.support.browser import WORKER_LOG_JS
+from tests.support.protocol import wait_for
 
 pytestmark = pytest.mark.browser
 

@@ -13,8 +13,8 @@ from contextlib import redirect_stderr, redirect_stdout
 
 import numpy as np
 import pytest
-from conftest import wait_for
 
+from tests.support.protocol import wait_for
 from tpm_viz import Params, forward_kinematics_both, inverse_kinematics
 from tpm_viz.ui.app import is_loopback, main
 from tpm_viz.ui.scene import COLORS

@@ -22,10 +22,10 @@ import re
 
 import numpy as np
 import pytest
-from fake_viser import FakeView, assert_clean
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from tests.support.fake_viser import FakeView, assert_clean
 from tpm_viz import InputError, Params, TpmVizError
 from tpm_viz.app import transitions as T
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES, read_choice, read_flag, read_number, read_upload, read_vec2

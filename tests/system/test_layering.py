@@ -7,7 +7,7 @@ import re
 import subprocess
 import sys
 
-ROOT = pathlib.Path(__file__).resolve().parents[1] / "tpm_viz"
+ROOT = pathlib.Path(__file__).resolve().parents[2] / "tpm_viz"
 
 
 def test_importing_the_library_loads_neither_viser_nor_pinocchio():

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from reference import minimal_coordinate_forces, rod_kinetic_energy
-from strategies import params_sets, regular_states
 
+from tests.support.reference import minimal_coordinate_forces, rod_kinetic_energy
+from tests.support.strategies import params_sets, regular_states
 from tpm_viz import (
     Params,
     SingularConfigurationError,

@@ -18,12 +18,12 @@ import pinocchio as pin
 import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
-from reference import rod_kinetic_energy
-from strategies import params_sets, regular_states
 
 import tpm_viz as tv
-from tpm_viz.multibody.model import PART_NAMES, MultibodyModel
+from tests.support.reference import rod_kinetic_energy
+from tests.support.strategies import params_sets, regular_states
 from tpm_viz import multibody
+from tpm_viz.multibody.model import PART_NAMES, MultibodyModel
 
 P = tv.Params.paper()
 MB = multibody.model_for(P)

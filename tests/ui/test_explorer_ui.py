@@ -7,8 +7,8 @@ import time
 
 import numpy as np
 import pytest
-from conftest import wait_for
 
+from tests.support.protocol import wait_for
 from tpm_viz import Params
 from tpm_viz.app.overlays import MAP_KINDS
 from tpm_viz.ui.teaching import explorer as explorer_module

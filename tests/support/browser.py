@@ -1,0 +1,46 @@
+"""Headless Chromium for the browser tests and benchmarks: Debian's binary, the flags this machine needs, and
+an init script that logs viser's websocket messages in the page."""
+
+CHROMIUM = "/usr/bin/chromium"
+CHROMIUM_ARGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
+
+
+WORKER_LOG_JS = """
+(() => {
+  // Wrap the websocket Web Worker: log every decoded incoming message and every outgoing one, with
+  // performance.now() timestamps (ms), in window.__viserLog.
+  const Orig = window.Worker;
+  const log = (window.__viserLog = []);
+  function Wrapped(url, opts) {
+    const w = new Orig(url, opts);
+    const post = w.postMessage.bind(w);
+    w.postMessage = (data, transfer) => {
+      if (data && data.type === "send" && data.message) {
+        log.push({ dir: "out", t: performance.now(), type: data.message.type, uuid: data.message.uuid,
+                   name: data.message.name });
+      }
+      return post(data, transfer);
+    };
+    w.addEventListener("message", (ev) => {
+      const d = ev.data;
+      if (d && d.type === "message_batch") {
+        const t = performance.now();
+        for (const m of d.messages) log.push({ dir: "in", t, type: m.type, uuid: m.uuid, name: m.name });
+      }
+    });
+    return w;
+  }
+  Wrapped.prototype = Orig.prototype;
+  window.Worker = Wrapped;
+})();
+"""
+"""Init script for a page: a timestamped log of viser's websocket messages in ``window.__viserLog``."""

@@ -1,0 +1,71 @@
+"""Fixtures shared by the UI and system tests (imported by their ``conftest.py``).
+
+- ``app``: a :class:`tpm_viz.ui.app.TpmApp` on ``127.0.0.1``, port 0 (a free one); stopped afterwards.
+- ``connect``: ``connect()`` opens a :class:`~tests.support.protocol.ProtocolClient` (viser's websocket protocol
+  from Python, no browser) and returns ``(client, view)`` once the app built the tab's view.
+- ``browser``: a Playwright Chromium context (Debian's ``/usr/bin/chromium``, fresh profile); the test is skipped
+  when Chromium or Playwright is missing.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+
+import pytest
+
+from tests.support.browser import CHROMIUM, CHROMIUM_ARGS
+from tests.support.protocol import ProtocolClient, wait_for
+from tpm_viz.ui.app import TpmApp, build_server
+
+__all__ = ["app", "browser", "connect"]
+
+
+@pytest.fixture
+def app():
+    """The app on a free loopback port."""
+    server = build_server("127.0.0.1", 0)
+    application = TpmApp(server)
+    yield application
+    application.stop()
+
+
+@pytest.fixture
+def connect(app):
+    """``connect()`` opens a protocol client and returns ``(client, view)`` once the app built its view."""
+    opened: list[ProtocolClient] = []
+
+    def _connect():
+        before = set(app.views)
+        client = ProtocolClient(app.port)
+        opened.append(client)
+        new = wait_for(lambda: set(app.views) - before, what="the app to build a view for the client")
+        view = app.views[next(iter(new))]
+        wait_for(lambda: view.session.readout is not None, what="the first render")
+        return client, view
+
+    yield _connect
+    for client in opened:  # one at a time: each tab's departure is processed before the next one leaves
+        count = len(app.views)
+        client.close()
+        wait_for(lambda count=count: len(app.views) < count, what="the app to drop the closed tab")
+
+
+@pytest.fixture
+def browser():
+    """A headless Chromium context with a fresh profile; skips when Chromium or Playwright is missing."""
+    if not os.path.exists(CHROMIUM):
+        pytest.skip(f"{CHROMIUM} is not installed")
+    sync_api = pytest.importorskip("playwright.sync_api")
+    with tempfile.TemporaryDirectory() as profile, sync_api.sync_playwright() as pw:
+        context = pw.chromium.launch_persistent_context(
+            profile,
+            executable_path=CHROMIUM,
+            args=CHROMIUM_ARGS,
+            headless=True,
+            viewport={"width": 1400, "height": 860},
+        )
+        try:
+            yield context
+        finally:
+            context.close()
