@@ -14,9 +14,7 @@ from tpm_viz.errors import (
 )
 from tpm_viz.paper.dynamics import DynamicsResult, inverse_dynamics, inverse_dynamics_detail, kinetic_energy
 from tpm_viz.paper.jacobians import (
-    STATUS_LABELS,
     Jacobians,
-    SingularityThresholds,
     actuator_acceleration,
     actuator_forces_from_platform_force,
     actuator_velocity,
@@ -28,7 +26,6 @@ from tpm_viz.paper.jacobians import (
     theta_dot,
 )
 from tpm_viz.paper.kinematics import (
-    FK_STATUS,
     FkSolutions,
     MechanismPose,
     forward_kinematics,
@@ -40,6 +37,7 @@ from tpm_viz.paper.kinematics import (
     mechanism_pose,
     reachable,
 )
+from tpm_viz.paper.status import FK_STATUS, STATUS_LABELS, FkStatus, PoseStatus, SingularityThresholds
 from tpm_viz.paper.trajectories import (
     DEFAULT_DURATIONS,
     Trajectory,
@@ -61,11 +59,13 @@ __all__ = [
     "STATUS_LABELS",
     "DynamicsResult",
     "FkSolutions",
+    "FkStatus",
     "InputError",
     "InvalidParametersError",
     "Jacobians",
     "MechanismPose",
     "Params",
+    "PoseStatus",
     "SingularConfigurationError",
     "SingularityThresholds",
     "TpmVizError",

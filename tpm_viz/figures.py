@@ -2,17 +2,21 @@
 
 As in the paper, the closed-form equations are drawn solid and the independent simulation model
 dotted (there ADAMS, here the Pinocchio closed-loop model); a second panel shows their difference.
-Matplotlib is imported lazily and drawn with its Agg canvas (no pyplot, no GUI backend).
+Drawn with matplotlib's Agg canvas (no pyplot, no GUI backend). Takes arrays, computes nothing: the command line
+(``tpm-viz figures``) and the app's player pass the forces of both models.
 """
 
 from __future__ import annotations
 
+import io
 import pathlib
+from typing import Protocol
 
-from tpm_viz.multibody.crosscheck import ForceComparison, compare_forces
-from tpm_viz.params import Params
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 
-__all__ = ["TITLES", "force_plot_png", "plot_forces", "write_paper_figures"]
+__all__ = ["FILE_NAMES", "TITLES", "ForceCurves", "force_plot_png", "plot_forces"]
 
 TITLES = {
     "line": "Fig. 4: line from (-100, -50) to (+100, +50) mm",
@@ -21,13 +25,19 @@ TITLES = {
 FILE_NAMES = {"line": "fig4_line.png", "circle": "fig5_circle.png"}
 
 
+class ForceCurves(Protocol):
+    """Forces along one trajectory by both models, e.g. :class:`tpm_viz.multibody.crosscheck.ForceComparison`."""
+
+    kind: str
+    duration: float  # [s]
+    t: np.ndarray  # (n,) [s]
+    tau_paper: np.ndarray  # (n, 2) [N]
+    tau_pinocchio: np.ndarray  # (n, 2) [N]
+
+
 def _force_figure(t, tau_paper, tau_ref, title: str, dpi: int):
     """The figure of :func:`plot_forces`: forces (paper solid, reference dotted) over their difference; one
     panel when there is no reference."""
-    import numpy as np
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
     fig = Figure(figsize=(7.0, 6.0 if tau_ref is not None else 4.2), dpi=dpi, layout="constrained")
     FigureCanvasAgg(fig)
     if tau_ref is not None:
@@ -60,8 +70,8 @@ def _force_figure(t, tau_paper, tau_ref, title: str, dpi: int):
     return fig
 
 
-def plot_forces(cmp: ForceComparison, path: str | pathlib.Path, dpi: int = 100) -> pathlib.Path:
-    """Write one force figure (two panels, N vs s) for a :class:`ForceComparison`; returns the path."""
+def plot_forces(cmp: ForceCurves, path: str | pathlib.Path, dpi: int = 100) -> pathlib.Path:
+    """Write one force figure (two panels, N vs s) for :class:`ForceCurves`; returns the path."""
     title = f"{TITLES.get(cmp.kind, cmp.kind)}, T = {cmp.duration:g} s"
     fig = _force_figure(cmp.t, cmp.tau_paper, cmp.tau_pinocchio, title, dpi)
     path = pathlib.Path(path)
@@ -72,25 +82,7 @@ def plot_forces(cmp: ForceComparison, path: str | pathlib.Path, dpi: int = 100) 
 def force_plot_png(t, tau_paper, tau_ref=None, title: str = "actuator forces", dpi: int = 100) -> bytes:
     """PNG bytes of the force figure for any trajectory (e.g. the app's player): ``t`` (n,) [s], forces (n, 2)
     [N]; the reference model (Pinocchio) dotted with a difference panel when ``tau_ref`` is given."""
-    import io
-
     fig = _force_figure(t, tau_paper, tau_ref, title, dpi)
     out = io.BytesIO()
     fig.savefig(out, format="png", dpi=dpi)
     return out.getvalue()
-
-
-def write_paper_figures(
-    params: Params,
-    output_dir: str | pathlib.Path,
-    duration_line: float | None = None,
-    duration_circle: float | None = None,
-    samples: int = 201,
-) -> list[pathlib.Path]:
-    """Write ``fig4_line.png`` and ``fig5_circle.png`` into ``output_dir`` (created if needed)."""
-    out = pathlib.Path(output_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    paths = []
-    for kind, duration in (("line", duration_line), ("circle", duration_circle)):
-        paths.append(plot_forces(compare_forces(params, kind, duration, samples), out / FILE_NAMES[kind]))
-    return paths

@@ -1,7 +1,7 @@
 """The parameter set of the 2-PPa TPM: geometry and masses, in SI units.
 
 Defaults are the paper's prototype (Tables 1 and 2). Symbols follow the paper and
-``conventions.md``: the slider joint of leg ``i`` is ``A_i = (d_i - a) e_i``, the
+``docs/conventions.md``: the slider joint of leg ``i`` is ``A_i = (d_i - a) e_i``, the
 platform-side joint is ``B_i = P - b e_i`` and ``|B_i - A_i| = l_a`` (eq. 2).
 """
 
@@ -67,7 +67,7 @@ class Params:
                     f"parameter {f.name} = {value:g} {f.metadata['unit']} is outside the supported range "
                     f"{low:g} to {high:g} {f.metadata['unit']}"
                 )
-        k = self.a - self.b
+        k = self.offset
         # Eq. (4): d_i = p_i + (a - b) - sqrt(l_a^2 - p_j^2). Over the reachable set
         # |p_1|, |p_2| < l_a the pairs (d_1, d_2) that both lie in [0, stroke] exist iff
         # a - b - sqrt(2) l_a < stroke and a - b + l_a > 0 (extremes on the diagonal p_1 = p_2).
@@ -110,9 +110,16 @@ class Params:
                 raise InvalidParametersError(f"parameter {name} must be a number, got {raw!r}") from None
         return self.replace(**changes)
 
-    def as_dict(self) -> dict[str, float]:
-        """All fields as a plain ``{name: value}`` dict (SI units)."""
-        return dataclasses.asdict(self)
+    @property
+    def offset(self) -> float:
+        """``a - b`` [m]: with it, ``c_i = p_i - d_i + (a - b) = l_a cos θ_i`` (eq. 23) and the working-mode
+        inverse kinematics is ``d_i = p_i + (a - b) - sqrt(l_a² - p_j²)`` (eq. 4)."""
+        return self.a - self.b
+
+    @property
+    def moving_mass(self) -> float:
+        """Total moving mass ``2 m_a + 2 m_b + m_p`` [kg] (both sliders, both parallelograms, the platform)."""
+        return 2.0 * self.m_a + 2.0 * self.m_b + self.m_p
 
 
 PARAM_INFO: dict[str, dict] = {f.name: dict(f.metadata) for f in dataclasses.fields(Params)}

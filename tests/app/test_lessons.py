@@ -7,11 +7,12 @@ import pytest
 
 from tpm_viz import InputError, Params, forward_kinematics_both, meshes
 from tpm_viz.app.lessons import DEMOS, demo_by_key, demo_params, demo_pose, demo_source, effect
-from tpm_viz.app.moves import OK, check
+from tpm_viz.app.moves import check
 from tpm_viz.app.overlays import MAP_KINDS, cached_map
 from tpm_viz.app.runs import Source, build_run
 from tpm_viz.paper.ellipses import manipulability_ellipses
 from tpm_viz.paper.jacobians import jacobians
+from tpm_viz.paper.status import PoseStatus
 from tpm_viz.paper.workspace import workspace_area
 
 P = Params.paper()
@@ -29,7 +30,7 @@ def test_keys_and_titles_are_unique_and_the_tour_is_ordered():
 def test_every_demo_is_a_valid_scene(demo):
     params = demo_params(demo)  # validated by Params
     pose = demo_pose(demo, params)
-    assert check(params, pose) == OK  # inside the stroke, clear of both singularities
+    assert check(params, pose) == PoseStatus.REGULAR  # inside the stroke, clear of both singularities
     assert pose.mode(params) == demo.mode or demo.d is None
     source = demo_source(demo)
     if source is not None:
@@ -90,8 +91,9 @@ def test_the_two_assembly_modes_exist_mirror_each_other_and_are_both_valid():
     dets = [float(jacobians(P, q, demo.d).det_jx) for q in (sol.plus, sol.minus)]
     assert dets[0] > 0.2 and dets[1] < -0.2  # opposite signs of det J_x, clear of the arc
     from tpm_viz.app.moves import Pose
+    from tpm_viz.paper.status import PoseStatus
 
-    assert check(P, Pose(sol.minus, demo.d)) == OK
+    assert check(P, Pose(sol.minus, demo.d)) == PoseStatus.REGULAR
     np.testing.assert_allclose(sol.plus, sol.plus[::-1])  # both on the diagonal, mirrored across the arc
     np.testing.assert_allclose(sol.minus, sol.minus[::-1])
 

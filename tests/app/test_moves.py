@@ -9,11 +9,6 @@ from hypothesis import strategies as st
 
 from tpm_viz import InputError, Params, forward_kinematics_both, inverse_kinematics
 from tpm_viz.app.moves import (
-    DIRECT,
-    INVERSE,
-    OK,
-    STROKE,
-    Limits,
     Pose,
     check,
     drag_to,
@@ -24,13 +19,14 @@ from tpm_viz.app.moves import (
     switch_mode,
 )
 from tpm_viz.paper.jacobians import jacobians
+from tpm_viz.paper.status import MOVE_LIMITS, PoseStatus
 
 P = Params.paper()
 HOME = Pose.working(P, (0.0, 0.0))
 
 
 def _assert_valid(params: Params, pose: Pose, mode: int = 1) -> None:
-    assert check(params, pose) == OK
+    assert check(params, pose) == PoseStatus.REGULAR
     assert pose.mode(params) == mode
     # d and p are one assembled configuration: both leg constraints of eq. (27) hold.
     c = pose.p - pose.d + (params.a - params.b)
@@ -86,7 +82,7 @@ def test_drag_towards_the_direct_singularity_stops_before_it():
     move = drag_to(P, HOME, (-0.3, -0.3))
     assert move.clamped and "direct singularity" in move.reason and "modes merge" in move.reason
     det = float(jacobians(P, move.pose.p, move.pose.d).det_jx)
-    assert det == pytest.approx(Limits().min_det, abs=1e-4)
+    assert det == pytest.approx(MOVE_LIMITS.direct, abs=1e-4)
     _assert_valid(P, move.pose)
 
 
@@ -169,9 +165,12 @@ def test_pose_codes_name_the_first_failing_rule():
     p = np.array([[0.0, 0.0], [0.2, 0.0], [-0.183, -0.183]])
     d = inverse_kinematics(P, p)
     codes = pose_codes(P, p, d, mode=1)
-    assert codes.tolist() == [OK, STROKE, DIRECT]
+    assert codes.tolist() == [PoseStatus.REGULAR, PoseStatus.OUT_OF_STROKE, PoseStatus.NEAR_DIRECT]
     near_edge = np.array([-0.2599, -0.24])  # |p_1| -> l_a: cos θ_2 -> 0
-    assert pose_codes(P, near_edge, ik_branch(P, near_edge, (1, 1)), mode=-1) in (INVERSE, STROKE)
+    assert pose_codes(P, near_edge, ik_branch(P, near_edge, (1, 1)), mode=-1) in (
+        PoseStatus.NEAR_INVERSE,
+        PoseStatus.OUT_OF_STROKE,
+    )
 
 
 def test_requests_must_be_finite():

@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 
 from tpm_viz import InputError, InvalidParametersError, Params, SingularityThresholds
-from tpm_viz.app.moves import OK, Limits, Pose, check
+from tpm_viz.app.moves import Pose, check
 from tpm_viz.app.poses import DEMO_KINDS, demo_pose, home_pose, settle
 from tpm_viz.paper.jacobians import jacobians
+from tpm_viz.paper.status import MOVE_LIMITS, PoseStatus
 
 P = Params.paper()
 
@@ -23,7 +24,7 @@ def test_home_of_the_paper_prototype_is_the_origin():
 def test_home_moves_off_the_origin_when_the_origin_is_out_of_stroke():
     params = P.replace(stroke=0.1)  # d_i(0) = 130 mm > 100 mm
     home = home_pose(params)
-    assert check(params, home) == OK
+    assert check(params, home) == PoseStatus.REGULAR
     assert np.linalg.norm(home.p) > 0.01
 
 
@@ -48,21 +49,21 @@ def test_settle_moves_an_invalid_pose_to_a_valid_one_and_says_so():
     params = P.replace(stroke=0.2)
     move = settle(params, pose)
     assert move.clamped and "nearest valid pose" in move.reason
-    assert check(params, move.pose) == OK
+    assert check(params, move.pose) == PoseStatus.REGULAR
 
 
 @pytest.mark.parametrize("kind", DEMO_KINDS)
 def test_demo_poses_are_valid_and_show_their_condition(kind):
-    limits, thr = Limits(), SingularityThresholds()
+    limits, thr = MOVE_LIMITS, SingularityThresholds()
     move = demo_pose(P, kind)
     pose = move.pose
     assert not move.clamped, move.reason
-    assert check(P, pose) == OK
+    assert check(P, pose) == PoseStatus.REGULAR
     jac = jacobians(P, pose.p, pose.d)
     if kind == "inverse":
-        assert limits.min_cos < min(abs(jac.jq[0, 0]), abs(jac.jq[1, 1])) < thr.inverse
+        assert limits.inverse < min(abs(jac.jq[0, 0]), abs(jac.jq[1, 1])) < thr.inverse
     elif kind == "direct":
-        assert limits.min_det < abs(float(jac.det_jx)) < thr.direct
+        assert limits.direct < abs(float(jac.det_jx)) < thr.direct
     else:
         assert np.min(np.minimum(pose.d, P.stroke - pose.d)) < 1e-6
 
@@ -72,7 +73,7 @@ def test_demo_pose_explains_when_the_stroke_keeps_the_mechanism_away():
     move = demo_pose(params, "direct")
     if move.clamped:
         assert "closest pose" in move.reason
-    assert check(params, move.pose) == OK
+    assert check(params, move.pose) == PoseStatus.REGULAR
 
 
 def test_demo_kind_is_checked():

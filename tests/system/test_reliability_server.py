@@ -170,7 +170,7 @@ def _sync(actor: ProtocolClient, view, pinged: threading.Event) -> None:
     for _ in range(3):
         time.sleep(0.002)
         assert ACTIVITY.wait_idle(10.0)
-        wait_for(lambda: not view._pending_drags, what="pending drags to drain")
+        wait_for(lambda: not view.session.drags.has(view), what="pending drags to drain")
         wait_for(worker.idle, what="background runs and maps")
 
 

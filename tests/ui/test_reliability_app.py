@@ -29,9 +29,11 @@ from tests.support.fake_viser import FakeView, assert_clean
 from tpm_viz import InputError, Params, TpmVizError
 from tpm_viz.app import transitions as T
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES, read_choice, read_flag, read_number, read_upload, read_vec2
-from tpm_viz.app.moves import OK, check, ik_branch
+from tpm_viz.app.moves import check, ik_branch
+from tpm_viz.app.state import AppState
+from tpm_viz.paper.status import PoseStatus
 from tpm_viz.params import PARAM_INFO
-from tpm_viz.ui.session import AppState, Hub
+from tpm_viz.ui.session import Hub
 
 P = Params.paper()
 BAD_TEXT = re.compile(r"\bnan\b|\binf\b|infinity", re.IGNORECASE)
@@ -125,7 +127,7 @@ def assert_valid(state: AppState) -> None:
     params, pose = state.params, state.pose
     assert np.all(np.isfinite(pose.p)) and np.all(np.isfinite(pose.d))
     np.testing.assert_allclose(pose.d, ik_branch(params, pose.p, pose.branch(params)), atol=1e-9)
-    assert check(params, pose) == OK, (params, pose)
+    assert check(params, pose) == PoseStatus.REGULAR, (params, pose)
     assert not BAD_TEXT.search(state.note)
     for value in (*state.load.f_ext, *state.load.dp, *state.load.ddp, state.trajectory.duration, state.trajectory.t):
         assert math.isfinite(value)

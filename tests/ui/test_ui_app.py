@@ -310,9 +310,10 @@ def test_simultaneous_drags_are_serialised_and_never_corrupt_state(app, connect)
     view = clients[0][1]
     _settle(view)
     state = _state(view)
-    from tpm_viz.app.moves import OK, check
+    from tpm_viz.app.moves import check
+    from tpm_viz.paper.status import PoseStatus
 
-    assert check(state.params, state.pose) == OK
+    assert check(state.params, state.pose) == PoseStatus.REGULAR
     np.testing.assert_allclose(state.pose.d, inverse_kinematics(P, state.pose.p))
     for _, v in clients:
         assert _state(v) is state
@@ -382,7 +383,7 @@ def test_a_class_pulling_the_shared_platform_at_once_is_paced_and_the_latest_dra
     times = [t for t, _ in commits]
     assert min(np.diff(times)) >= 0.9 * client_module.SHARED_DRAG_INTERVAL
     assert len({id(f) for f in drawn}) == len(drawn) <= len(commits)  # one broadcast drawing per commit
-    assert not hub.shared.drain_scheduled
+    assert not hub.shared.drags.scheduled
 
     client, last = tabs[-1]  # a drag after the storm: applied, shown everywhere, gizmos written back
     client.drag(last.scene.gizmo, str(last.client.client_id), [(0.03, -0.02, 0.09)])

@@ -10,7 +10,8 @@ import pytest
 
 from tpm_viz import InputError, Params
 from tpm_viz.app.moves import Pose
-from tpm_viz.ui.session import AppState, Hub, read_number, read_vec2
+from tpm_viz.app.state import AppState
+from tpm_viz.ui.session import Hub, read_number, read_vec2
 
 P = Params.paper()
 

@@ -12,7 +12,7 @@ from tpm_viz import Params
 from tpm_viz.app.moves import Pose
 from tpm_viz.app.poses import demo_pose
 from tpm_viz.app.readouts import Forces, Load, evaluate
-from tpm_viz.ui.session import AppState
+from tpm_viz.app.state import AppState
 from tpm_viz.ui.text import banner_level, dashboard_html, force_scale, legend_html, num
 
 P = Params.paper()

@@ -20,7 +20,7 @@ import weakref
 
 from tpm_viz.errors import InputError
 
-__all__ = ["LOCKOUT_SECONDS", "MAX_FAILURES", "Access", "AccessDenied", "LoginPanel"]
+__all__ = ["LOCKOUT_SECONDS", "MAX_FAILURES", "Access", "AccessDenied"]
 
 MAX_FAILURES = 5
 LOCKOUT_SECONDS = 60.0
@@ -100,23 +100,3 @@ class Access:
         with self._lock:
             self._presenters.discard(view)
             self._failures.pop(view, None)
-
-
-class LoginPanel:
-    """The *Presenter login* folder of one tab: a token field, a button and a status line."""
-
-    def __init__(self, gui, on_login) -> None:
-        with gui.add_folder("Presenter login", expand_by_default=False):
-            self.status = gui.add_markdown("Students: you watch the presenter here, or work on your own copy.")
-            self.token = gui.add_text("Presenter token", "", hint="Cleared as soon as it is read")
-            self.button = gui.add_button("Log in as presenter")
-        self.button.on_click(on_login)
-
-    def take(self) -> str:
-        """The typed token, then clear the field (it never stays on screen after an attempt)."""
-        value = self.token.value
-        self.token.value = ""
-        return value
-
-    def show(self, text: str) -> None:
-        self.status.content = text

@@ -68,7 +68,7 @@ def procedure_html(params: Params, res: DynamicsResult, jac: Jacobians, f_ext=(0
     Lengths in mm, velocities in mm/s, accelerations in mm/s², multipliers in N/m, forces in N.
     """
     mm = 1e3
-    c = res.p - res.d + (params.a - params.b)
+    c = res.p - res.d + params.offset
     g = np.array([[2 * c[0], 2 * res.p[0]], [2 * res.p[1], 2 * c[1]]])
     f = np.asarray(f_ext, dtype=float)
     parts = [
@@ -90,9 +90,9 @@ def procedure_html(params: Params, res: DynamicsResult, jac: Jacobians, f_ext=(0
             "<mo>=</mo>",
             _vec(res.p * mm),
             "<mo>+</mo>",
-            _num((params.a - params.b) * mm),
+            _num(params.offset * mm),
             "<mo>−</mo>",
-            _vec((res.p - res.d + params.a - params.b) * mm),
+            _vec((res.p - res.d + params.offset) * mm),
             _unit("mm"),
         ),
         "<p><b>(b) Velocities, eq. (9).</b> ḋ = J ṗ with J = J<sub>q</sub><sup>−1</sup> J<sub>x</sub> "

@@ -18,6 +18,7 @@ from tpm_viz.app.moves import Pose
 from tpm_viz.app.overlays import cached_map
 from tpm_viz.app.runs import Source, build_run
 from tpm_viz.errors import InputError
+from tpm_viz.paper.ellipses import manipulability_ellipses
 from tpm_viz.paper.jacobians import condition_number, jacobians
 from tpm_viz.paper.kinematics import forward_kinematics, forward_kinematics_both
 from tpm_viz.paper.workspace import workspace_area
@@ -249,8 +250,6 @@ def effect(demo: Demo) -> str:
         jac = jacobians(params, pose.p)
         cos = np.array([jac.jq[0, 0], jac.jq[1, 1]])
         cond = float(condition_number(params, pose.p))
-        from tpm_viz.paper.ellipses import manipulability_ellipses
-
         ell = manipulability_ellipses(params, pose.p)
         v, f = ell.velocity.radii, ell.force.radii
         return (

@@ -22,16 +22,16 @@ singularity) are in :mod:`tpm_viz.app.poses`.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Literal, NamedTuple
 
 import numpy as np
 
 from tpm_viz.errors import InputError
 from tpm_viz.paper.kinematics import forward_kinematics_both, inverse_kinematics
+from tpm_viz.paper.status import MOVE_LIMITS, PoseStatus, SingularityThresholds
 from tpm_viz.params import Params
 
 __all__ = [
-    "Limits",
     "Move",
     "Pose",
     "check",
@@ -42,23 +42,13 @@ __all__ = [
     "place",
     "pose_codes",
     "switch_mode",
+    "why_not",
 ]
 
-OK, UNREACHABLE, STROKE, INVERSE, DIRECT = 0, 1, 2, 3, 4
-"""Codes of :func:`pose_codes` (why a pose is not valid)."""
 
 _STROKE_TOL = 1e-9  # m
 _SAMPLES = 48  # samples per refinement round of a segment
 _ROUNDS = 3  # resolution 1 / 48**3 of the segment
-
-
-class Limits(NamedTuple):
-    """Hard margins of the valid set (dimensionless). Moves stop here, before the quantities vanish."""
-
-    min_cos: float = 0.03
-    """Smallest allowed ``|cos θ_i|`` (inverse singularity, eq. 11)."""
-    min_det: float = 0.03
-    """Smallest allowed ``|cos(θ1 + θ2)|`` (direct singularity, eq. 12)."""
 
 
 @dataclass(frozen=True)
@@ -78,11 +68,11 @@ class Pose:
 
     def branch(self, params: Params) -> np.ndarray:
         """Sign of ``c_i = l_a cos θ_i`` per leg (``+1`` is the working mode of eq. 4), shape (2,)."""
-        return np.where(self.p - self.d + (params.a - params.b) >= 0.0, 1.0, -1.0)
+        return np.where(self.p - self.d + params.offset >= 0.0, 1.0, -1.0)
 
     def mode(self, params: Params) -> int:
         """Assembly mode: the sign of ``det J_x = cos(θ1 + θ2)`` (eq. 12), ``+1`` or ``-1``."""
-        c = self.p - self.d + (params.a - params.b)
+        c = self.p - self.d + params.offset
         return 1 if c[0] * c[1] - self.p[0] * self.p[1] >= 0.0 else -1
 
     @classmethod
@@ -107,10 +97,10 @@ def ik_branch(params: Params, p, branch) -> np.ndarray:
     p = np.asarray(p, dtype=float)
     with np.errstate(invalid="ignore"):
         root = np.sqrt(params.l_a**2 - p[..., ::-1] ** 2)
-    return p + (params.a - params.b) - np.asarray(branch, dtype=float) * root
+    return p + params.offset - np.asarray(branch, dtype=float) * root
 
 
-def margins(params: Params, p, d, mode: int, limits: Limits = Limits()) -> np.ndarray:
+def margins(params: Params, p, d, mode: int, limits: SingularityThresholds = MOVE_LIMITS) -> np.ndarray:
     """Signed distances to the edges of the valid set, shape ``(..., 5)``; the pose is valid iff all are >= 0.
 
     Columns: the stroke of each actuator ``min(d_i, Δd - d_i)`` [m] (2 columns), ``|cos θ_i| - min_cos``
@@ -118,76 +108,88 @@ def margins(params: Params, p, d, mode: int, limits: Limits = Limits()) -> np.nd
     """
     p = np.asarray(p, dtype=float)
     d = np.asarray(d, dtype=float)
-    cos = (p - d + (params.a - params.b)) / params.l_a
+    cos = (p - d + params.offset) / params.l_a
     sin = p[..., ::-1] / params.l_a
     det = cos[..., 0] * cos[..., 1] - sin[..., 0] * sin[..., 1]
     stroke = np.minimum(d, params.stroke - d)
-    return np.concatenate([stroke, np.abs(cos) - limits.min_cos, (mode * det - limits.min_det)[..., None]], axis=-1)
+    return np.concatenate([stroke, np.abs(cos) - limits.inverse, (mode * det - limits.direct)[..., None]], axis=-1)
 
 
-_CODE_OF_COLUMN = np.array([STROKE, STROKE, INVERSE, INVERSE, DIRECT])
+_CODE_OF_COLUMN = np.array([PoseStatus.OUT_OF_STROKE] * 2 + [PoseStatus.NEAR_INVERSE] * 2 + [PoseStatus.NEAR_DIRECT])
 
 
-def pose_codes(params: Params, p, d, mode: int, branch=None, limits: Limits = Limits()) -> np.ndarray:
-    """Validity code per pose (``OK`` or the first failing rule: stroke, inverse, direct), shape ``(...)``.
+def pose_codes(params: Params, p, d, mode: int, branch=None, limits: SingularityThresholds = MOVE_LIMITS) -> np.ndarray:
+    """Validity code per pose (``PoseStatus.REGULAR`` or the first failing rule: stroke, inverse, direct), shape ``(...)``.
 
     ``mode`` is the required sign of ``det J_x``; ``branch`` (optional) the required sign of each ``c_i``.
-    Non-finite ``p`` or ``d`` count as ``UNREACHABLE``.
+    Non-finite ``p`` or ``d`` count as ``PoseStatus.UNREACHABLE``.
     """
     m = margins(params, p, d, mode, limits)
     m[..., :2] += _STROKE_TOL
     finite = np.all(np.isfinite(m), axis=-1)
     bad = m < 0.0
     if branch is not None:
-        cos_sign = np.sign(np.asarray(p, dtype=float) - np.asarray(d, dtype=float) + (params.a - params.b))
+        cos_sign = np.sign(np.asarray(p, dtype=float) - np.asarray(d, dtype=float) + params.offset)
         bad[..., 2:4] |= cos_sign != np.asarray(branch)
     first = np.argmax(bad, axis=-1)
-    code = np.where(np.any(bad, axis=-1), _CODE_OF_COLUMN[first], OK)
-    return np.where(finite, code, UNREACHABLE)
+    code = np.where(np.any(bad, axis=-1), _CODE_OF_COLUMN[first], PoseStatus.REGULAR)
+    return np.where(finite, code, PoseStatus.UNREACHABLE)
 
 
-def check(params: Params, pose: Pose, limits: Limits = Limits()) -> int:
-    """Validity code of one pose in its own branch and mode (``OK`` = 0 when valid)."""
+def check(params: Params, pose: Pose, limits: SingularityThresholds = MOVE_LIMITS) -> int:
+    """Validity code of one pose in its own branch and mode (``PoseStatus.REGULAR`` = 0 when valid)."""
     return int(pose_codes(params, pose.p, pose.d, pose.mode(params), pose.branch(params), limits))
 
 
-def _reason(params: Params, code: int, p: np.ndarray, d: np.ndarray, drive: bool) -> str:
-    """One line saying why the pose ``(p, d)`` is not valid."""
-    if code == STROKE:
+Cause = Literal["drag", "drive", "path"]
+"""What led to a pose: a drag of the platform, a drive of the actuators, or a sample of a given path."""
+
+
+def why_not(params: Params, status: int, p, d, cause: Cause = "path") -> str:
+    """One line saying why the pose ``(p, d)`` [m] is not valid, for a status of :class:`PoseStatus` other than
+    ``REGULAR``: the one describer of refusals (moves, trajectories, presets). For a drag or a drive ``(p, d)`` is
+    the first blocked pose of the move; for a path, the offending sample."""
+    p, d, mm = np.asarray(p, dtype=float), np.asarray(d, dtype=float), 1e3
+    cos = (p - d + params.offset) / params.l_a
+    if status == PoseStatus.OUT_OF_STROKE:
         i = int(np.argmax(np.maximum(-d, d - params.stroke)))
-        end = 0.0 if d[i] < 0 else params.stroke
-        return f"actuator {i + 1} reached the end of its stroke (d{i + 1} = {end * 1e3:.1f} mm)"
-    if code == INVERSE:
-        cos = np.abs(p - d + (params.a - params.b)) / params.l_a
-        i = int(np.argmin(cos))
-        return f"leg {i + 1} reached the inverse singularity (cos θ{i + 1} → 0, eq. 11)"
-    if code == DIRECT:
-        c = p - d + (params.a - params.b)
-        dot = c[0] * p[1] + p[0] * c[1]  # l_a² s_1 · s_2
+        if cause != "path":
+            end = 0.0 if d[i] < 0.5 * params.stroke else params.stroke
+            return f"actuator {i + 1} reached the end of its stroke (d{i + 1} = {end * mm:.1f} mm)"
+        stroke = f"0 to {params.stroke * mm:.0f} mm"
+        return f"actuator {i + 1} would leave its stroke (d{i + 1} = {d[i] * mm:.1f} mm, {stroke})"
+    if status == PoseStatus.NEAR_INVERSE:
+        i = int(np.nanargmin(np.abs(cos))) if np.any(np.isfinite(cos)) else 0
+        value = f"cos θ{i + 1} = {cos[i]:.3f}, " if np.isfinite(cos[i]) else ""
+        return f"leg {i + 1} comes too close to the inverse singularity ({value}eq. 11)"
+    if status == PoseStatus.NEAR_DIRECT:
+        det = cos[0] * cos[1] - p[1] * p[0] / params.l_a**2
+        dot = cos[0] * p[1] + p[0] * cos[1]  # l_a s_1 · s_2 / l_a
         kind = "the leg circles coincide" if dot > 0 else "the two assembly modes merge"
-        return f"direct singularity ahead (cos(θ1+θ2) → 0, eq. 12): {kind}"
-    if drive:
+        value = f"cos(θ1+θ2) = {det:.3f}, " if np.isfinite(det) else ""
+        return f"too close to the direct singularity ({value}eq. 12): {kind}"
+    if cause == "drive":
         return "the leg circles no longer meet: the mechanism cannot be assembled there"
-    return f"the platform must stay within |p1|, |p2| < l_a = {params.l_a * 1e3:.1f} mm"
+    return f"out of reach (|p1|, |p2| must stay below l_a = {params.l_a * mm:.1f} mm)"
 
 
 def _clamp(codes_of, x0: np.ndarray, x1: np.ndarray) -> tuple[np.ndarray, int]:
-    """Last valid point of the segment ``x0 -> x1`` and the code that stopped it (``OK`` if none)."""
+    """Last valid point of the segment ``x0 -> x1`` and the code that stopped it (``PoseStatus.REGULAR`` if none)."""
     t_ok, t_end = 0.0, 1.0
-    stop = OK
+    stop = PoseStatus.REGULAR
     for _ in range(_ROUNDS):
         ts = np.linspace(t_ok, t_end, _SAMPLES + 1)[1:]
         codes = codes_of(x0 + ts[:, None] * (x1 - x0))
-        bad = np.flatnonzero(codes != OK)
+        bad = np.flatnonzero(codes != PoseStatus.REGULAR)
         if bad.size == 0:
-            return (x1, stop) if stop == OK else (x0 + t_ok * (x1 - x0), stop)
+            return (x1, stop) if stop == PoseStatus.REGULAR else (x0 + t_ok * (x1 - x0), stop)
         k = int(bad[0])
         stop = int(codes[k])
         t_ok, t_end = (ts[k - 1] if k > 0 else t_ok), ts[k]
     return x0 + t_ok * (x1 - x0), stop
 
 
-def _drag_codes(params: Params, branch: np.ndarray, mode: int, limits: Limits):
+def _drag_codes(params: Params, branch: np.ndarray, mode: int, limits: SingularityThresholds):
     def codes_of(p: np.ndarray) -> np.ndarray:
         d = ik_branch(params, p, branch)
         return pose_codes(params, p, d, mode, branch, limits)
@@ -195,7 +197,7 @@ def _drag_codes(params: Params, branch: np.ndarray, mode: int, limits: Limits):
     return codes_of
 
 
-def drag_to(params: Params, pose: Pose, p_req, limits: Limits = Limits()) -> Move:
+def drag_to(params: Params, pose: Pose, p_req, limits: SingularityThresholds = MOVE_LIMITS) -> Move:
     """Move the platform towards ``p_req`` [m] by inverse kinematics, in the pose's branch and mode.
 
     Stops at the last valid pose on the way (see the module docstring). When stopped, it then slides along
@@ -208,7 +210,7 @@ def drag_to(params: Params, pose: Pose, p_req, limits: Limits = Limits()) -> Mov
     codes_of = _drag_codes(params, branch, mode, limits)
     p0 = pose.p.astype(float)
     best, stop = _clamp(codes_of, p0, p_req)
-    if stop == OK:
+    if stop == PoseStatus.REGULAR:
         return Move(Pose(best, ik_branch(params, best, branch)))
     blocked = _first_bad(codes_of, p0, p_req)
 
@@ -221,7 +223,7 @@ def drag_to(params: Params, pose: Pose, p_req, limits: Limits = Limits()) -> Mov
         if np.linalg.norm(slid - p_req) < np.linalg.norm(best - p_req) - 1e-12:
             best = slid
     new = Pose(best, ik_branch(params, best, branch))
-    return Move(new, True, "stopped: " + _reason(params, stop, blocked, ik_branch(params, blocked, branch), False))
+    return Move(new, True, "stopped: " + why_not(params, stop, blocked, ik_branch(params, blocked, branch), "drag"))
 
 
 def _project_on_edge(margins_of, start: np.ndarray, blocked: np.ndarray) -> np.ndarray | None:
@@ -254,7 +256,7 @@ def _first_bad(codes_of, x0: np.ndarray, x1: np.ndarray) -> np.ndarray:
     """A point just past the last valid one on ``x0 -> x1`` (for the wording of the reason)."""
     ts = np.linspace(0.0, 1.0, 4 * _SAMPLES + 1)[1:]
     pts = x0 + ts[:, None] * (x1 - x0)
-    bad = np.flatnonzero(codes_of(pts) != OK)
+    bad = np.flatnonzero(codes_of(pts) != PoseStatus.REGULAR)
     return pts[int(bad[0])] if bad.size else x1
 
 
@@ -265,7 +267,7 @@ def _fk(params: Params, d: np.ndarray, mode: int) -> np.ndarray:
     return np.where(sol.exists[..., None], p, np.nan)
 
 
-def drive_to(params: Params, pose: Pose, d_req, limits: Limits = Limits()) -> Move:
+def drive_to(params: Params, pose: Pose, d_req, limits: SingularityThresholds = MOVE_LIMITS) -> Move:
     """Move the actuators towards ``d_req`` [m]; the platform follows by forward kinematics in the pose's mode.
 
     Stops at the last valid pose on the way: at a stroke end, before an inverse singularity, or before the
@@ -282,40 +284,44 @@ def drive_to(params: Params, pose: Pose, d_req, limits: Limits = Limits()) -> Mo
     d0 = pose.d.astype(float)
     d_box = np.clip(d_req, 0.0, params.stroke)  # the stroke is a box in d: clipping the request is exact
     d_new, stop = _clamp(codes_of, d0, d_box)
-    if stop == OK and not np.array_equal(d_box, d_req):
-        stop = STROKE
+    if stop == PoseStatus.REGULAR and not np.array_equal(d_box, d_req):
+        stop = PoseStatus.OUT_OF_STROKE
     p_new = _fk(params, d_new, mode)
     new = Pose(p_new, d_new) if np.all(np.isfinite(p_new)) else pose
-    if stop == OK:
+    if stop == PoseStatus.REGULAR:
         return Move(new)
     d_bad = _first_bad(codes_of, d0, d_req)
     p_bad = _fk(params, d_bad, mode)
-    return Move(new, True, "stopped: " + _reason(params, stop, p_bad, d_bad, True))
+    return Move(new, True, "stopped: " + why_not(params, stop, p_bad, d_bad, "drive"))
 
 
-def switch_mode(params: Params, pose: Pose, limits: Limits = Limits()) -> Move:
+def switch_mode(params: Params, pose: Pose, limits: SingularityThresholds = MOVE_LIMITS) -> Move:
     """Jump to the other assembly mode at the same actuator positions (the other circle intersection)."""
     other = _fk(params, pose.d, -pose.mode(params))
     if not np.all(np.isfinite(other)):
-        return Move(pose, True, "no other assembly mode here: " + _reason(params, UNREACHABLE, pose.p, pose.d, True))
-    code = int(pose_codes(params, other, pose.d, -pose.mode(params), None, limits))
-    if code != OK:
         return Move(
-            pose, True, "the other assembly mode is not usable here: " + _reason(params, code, other, pose.d, True)
+            pose,
+            True,
+            "no other assembly mode here: " + why_not(params, PoseStatus.UNREACHABLE, pose.p, pose.d, "drive"),
+        )
+    code = int(pose_codes(params, other, pose.d, -pose.mode(params), None, limits))
+    if code != PoseStatus.REGULAR:
+        return Move(
+            pose, True, "the other assembly mode is not usable here: " + why_not(params, code, other, pose.d, "drive")
         )
     return Move(Pose(other, pose.d))
 
 
-def place(params: Params, pose: Pose, p, limits: Limits = Limits()) -> Move:
+def place(params: Params, pose: Pose, p, limits: SingularityThresholds = MOVE_LIMITS) -> Move:
     """Jump to ``p`` [m] in the working mode (eq. 4), e.g. a trajectory sample; refused if not valid there."""
     p = np.asarray(p, dtype=float).reshape(-1)
     if p.shape != (2,) or not np.all(np.isfinite(p)):
         raise InputError(f"platform position must be two finite numbers, got {p!r}")
     d = ik_branch(params, p, (1.0, 1.0))
     if not np.all(np.isfinite(d)):
-        return Move(pose, True, "refused: " + _reason(params, UNREACHABLE, p, d, False))
+        return Move(pose, True, "refused: " + why_not(params, PoseStatus.UNREACHABLE, p, d, "drag"))
     new = Pose(p, d)
     code = check(params, new, limits)
-    if code != OK:
-        return Move(pose, True, "refused: " + _reason(params, code, p, d, False))
+    if code != PoseStatus.REGULAR:
+        return Move(pose, True, "refused: " + why_not(params, code, p, d, "drag"))
     return Move(new)

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from tpm_viz.app.moves import OK, Limits, Move, Pose, check, drag_to, ik_branch, pose_codes
+from tpm_viz.app.moves import Move, Pose, check, drag_to, ik_branch, pose_codes
 from tpm_viz.errors import InputError, InvalidParametersError
-from tpm_viz.paper.jacobians import SingularityThresholds
+from tpm_viz.paper.status import MOVE_LIMITS, WARN, PoseStatus, SingularityThresholds
 from tpm_viz.params import Params
 
 __all__ = ["DEMO_KINDS", "demo_pose", "home_pose", "settle"]
@@ -33,12 +33,14 @@ def _grid(params: Params, n: int) -> tuple[np.ndarray, np.ndarray]:
     return p, ik_branch(params, p, _WORKING)
 
 
-def _valid(params: Params, p: np.ndarray, d: np.ndarray, limits: Limits, modes=(1, -1)) -> list[np.ndarray]:
+def _valid(
+    params: Params, p: np.ndarray, d: np.ndarray, limits: SingularityThresholds, modes=(1, -1)
+) -> list[np.ndarray]:
     """Masks of the valid grid points, one per assembly mode in ``modes`` (in that order)."""
-    return [pose_codes(params, p, d, m, _WORKING, limits) == OK for m in modes]
+    return [pose_codes(params, p, d, m, _WORKING, limits) == PoseStatus.REGULAR for m in modes]
 
 
-def home_pose(params: Params, near=(0.0, 0.0), limits: Limits = Limits(), n: int = 101) -> Pose:
+def home_pose(params: Params, near=(0.0, 0.0), limits: SingularityThresholds = MOVE_LIMITS, n: int = 101) -> Pose:
     """The valid working-mode pose nearest ``near`` [m], preferring assembly mode +1 (the home pose's mode).
 
     Raises :class:`~tpm_viz.InvalidParametersError` if no pose is valid (e.g. a stroke so short that every
@@ -48,7 +50,7 @@ def home_pose(params: Params, near=(0.0, 0.0), limits: Limits = Limits(), n: int
     if near.shape != (2,) or not np.all(np.isfinite(near)):
         raise InputError(f"near must be two finite numbers, got {near!r}")
     d_near = ik_branch(params, near, _WORKING)
-    if np.all(np.isfinite(d_near)) and pose_codes(params, near, d_near, 1, _WORKING, limits) == OK:
+    if np.all(np.isfinite(d_near)) and pose_codes(params, near, d_near, 1, _WORKING, limits) == PoseStatus.REGULAR:
         return Pose(near, d_near)
     p, d = _grid(params, n)
     for mask in _valid(params, p, d, limits):
@@ -61,14 +63,14 @@ def home_pose(params: Params, near=(0.0, 0.0), limits: Limits = Limits(), n: int
     )
 
 
-def settle(params: Params, pose: Pose, limits: Limits = Limits()) -> Move:
+def settle(params: Params, pose: Pose, limits: SingularityThresholds = MOVE_LIMITS) -> Move:
     """The pose to show after a parameter change: the same ``p`` in the same branch and mode if still valid,
     otherwise the valid pose nearest to it (:func:`home_pose`). Raises like :func:`home_pose`."""
     branch = pose.branch(params)
     d = ik_branch(params, pose.p, branch)
     if np.all(np.isfinite(d)):
         kept = Pose(pose.p, d)
-        if kept.mode(params) == pose.mode(params) and check(params, kept, limits) == OK:
+        if kept.mode(params) == pose.mode(params) and check(params, kept, limits) == PoseStatus.REGULAR:
             return Move(kept)
     home = home_pose(params, near=pose.p, limits=limits)
     return Move(home, True, "the previous pose is not valid with these parameters: moved to the nearest valid pose")
@@ -76,7 +78,7 @@ def settle(params: Params, pose: Pose, limits: Limits = Limits()) -> Move:
 
 def _measure(params: Params, kind: str, p: np.ndarray, d: np.ndarray) -> np.ndarray:
     """Distance to the demonstrated condition: ``min |cos θ_i|``, ``|cos(θ1+θ2)|`` or to a stroke end [m]."""
-    cos = (p - d + (params.a - params.b)) / params.l_a
+    cos = (p - d + params.offset) / params.l_a
     if kind == "inverse":
         return np.min(np.abs(cos), axis=-1)
     if kind == "direct":
@@ -89,8 +91,8 @@ def demo_pose(
     params: Params,
     kind: str,
     near=(0.0, 0.0),
-    limits: Limits = Limits(),
-    thresholds: SingularityThresholds = SingularityThresholds(),
+    limits: SingularityThresholds = MOVE_LIMITS,
+    thresholds: SingularityThresholds = WARN,
     n: int = 161,
 ) -> Move:
     """A valid pose that demonstrates ``kind`` (see :data:`DEMO_KINDS`), the one nearest ``near`` [m].
@@ -115,7 +117,7 @@ def demo_pose(
     if kind == "stroke":
         band = m <= 0.02 * params.stroke
     else:
-        lo = limits.min_cos if kind == "inverse" else limits.min_det
+        lo = limits.inverse if kind == "inverse" else limits.direct
         hi = thresholds.inverse if kind == "inverse" else thresholds.direct
         band = (m >= lo + 0.25 * (hi - lo)) & (m <= lo + 0.6 * (hi - lo))
     if not np.any(band):

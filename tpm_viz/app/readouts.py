@@ -15,25 +15,31 @@ Every number in a :class:`Readout` is finite; what cannot be computed is ``None`
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import NamedTuple, Protocol
 
 import numpy as np
 
 from tpm_viz.app.moves import Pose
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.paper.dynamics import inverse_dynamics
-from tpm_viz.paper.jacobians import SingularityThresholds, jacobians
+from tpm_viz.paper.jacobians import jacobians
 from tpm_viz.paper.kinematics import forward_kinematics_both
+from tpm_viz.paper.status import WARN, SingularityThresholds
 from tpm_viz.params import Params
 
 __all__ = ["LOAD_MODES", "Alert", "Forces", "Load", "Readout", "Reference", "evaluate"]
 
 LOAD_MODES = ("static", "dynamic")
 
-Reference = Callable[..., np.ndarray]
-"""``reference(params, p, dp, ddp, f_ext) -> τ`` [N], working mode; e.g. ``tpm_viz.multibody.inverse_dynamics``."""
+
+class Reference(Protocol):
+    """The reference model's inverse dynamics: ``reference(params, p, dp, ddp, f_ext=None) -> τ`` [N], working mode,
+    for one state (shape (2,)) or arrays of states (shape (n, 2)), e.g. ``tpm_viz.multibody.inverse_dynamics``
+    (the app layer never imports Pinocchio: the UI passes it in)."""
+
+    def __call__(self, params: Params, p, dp, ddp, f_ext=None) -> np.ndarray: ...
+
 
 STROKE_END_TOL = 0.5e-3
 """An actuator within this distance [m] of 0 or ``Δd`` counts as *at* its stroke end."""
@@ -165,7 +171,7 @@ def evaluate(
     pose: Pose,
     load: Load = Load(),
     reference: Reference | None = None,
-    thresholds: SingularityThresholds = SingularityThresholds(),
+    thresholds: SingularityThresholds = WARN,
 ) -> Readout:
     """All displayed quantities at ``pose`` under ``load`` (see the module docstring)."""
     jac = jacobians(params, pose.p, pose.d)

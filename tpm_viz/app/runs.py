@@ -15,15 +15,16 @@ SI units throughout; :meth:`Run.columns` is the CSV export.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from tpm_viz.app.moves import DIRECT, INVERSE, OK, STROKE, UNREACHABLE, Limits, ik_branch, pose_codes
+from tpm_viz.app.moves import ik_branch, pose_codes, why_not
+from tpm_viz.app.readouts import Reference
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.paper.dynamics import inverse_dynamics_detail
 from tpm_viz.paper.spline import CubicSpline
+from tpm_viz.paper.status import MOVE_LIMITS, PoseStatus
 from tpm_viz.paper.trajectories import DEFAULT_DURATIONS, Trajectory, circle_state, line_state
 from tpm_viz.params import Params
 
@@ -33,9 +34,6 @@ RUN_SAMPLES = 401
 """Samples of a run, uniform in time (charts, exports, the Pinocchio forces)."""
 MAX_DURATION = 100.0  # s, the paper's line and circle and the demo segments
 MIN_DURATION = 0.01  # s
-
-Reference = Callable[..., np.ndarray]
-"""``reference(params, p, dp, ddp) -> τ`` [N] for arrays of states, e.g. ``tpm_viz.multibody.inverse_dynamics``."""
 
 
 @dataclass(frozen=True)
@@ -54,7 +52,7 @@ class Source:
 
     @classmethod
     def paper(cls, kind: str, duration: float | None = None) -> Source:
-        """The paper's line (Fig. 4) or circle (Fig. 5); default durations from ``conventions.md``."""
+        """The paper's line (Fig. 4) or circle (Fig. 5); default durations from ``docs/conventions.md``."""
         if kind not in DEFAULT_DURATIONS:
             raise InputError(f"trajectory must be 'line' or 'circle', got {kind!r}")
         duration = _duration(DEFAULT_DURATIONS[kind] if duration is None else duration)
@@ -105,38 +103,19 @@ def _duration(value) -> float:
     return duration
 
 
-def _why(params: Params, code: int, p: np.ndarray, d: np.ndarray) -> str:
-    """Why the sample ``(p, d)`` is not a valid pose (one phrase)."""
-    mm = 1e3
-    if code == UNREACHABLE:
-        return f"out of reach (|p1|, |p2| must stay below l_a = {params.l_a * mm:.1f} mm)"
-    if code == STROKE:
-        i = int(np.argmax(np.maximum(-d, d - params.stroke)))
-        stroke = f"0 to {params.stroke * mm:.0f} mm"
-        return f"actuator {i + 1} would leave its stroke (d{i + 1} = {d[i] * mm:.1f} mm, {stroke})"
-    cos = (p - d + (params.a - params.b)) / params.l_a
-    if code == INVERSE:
-        i = int(np.argmin(np.abs(cos)))
-        return f"leg {i + 1} comes too close to the inverse singularity (cos θ{i + 1} = {cos[i]:.3f}, eq. 11)"
-    if code == DIRECT:
-        det = cos[0] * cos[1] - p[1] * p[0] / params.l_a**2
-        return f"too close to the direct singularity (cos(θ1+θ2) = {det:.3f}, eq. 12)"
-    return "not a valid pose"
-
-
-def check_path(params: Params, t: np.ndarray, p: np.ndarray, what: str = "the trajectory", limits=Limits()) -> None:
+def check_path(params: Params, t: np.ndarray, p: np.ndarray, what: str = "the trajectory", limits=MOVE_LIMITS) -> None:
     """Raise :class:`InputError` at the first sample of ``p`` (``(n, 2)`` [m] at times ``t``) that is not a
     valid working-mode pose in the assembly mode of the first sample."""
     d = ik_branch(params, p, (1.0, 1.0))
-    c = p - d + (params.a - params.b)
+    c = p - d + params.offset
     det0 = c[0, 0] * c[0, 1] - p[0, 0] * p[0, 1]
     mode = 1 if not np.isfinite(det0) or det0 >= 0 else -1
     codes = pose_codes(params, p, d, mode, (1.0, 1.0), limits)
-    bad = np.flatnonzero(codes != OK)
+    bad = np.flatnonzero(codes != PoseStatus.REGULAR)
     if bad.size:
         k = int(bad[0])
         where = f"at t = {t[k]:.3f} s, p = ({p[k, 0] * 1e3:.1f}, {p[k, 1] * 1e3:.1f}) mm"
-        raise InputError(f"{what}: {where}: {_why(params, int(codes[k]), p[k], d[k])}")
+        raise InputError(f"{what}: {where}: {why_not(params, int(codes[k]), p[k], d[k])}")
 
 
 @dataclass(frozen=True)

@@ -18,8 +18,8 @@ from tpm_viz.app.inputs import read_choice, read_number, read_params, read_vec2
 from tpm_viz.app.moves import Move, drag_to, drive_to, switch_mode
 from tpm_viz.app.poses import DEMO_KINDS, demo_pose, home_pose, settle
 from tpm_viz.app.readouts import LOAD_MODES, Load
+from tpm_viz.app.state import AppState, TrajectorySample
 from tpm_viz.params import Params
-from tpm_viz.ui.session import AppState, TrajectorySample
 
 __all__ = [
     "MAX_ACCEL",

@@ -13,7 +13,7 @@ Section 3, steps (a)-(e):
 
 ``v_i`` and ``w_i`` are the printed expressions below eqs. (29) and (31), written with
 ``c_i`` in place of ``p_i - d_i + a - b``; both were re-derived and agree with the paper.
-Mass model (``conventions.md``): sliders ``m_a`` and platform ``m_p`` translate; each
+Mass model (``docs/conventions.md``): sliders ``m_a`` and platform ``m_p`` translate; each
 parallelogram's two links (together ``m_b``) are uniform slender rods, which gives the
 link kinetic energy of eq. (22) read with ``ḋ_i^2`` (the paper prints ``d_i^2``: erratum).
 No gravity (horizontal plane, ``U = 0``), no friction. Forces in N, SI throughout.
@@ -151,7 +151,7 @@ def _inverse_dynamics_one(params: Params, p, dp, ddp, f_ext, d=None) -> np.ndarr
     if d is None:
         c1, c2 = math.sqrt(la2 - p2 * p2), math.sqrt(la2 - p1 * p1)  # eq. (4): c_i = sqrt(l_a² - p_j²)
     else:
-        c1, c2 = p1 - d1 + params.a - params.b, p2 - d2 + params.a - params.b  # c_i = l_a cos θ_i on d's branch
+        c1, c2 = p1 - d1 + params.offset, p2 - d2 + params.offset  # c_i = l_a cos θ_i on d's branch
     _check_regular(params, c1, c2, p1, p2)
     try:
         out = _procedure(params, p1, p2, dp1, dp2, ddp1, ddp2, c1, c2, f1, f2)

@@ -21,6 +21,7 @@ import numpy as np
 
 from tpm_viz.errors import SingularConfigurationError
 from tpm_viz.paper.kinematics import as_xy, finite_result, in_stroke, inverse_kinematics, leg_components, reachable
+from tpm_viz.paper.status import STATUS_LABELS, WARN, PoseStatus, SingularityThresholds
 from tpm_viz.params import Params
 
 __all__ = [
@@ -82,27 +83,8 @@ def condition_number(params: Params, p, d=None) -> np.ndarray:
     return np.where(bad | ~np.isfinite(cond), np.inf, cond)
 
 
-class SingularityThresholds(NamedTuple):
-    """When a pose counts as *near* a singularity (dimensionless, on eqs. 11-12)."""
-
-    inverse: float = 0.2
-    """Near an inverse singularity when ``min_i |cos θ_i|`` is below this."""
-    direct: float = 0.2
-    """Near the direct singularity when ``|cos(θ1 + θ2)|`` is below this."""
-
-
-STATUS_LABELS = {
-    0: "regular",
-    1: "near inverse singularity",
-    2: "near direct singularity",
-    3: "out of stroke",
-    4: "unreachable",
-}
-"""Status codes of :func:`classify`, most severe last."""
-
-
-def classify(params: Params, p, thresholds: SingularityThresholds = SingularityThresholds()) -> np.ndarray:
-    """Status code per pose (see :data:`STATUS_LABELS`); the most severe condition wins.
+def classify(params: Params, p, thresholds: SingularityThresholds = WARN) -> np.ndarray:
+    """Status per pose (values of :class:`~tpm_viz.paper.status.PoseStatus`); the most severe condition wins.
 
     Working-mode inverse kinematics (eq. 4). Non-finite poses count as unreachable.
     """
@@ -112,11 +94,11 @@ def classify(params: Params, p, thresholds: SingularityThresholds = SingularityT
     d = inverse_kinematics(params, safe)
     jac = jacobians(params, safe, d)
     cos = np.stack([jac.jq[..., 0, 0], jac.jq[..., 1, 1]], -1)
-    status = np.zeros(ok.shape, dtype=int)
-    status = np.where(np.min(np.abs(cos), axis=-1) < thresholds.inverse, 1, status)
-    status = np.where(np.abs(jac.det_jx) < thresholds.direct, 2, status)
-    status = np.where(~in_stroke(params, d), 3, status)
-    return np.where(ok, status, 4)
+    status = np.full(ok.shape, PoseStatus.REGULAR, dtype=int)
+    status = np.where(np.min(np.abs(cos), axis=-1) < thresholds.inverse, PoseStatus.NEAR_INVERSE, status)
+    status = np.where(np.abs(jac.det_jx) < thresholds.direct, PoseStatus.NEAR_DIRECT, status)
+    status = np.where(~in_stroke(params, d), PoseStatus.OUT_OF_STROKE, status)
+    return np.where(ok, status, PoseStatus.UNREACHABLE)
 
 
 def _check_regular(jac: Jacobians, which: str) -> None:

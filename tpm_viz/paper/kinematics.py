@@ -3,7 +3,7 @@
 Shapes: a platform position ``p`` and actuator positions ``d`` are arrays of shape
 ``(..., 2)`` in metres; every function broadcasts over the leading axes.
 
-Geometry (eq. 1, ``conventions.md``): ``A_i = (d_i - a) e_i``, ``B_i = P - b e_i`` and
+Geometry (eq. 1, ``docs/conventions.md``): ``A_i = (d_i - a) e_i``, ``B_i = P - b e_i`` and
 ``l_a s_i = B_i - A_i``. Writing ``c_i = p_i - d_i + a - b`` (the ``e_i`` component of
 ``l_a s_i``), leg ``i`` satisfies ``c_i^2 + p_j^2 = l_a^2`` (eq. 27) and the leg angles are
 ``tan θ_i = p_j / c_i`` (eq. 23): ``θ_1`` from ``e_1`` towards ``e_2``, ``θ_2`` from ``e_2``
@@ -18,6 +18,7 @@ from typing import NamedTuple
 import numpy as np
 
 from tpm_viz.errors import InputError, SingularConfigurationError, UnreachablePoseError
+from tpm_viz.paper.status import FK_STATUS, FkStatus
 from tpm_viz.params import Params
 
 __all__ = [
@@ -77,7 +78,7 @@ def _ik_unchecked(params: Params, p: np.ndarray) -> np.ndarray:
     """Eq. (4) without checks: ``d_i = p_i + a - b - sqrt(l_a^2 - p_j^2)``; NaN where unreachable."""
     with np.errstate(invalid="ignore"):
         root = np.sqrt(params.l_a**2 - p[..., ::-1] ** 2)
-    return p + (params.a - params.b) - root
+    return p + params.offset - root
 
 
 def inverse_kinematics(params: Params, p) -> np.ndarray:
@@ -102,7 +103,7 @@ def leg_components(params: Params, p, d) -> tuple[np.ndarray, np.ndarray]:
     """``(c, s)`` with ``c_i = p_i - d_i + a - b = l_a cos θ_i`` and ``s_i = p_j = l_a sin θ_i`` [m]."""
     p = np.asarray(p, dtype=float)
     d = np.asarray(d, dtype=float)
-    return p - d + (params.a - params.b), p[..., ::-1]
+    return p - d + params.offset, p[..., ::-1]
 
 
 def leg_angles(params: Params, p, d=None) -> np.ndarray:
@@ -125,22 +126,13 @@ class FkSolutions(NamedTuple):
     mode: the arc ``p_1² + p_2² = l_a²`` in the third quadrant); ``s_1 = s_2``, the circles
     coincide (``d_1 = d_2 = a - b``, first-quadrant arc) and the position is undetermined.
     ``exists`` is False where the circles do not meet or coincide (positions are NaN there);
-    ``status`` holds a code of :data:`FK_STATUS` per input.
+    ``status`` holds a :class:`~tpm_viz.paper.status.FkStatus` value per input.
     """
 
     plus: np.ndarray
     minus: np.ndarray
     exists: np.ndarray
     status: np.ndarray
-
-
-FK_STATUS = {
-    0: "two assembly modes",
-    1: "direct singularity: the two assembly modes merge (eq. 12)",
-    2: "cannot assemble: the leg circles are more than 2 l_a apart",
-    3: "direct singularity: the leg circles coincide, the platform position is undetermined (eq. 12)",
-}
-"""Codes of :attr:`FkSolutions.status`."""
 
 
 def forward_kinematics_both(params: Params, d) -> FkSolutions:
@@ -155,7 +147,7 @@ def forward_kinematics_both(params: Params, d) -> FkSolutions:
 
 
 def _fk_both(params: Params, d: np.ndarray) -> FkSolutions:
-    k = params.a - params.b
+    k = params.offset
     c1 = np.stack([d[..., 0] - k, np.zeros_like(d[..., 0])], axis=-1)
     c2 = np.stack([np.zeros_like(d[..., 1]), d[..., 1] - k], axis=-1)
     delta = c2 - c1
@@ -175,10 +167,10 @@ def _fk_both(params: Params, d: np.ndarray) -> FkSolutions:
     swap = (det_a < 0)[..., None]
     plus = np.where(swap, cand_b, cand_a)
     minus = np.where(swap, cand_a, cand_b)
-    status = np.where(h <= 1e-9 * params.l_a, 1, 0)
-    status = np.where(half > params.l_a * (1 + 1e-12), 2, status)
-    status = np.where(dist <= 1e-12 * params.l_a, 3, status)
-    return FkSolutions(plus, minus, exists, np.where(np.isfinite(dist), status, 2))
+    status = np.where(h <= 1e-9 * params.l_a, FkStatus.MODES_MERGE, FkStatus.TWO_MODES)
+    status = np.where(half > params.l_a * (1 + 1e-12), FkStatus.APART, status)
+    status = np.where(dist <= 1e-12 * params.l_a, FkStatus.COINCIDE, status)
+    return FkSolutions(plus, minus, exists, np.where(np.isfinite(dist), status, FkStatus.APART))
 
 
 def _cross_s(params: Params, p: np.ndarray, d: np.ndarray) -> np.ndarray:
@@ -191,7 +183,7 @@ def _raise_if_missing(params: Params, d: np.ndarray, sol: FkSolutions) -> None:
     if np.all(sol.exists):
         return
     bad = np.asarray(d)[~sol.exists][0] if np.ndim(sol.exists) else np.asarray(d)
-    k = params.a - params.b
+    k = params.offset
     if abs(float(bad[0]) - k) + abs(float(bad[1]) - k) <= 1e-12 * params.l_a:
         raise SingularConfigurationError(
             f"d1 = d2 = a - b = {k * 1e3:.1f} mm: the two leg circles coincide, the platform position "

@@ -106,7 +106,7 @@ def inverse_singularity_loci(params: Params) -> list[np.ndarray]:
 
 def stroke_limit_loci(params: Params, n: int = 90) -> list[np.ndarray]:
     """Curves ``d_i = 0`` and ``d_i = Δd`` in the platform plane, clipped to ``|p| <= l_a``: ``(m, 2)`` each."""
-    k = params.a - params.b
+    k = params.offset
     pj = np.linspace(-params.l_a, params.l_a, n)
     curves = []
     for i in range(2):

@@ -26,33 +26,24 @@ import warnings
 
 import viser
 
-from tpm_viz.app.access import Access, LoginPanel
+from tpm_viz import multibody
+from tpm_viz.app.access import Access
 from tpm_viz.app.readouts import Reference
+from tpm_viz.app.state import AppState
 from tpm_viz.errors import TpmVizError
 from tpm_viz.params import Params
+from tpm_viz.ui._viser import check_viser, disable_share_url, thread_pool
 from tpm_viz.ui.client import ClientView
 from tpm_viz.ui.guard import guard_executor, guarded, log, report
+from tpm_viz.ui.login import LoginPanel
 from tpm_viz.ui.scene import MechanismScene, camera_pose
-from tpm_viz.ui.session import AppState, Hub
+from tpm_viz.ui.session import Hub
+from tpm_viz.ui.teaching.tabs import Services
 from tpm_viz.ui.transport import harden
 
 __all__ = ["TpmApp", "build_server", "main"]
 
 BRAND = (13, 148, 136)
-
-
-def _no_share_url(*_args, **_kwargs) -> None:
-    """Replacement of ``ViserServer.request_share_url``: the share tunnel stays off."""
-    return None
-
-
-def _reference() -> Reference | None:
-    """The Pinocchio model's inverse dynamics, if :mod:`tpm_viz.multibody.model` can be imported."""
-    try:
-        from tpm_viz import multibody
-    except ImportError:  # pragma: no cover - pinocchio is a declared dependency
-        return None
-    return multibody.inverse_dynamics
 
 
 def is_loopback(host: str) -> bool:
@@ -66,11 +57,15 @@ def is_loopback(host: str) -> bool:
 
 
 def build_server(host: str = "127.0.0.1", port: int = 8080) -> viser.ViserServer:
-    """A quiet viser server: no share tunnel, no environment map or shadows (fast first paint)."""
+    """A quiet viser server: no share tunnel, no environment map or shadows (fast first paint).
+
+    Raises :class:`~tpm_viz.ui._viser.IncompatibleViserError` (one line) if the installed viser is not the tested one.
+    """
+    check_viser()
     with contextlib.redirect_stdout(io.StringIO()):  # viser prints its own banner even with verbose=False
         server = viser.ViserServer(host=host, port=port, label="tpm-viz", verbose=False)
-    server.request_share_url = _no_share_url  # type: ignore[method-assign]
-    guard_executor(server._thread_executor)  # every callback's exception is logged (viser 1.1.1 internals)
+    disable_share_url(server)
+    guard_executor(thread_pool(server))  # every callback's exception is logged
     server.gui.configure_theme(
         control_width="large", show_share_button=False, show_logo=False, brand_color=BRAND, dark_mode=False
     )
@@ -91,15 +86,19 @@ class TpmApp:
         self,
         server: viser.ViserServer,
         params: Params | None = None,
-        reference="auto",
+        reference: Reference | str | None = "auto",
         presenter_token: str | None = None,
     ) -> None:
         self.server = server
         self.access = Access(presenter_token)
         state = AppState.initial(params)
         shared_scene = MechanismScene(server.scene, state.params, sink=server)  # drawn once for every tab
-        self.hub = Hub(state, _reference() if reference == "auto" else reference, self.access, shared_scene)
+        self.hub = Hub(
+            state, multibody.inverse_dynamics if reference == "auto" else reference, self.access, shared_scene
+        )
         self.hub.evaluate(self.hub.shared.state)  # warm-up: builds the Pinocchio model once
+        self.services = Services.create(self.hub)
+        """The worker, floor maps and trajectory runs every tab of this app shares."""
         self.views: dict[int, ClientView] = {}
         self._views_lock = threading.Lock()
         position, look_at = camera_pose(self.hub.shared.state.params)
@@ -117,7 +116,7 @@ class TpmApp:
     @guarded
     def _connect(self, client: viser.ClientHandle) -> None:
         harden(client)  # malformed GUI updates and oversized uploads are dropped before viser sees them
-        view = ClientView(client, self.hub)
+        view = ClientView(client, self.hub, self.services)
         if self.access.enabled:
             view.login = LoginPanel(client.gui, lambda event, view=view: self._login(event, view))
         with self._views_lock:
@@ -165,8 +164,9 @@ class TpmApp:
             view.set_class_info(text)
 
     def stop(self) -> None:
-        """Stop the server (the port is free again at once)."""
+        """Stop the server (the port is free again at once) and the app's drag threads."""
         self.server.stop()
+        self.hub.drag_pool.shutdown(wait=False, cancel_futures=True)
 
 
 def _log_to_stderr() -> None:

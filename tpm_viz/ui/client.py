@@ -13,9 +13,7 @@ from __future__ import annotations
 
 import asyncio
 import functools
-import itertools
 import time
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import viser
@@ -23,15 +21,17 @@ import viser
 from tpm_viz import meshes
 from tpm_viz.app import transitions
 from tpm_viz.app.poses import DEMO_KINDS
+from tpm_viz.app.state import AppState
 from tpm_viz.errors import TpmVizError
 from tpm_viz.params import Params
+from tpm_viz.ui.drags import PendingDrag
 from tpm_viz.ui.guard import guarded
 from tpm_viz.ui.panels import Panel
 from tpm_viz.ui.scene import camera_pose
-from tpm_viz.ui.session import AppState, Hub, Session
-from tpm_viz.ui.snapshot import Frame
+from tpm_viz.ui.session import Hub, Session
+from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.tabscene import TabScene
-from tpm_viz.ui.teaching.tabs import Teaching
+from tpm_viz.ui.teaching.tabs import Services, Teaching
 
 __all__ = ["ClientView"]
 
@@ -44,12 +44,8 @@ def _size(params: Params) -> float:
     return hi - lo
 
 
-_ARRIVALS = itertools.count()  # gizmo events in arrival order (they arrive on the event loop, one at a time)
 INLINE_DRAG_VIEWS = 4
 """A drag of a session shown by at most this many tabs is applied on the event loop itself (bench_load.py)."""
-_DRAGS = ThreadPoolExecutor(max_workers=2, thread_name_prefix="tpm-viz-drag")
-"""Where gizmo updates are applied: two threads (they serialise on the hub's lock anyway); a plain executor, not
-``loop.run_in_executor``, so that finishing a drag does not wake the event loop once more."""
 SHARED_DRAG_INTERVAL = 0.025
 """Drags of a session shown by more than :data:`INLINE_DRAG_VIEWS` tabs are committed at most once per this many
 seconds (40 Hz; latest value wins in between), however many students pull the shared platform at once: one
@@ -87,18 +83,16 @@ def _callback(method):
 class ClientView:
     """The scene, panel and callbacks of one connected browser tab."""
 
-    def __init__(self, client: viser.ClientHandle, hub: Hub) -> None:
+    def __init__(self, client: viser.ClientHandle, hub: Hub, services: Services) -> None:
         self.client = client
         self.hub = hub
         self.closed = False
-        self._pending_drags: list[tuple[str, np.ndarray]] = []
-        self._last_arrival = -1  # arrival number of this tab's latest gizmo event
         self._notified: tuple[str, float] = ("", 0.0)
         self._drawn_at = -1.0  # time.monotonic() of this tab's last render
         with hub.lock:
             state = hub.shared.state
             self.scene = TabScene(client, hub.shared.scene)
-            self.teaching = Teaching(self)  # player, explorer, demonstrations (ui/teaching.py)
+            self.teaching = Teaching(self, services)  # player, explorer, lessons (ui/teaching/)
             self.panel = Panel(client.gui, state, extra_tabs=self.teaching.build_tabs)
             self._wire()
             self.frame_camera(state.params)
@@ -106,7 +100,7 @@ class ClientView:
             self.teaching.attach()
 
     # -- drawing -------------------------------------------------------------------------------------------
-    def render(self, frame: Frame, *, dragging: bool = False) -> None:
+    def render(self, frame: Snapshot, *, dragging: bool = False) -> None:
         """Draw this tab's part of ``frame`` (called by the hub under its lock, after the session's mechanism) and
         flush at once; another tab's intermediate frames at most every :data:`WATCH_INTERVAL`."""
         if self.closed:
@@ -191,21 +185,24 @@ class ClientView:
         """Gizmo events, in arrival order on the event loop: keep a snapshot, then apply the latest one, here if
         the hub is free and few tabs show this session (a private copy: no thread hop), else in the pool, at most
         every :data:`SHARED_DRAG_INTERVAL` for a session shown by many tabs."""
-        self._pending_drags.append((event.phase, np.array(event.target.position, dtype=float)))
-        self._last_arrival = next(_ARRIVALS)
+        drag = PendingDrag(event.phase, np.array(event.target.position, dtype=float), next(self.hub.arrivals))
         session = getattr(self, "session", None)  # None while this tab is still being built (under the lock)
-        if session is not None and len(session.views) <= INLINE_DRAG_VIEWS:
+        if session is None:
+            self.hub.drag_pool.submit(self._drag_after_build, drag)  # waits for the lock the build holds
+            return
+        session.drags.push(self, drag)
+        if len(session.views) <= INLINE_DRAG_VIEWS:
             if self.hub.lock.acquire(blocking=False):
                 try:
                     self._drain_drags()  # ~1 ms, never blocks (the lock is ours, pushes and flushes are queued)
                 finally:
                     self.hub.lock.release()
                 return
-        elif session is not None and self.hub.access.may_change(self, session):
-            if session.drain_scheduled:
+        elif self.hub.access.may_change(self, session):
+            if session.drags.scheduled:
                 return  # the scheduled drain takes this drag (latest value wins)
-            session.drain_scheduled = True
-            delay = session.next_drag_at - time.monotonic()
+            session.drags.scheduled = True
+            delay = session.drags.next_at - time.monotonic()
             if delay > 0:
                 asyncio.get_running_loop().call_later(delay, self._submit_drain)
                 return
@@ -213,7 +210,7 @@ class ClientView:
 
     def _submit_drain(self) -> None:
         try:
-            _DRAGS.submit(self._drain_drags)  # guarded: its errors are logged, never lost in a future
+            self.hub.drag_pool.submit(self._drain_drags)  # guarded: its errors are logged, never lost in a future
         except RuntimeError:  # the interpreter is shutting down
             return
 
@@ -226,33 +223,46 @@ class ClientView:
         commit per round, not 30)."""
         with self.hub.lock:
             session = self.session
-            session.drain_scheduled = False  # first: a drag that arrives from now on schedules the next drain,
-            session.next_drag_at = time.monotonic() + SHARED_DRAG_INTERVAL  # not before this
-            if self.closed or not self._pending_drags:
-                other = next((v for v in session.views if v is not self and getattr(v, "_pending_drags", None)), None)
-                if other is not None and not other.closed:
-                    other._drain_drags()  # this tab left (or was merged) with the session's drain: hand it on
+            queue = session.drags
+            queue.scheduled = False  # first: a drag that arrives from now on schedules the next drain,
+            queue.next_at = time.monotonic() + SHARED_DRAG_INTERVAL  # not before this
+            take = None if self.closed else queue.take(self, lambda view: self.hub.access.may_change(view, session))
+            if take is None:
+                queue.drop(self)
+                for other in queue.waiting():  # this tab left (or was merged) with the session's drain: hand it on
+                    if not other.closed:
+                        other.drain_drags()
+                        break
                 return
-            mover, latest, arrival = self, self._pending_drags[-1], self._last_arrival
-            ended = any(entry[0] == "end" for entry in self._pending_drags)
-            self._pending_drags.clear()
-            if self.hub.access.may_change(self, session):
-                for view in session.views:
-                    pending = getattr(view, "_pending_drags", None)
-                    if view is self or not pending or view.closed or not self.hub.access.may_change(view, view.session):
-                        continue
-                    if any(entry[0] == "end" for entry in pending):
-                        view.scene.forget()  # its drag ended: its gizmo is written back by this commit
-                    if view._last_arrival > arrival:
-                        mover, latest, arrival = view, pending[-1], view._last_arrival
-                    pending.clear()
-            if ended and mover is not self:
-                self.scene.forget()
-            phase, position = latest
+            for view in take.ended:
+                view.drag_ended()  # its drag ended: its gizmo is written back by this commit
+            mover, latest = take.mover, take.latest
             try:
-                mover._commit(transitions.drag(mover.session.state, position), dragging=phase != "end")
+                mover.commit_drag(latest.phase, latest.position)
             except TpmVizError as exc:  # the gizmo goes back to the last good pose when the drag ends
-                mover.refuse(str(exc), resync=phase == "end")
+                mover.refuse(str(exc), resync=latest.phase == "end")
+
+    @guarded(on_error=_internal_error)
+    def _drag_after_build(self, drag: PendingDrag) -> None:
+        with self.hub.lock:
+            self.session.drags.push(self, drag)
+            self._drain_drags()
+
+    def drain_drags(self) -> None:
+        """Commit the session's pending drags (called by a tab that leaves with the session's drain)."""
+        self._drain_drags()
+
+    def commit_drag(self, phase: str, position: np.ndarray) -> None:
+        """Commit this tab's drag to ``position`` [m] (under the hub's lock)."""
+        self._commit(transitions.drag(self.session.state, position), dragging=phase != "end")
+
+    def drag_ended(self) -> None:
+        """This tab's drag ended inside another tab's commit: its gizmo is written back by that commit."""
+        self.scene.forget()
+
+    def run_changed(self) -> None:
+        """The session's run changed: redraw this tab's player."""
+        self.teaching.player.refresh()
 
     @_callback
     def _on_p(self, event) -> None:

@@ -12,9 +12,9 @@ import viser
 
 from tpm_viz.app.poses import DEMO_KINDS
 from tpm_viz.app.readouts import LOAD_MODES
+from tpm_viz.app.state import AppState
 from tpm_viz.params import PARAM_INFO, Params
-from tpm_viz.ui.session import AppState
-from tpm_viz.ui.snapshot import Frame
+from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.text import legend_html
 
 __all__ = ["PARAM_LABELS", "Panel"]
@@ -108,9 +108,9 @@ class Panel:
             self.class_info = gui.add_markdown("")
             self.show_toggles = {k: gui.add_checkbox(label, True) for k, label in SHOW_LABELS.items()}
             gui.add_html(legend_html())
-            self.frame_camera = gui.add_button("Frame the mechanism", icon=viser.Icon.FOCUS_CENTERED)
+            self.frame_camera = gui.add_button("Snapshot the mechanism", icon=viser.Icon.FOCUS_CENTERED)
 
-    def show(self, frame: Frame) -> None:
+    def show(self, frame: Snapshot) -> None:
         """Write every value of the frame's state and readout into the widgets (viser skips unchanged ones)."""
         state, readout = frame.state, frame.readout
         now = time.monotonic()

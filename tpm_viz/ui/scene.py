@@ -18,10 +18,10 @@ import viser
 from tpm_viz import meshes
 from tpm_viz.app.overlays import cached_map
 from tpm_viz.app.readouts import Readout
+from tpm_viz.app.state import AppState
 from tpm_viz.paper.workspace import direct_singularity_locus, inverse_singularity_loci
 from tpm_viz.params import Params
-from tpm_viz.ui.session import AppState
-from tpm_viz.ui.snapshot import Frame
+from tpm_viz.ui.snapshot import Snapshot
 
 __all__ = ["COLORS", "FAMILIES", "FORCE_SCALE", "GIZMO_Z", "MechanismScene", "camera_pose"]
 
@@ -86,7 +86,7 @@ class MechanismScene:
         self._sink = sink
         self._flush = flush
         self._sent: dict[str, object] = {}
-        self._drawn = None  # the Frame last drawn (a frame is drawn once, whoever asks)
+        self._drawn = None  # the Snapshot last drawn (a frame is drawn once, whoever asks)
         self.params: Params | None = None
         self.show = dict.fromkeys((*FAMILIES, "region"), True)
         self.slider_bodies: list = [None, None]
@@ -285,7 +285,7 @@ class MechanismScene:
             del self._sent[key]  # re-evaluated at the next update
         self._drawn = None
 
-    def update(self, frame: Frame) -> None:
+    def update(self, frame: Snapshot) -> None:
         """Move every part to the frame's pose and recolour it from its alerts (nothing if ``frame`` is drawn)."""
         if frame is self._drawn:
             return
@@ -298,7 +298,7 @@ class MechanismScene:
                 self._sink.flush()
         self._drawn = frame
 
-    def _update(self, frame: Frame) -> None:
+    def _update(self, frame: Snapshot) -> None:
         state, readout = frame.state, frame.readout
         params = state.params
         if params != self.params:

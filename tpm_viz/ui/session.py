@@ -17,60 +17,24 @@ every tab receives; for a private copy its tab's own drawing), then each view dr
 
 from __future__ import annotations
 
-import dataclasses
+import itertools
 import threading
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from typing import Protocol
+from concurrent.futures import ThreadPoolExecutor
+from typing import Any, Protocol
 
 import numpy as np
 
 from tpm_viz.app.access import Access
 from tpm_viz.app.inputs import read_number, read_vec2
-from tpm_viz.app.moves import Pose
-from tpm_viz.app.poses import home_pose
-from tpm_viz.app.readouts import Load, Readout, Reference, evaluate
+from tpm_viz.app.readouts import Readout, Reference, evaluate
+from tpm_viz.app.state import AppState
 from tpm_viz.errors import InputError
-from tpm_viz.params import Params
+from tpm_viz.ui.drags import DragQueue
 from tpm_viz.ui.guard import report
+from tpm_viz.ui.snapshot import Snapshot
 
-__all__ = ["TRAJECTORY_KINDS", "AppState", "Hub", "Session", "View", "read_number", "read_vec2"]
-
-
-TRAJECTORY_KINDS = ("none", "line", "circle")
-"""Trajectory sample that drives the platform: none, the paper's line (Fig. 4) or circle (Fig. 5)."""
-
-
-@dataclass(frozen=True)
-class TrajectorySample:
-    """Which trajectory sample drives the platform: ``kind``, duration ``T`` [s] and time ``t`` [s]."""
-
-    kind: str = "none"
-    duration: float = 0.2
-    t: float = 0.0
-
-
-@dataclass(frozen=True)
-class AppState:
-    """Everything a view draws (SI units). Replaced, never mutated."""
-
-    params: Params
-    pose: Pose
-    load: Load = field(default_factory=Load)
-    trajectory: TrajectorySample = field(default_factory=TrajectorySample)
-    note: str = ""
-    """Why the last move stopped short (shown to every viewer of the session), or empty."""
-    version: int = 0
-
-    @classmethod
-    def initial(cls, params: Params | None = None) -> AppState:
-        """The paper's prototype at its home pose (``p = 0``), static mode, no load."""
-        params = Params.paper() if params is None else params
-        return cls(params=params, pose=home_pose(params))
-
-    def replace(self, **changes) -> AppState:
-        """A copy with some fields changed and the version bumped."""
-        return dataclasses.replace(self, version=self.version + 1, **changes)
+__all__ = ["AppState", "Hub", "Session", "View", "read_number", "read_vec2"]
 
 
 class Drawing(Protocol):
@@ -81,11 +45,26 @@ class Drawing(Protocol):
 
 
 class View(Protocol):
-    """What a session needs from a browser tab."""
+    """What the hub, the runs and the teaching tabs use of a browser tab (:class:`~tpm_viz.ui.client.ClientView`):
+    the typed context of every sub-view. Nothing reaches into a view's private fields."""
 
-    def render(self, frame, *, dragging: bool) -> None:
-        """Draw ``frame`` (a :class:`~tpm_viz.ui.snapshot.Frame`); ``dragging`` is True while this tab's own gizmo
-        is being dragged."""
+    closed: bool
+    hub: Hub
+    session: Session
+    client: Any
+    """The tab's ``viser.ClientHandle`` (its own scene, GUI, downloads)."""
+
+    def render(self, frame: Snapshot, *, dragging: bool) -> None:
+        """Draw ``frame``; ``dragging`` is True while this tab's own gizmo is being dragged."""
+
+    def refuse(self, text: str, resync: bool = True) -> None:
+        """Tell this tab (only) that its input was refused, and why."""
+
+    def run_changed(self) -> None:
+        """The session's trajectory run changed (loaded, playing, paused): redraw the player."""
+
+    def drag_ended(self) -> None:
+        """This tab's drag was merged into another tab's commit and has ended: write its gizmo back."""
 
 
 class Session:
@@ -97,10 +76,10 @@ class Session:
         self.scene = scene
         """Where the mechanism is drawn once per commit, or None (each view draws it)."""
         self.views: list[View] = []
-        self.frame = None  # the Frame last drawn (tpm_viz.ui.snapshot), None until the first draw
+        self.frame = None  # the Snapshot last drawn (tpm_viz.ui.snapshot), None until the first draw
         self.play_token = 0  # a playing trajectory stops when this changes
-        self.drain_scheduled = False  # a drag commit is scheduled (ui/client.py: latest value wins)
-        self.next_drag_at = 0.0  # time.monotonic() before which no further drag is committed
+        self.drags = DragQueue()
+        """Gizmo drags waiting to be committed (latest value wins across the tabs, :mod:`.drags`)."""
 
     @property
     def readout(self) -> Readout | None:
@@ -124,6 +103,11 @@ class Hub:
         self.access = access if access is not None else Access()
         """Who may commit to the shared session (everybody unless a presenter token is set)."""
         self.on_membership: Callable[[], None] | None = None
+        self.arrivals = itertools.count()
+        """Numbers gizmo events in arrival order (they arrive on the event loop, one at a time)."""
+        self.drag_pool = ThreadPoolExecutor(max_workers=2, thread_name_prefix="tpm-viz-drag")
+        """Where drags of a session shown by many tabs are committed: two threads (they serialise on the lock); a
+        plain executor, not ``loop.run_in_executor``, so that finishing a drag does not wake the event loop."""
 
     def evaluate(self, state: AppState, live: bool = False) -> Readout:
         """All numbers for ``state``: closed form and reference (Pinocchio) forces. ``live`` (an intermediate frame
@@ -132,11 +116,9 @@ class Hub:
         return evaluate(state.params, state.pose, state.load, None if live else self.reference)
 
     def frame(self, state: AppState, dragging: bool = False):
-        """The :class:`~tpm_viz.ui.snapshot.Frame` of ``state`` with the data every view draws, computed and checked
+        """The :class:`~tpm_viz.ui.snapshot.Snapshot` of ``state`` with the data every view draws, computed and checked
         before anything changes: raises :class:`~tpm_viz.InputError` if a drawn number is not finite."""
-        from tpm_viz.ui.snapshot import Frame
-
-        frame = Frame(state, self.evaluate(state, live=dragging), in_drag=dragging)
+        frame = Snapshot(state, self.evaluate(state, live=dragging), in_drag=dragging)
         if dragging and self.reference is not None:
             frame.complete_readout = lambda: self.evaluate(state)  # both models, computed when displayed
         positions, wxyzs = frame.links
@@ -169,6 +151,7 @@ class Hub:
         with self.lock:
             if view in session.views:
                 session.views.remove(view)
+            session.drags.drop(view)
         self.membership_changed()
 
     def commit(self, session: Session, state: AppState, origin: View | None = None, dragging: bool = False) -> None:

@@ -15,17 +15,17 @@ import numpy as np
 from tpm_viz import meshes
 from tpm_viz.app.equations import ERRATA_HTML, procedure_html
 from tpm_viz.app.readouts import Readout
+from tpm_viz.app.state import AppState
 from tpm_viz.errors import TpmVizError
 from tpm_viz.paper.dynamics import inverse_dynamics_detail
 from tpm_viz.paper.jacobians import jacobians
 from tpm_viz.paper.kinematics import MechanismPose, mechanism_pose
-from tpm_viz.ui.session import AppState
 from tpm_viz.ui.text import dashboard_html
 
-__all__ = ["Frame"]
+__all__ = ["Snapshot"]
 
 
-class Frame:
+class Snapshot:
     """``state`` and its ``readout``; derived drawing data are cached properties."""
 
     def __init__(self, state: AppState, readout: Readout, in_drag: bool = False) -> None:

@@ -20,22 +20,14 @@ import numpy as np
 import viser
 
 from tpm_viz.params import Params
+from tpm_viz.ui._viser import drop_gizmo_echo
 from tpm_viz.ui.scene import FAMILIES, GIZMO_Z, MechanismScene
-from tpm_viz.ui.snapshot import Frame
+from tpm_viz.ui.snapshot import Snapshot
 
 __all__ = ["PRIVATE_ROOT", "TabScene"]
 
 PRIVATE_ROOT = "/own"
 """Where a tab draws its private copy (its own scope)."""
-
-
-def _no_echo(gizmo) -> None:
-    """Drop viser's cross-client echo of this gizmo's drags: for a client-scoped gizmo it queues two messages per
-    drag event that are addressed to every client but this one, i.e. to nobody (viser 1.1.1 internals; ~5 % of
-    the server's CPU with 30 tabs dragging, benchmarks/bench_load.py). Harmless if viser changes."""
-    aux = getattr(gizmo, "_impl_aux", None)
-    if aux is not None and hasattr(aux, "sync_cb"):
-        aux.sync_cb = None
 
 
 class TabScene:
@@ -60,7 +52,7 @@ class TabScene:
             depth_test=False,
             position=(0.0, 0.0, GIZMO_Z),
         )
-        _no_echo(self.gizmo)
+        drop_gizmo_echo(self.gizmo)
 
     @property
     def mechanism(self) -> MechanismScene:
@@ -138,7 +130,7 @@ class TabScene:
             self._shadows[name] = self._api.add_frame(name, show_axes=False, visible=False)
 
     # -- per frame -----------------------------------------------------------------------------------------
-    def update(self, frame: Frame, dragging: bool = False) -> None:
+    def update(self, frame: Snapshot, dragging: bool = False) -> None:
         """Put the gizmo on the platform, unless this tab is dragging it (the browser moves it itself)."""
         if dragging:
             self._gizmo_at = None  # written again once the drag is over

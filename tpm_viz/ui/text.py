@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from tpm_viz.app.readouts import Readout
-from tpm_viz.ui.session import AppState
+from tpm_viz.app.state import AppState
 
 __all__ = ["COLORS_CSS", "banner_level", "dashboard_html", "force_scale", "legend_html", "num"]
 

@@ -12,8 +12,7 @@ files no larger than the user picked. A hand-written client can send anything, a
 like viser casts it, into finite numbers, else it is dropped with one warning line (at most one per second per
 tab); an upload larger than :data:`~.validate.MAX_UPLOAD_BYTES` is refused before any byte is buffered, and a
 transfer that sends more than it declared is dropped. What passes still goes through the callbacks' own
-validation (:mod:`.validate`). Uses viser internals (``client._websock_connection``, ``gui._handle_*``);
-``tests/test_security.py`` pins them.
+validation (:mod:`tpm_viz.app.inputs`). viser's internals are reached through :class:`~._viser.ClientDoor`.
 """
 
 from __future__ import annotations
@@ -25,11 +24,10 @@ import time
 import viser
 
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES
+from tpm_viz.ui._viser import ClientDoor, widget_value
 from tpm_viz.ui.guard import log
 
 __all__ = ["harden", "update_problem"]
-
-_messages = viser._messages
 
 
 def update_problem(current, updates) -> str | None:
@@ -70,21 +68,17 @@ class _Warner:
 
 def harden(client: viser.ClientHandle, max_upload_bytes: int = MAX_UPLOAD_BYTES) -> None:
     """Install the filters of the module docstring on ``client``'s connection (call once, on connect)."""
-    conn, gui = client._websock_connection, client.gui
+    door = ClientDoor(client)
     warn = _Warner(client.client_id)
-    gui_handler = gui._handle_gui_updates
-    start_handler, part_handler = gui._handle_file_transfer_start, gui._handle_file_transfer_part
-    transfers = gui._current_file_upload_states
-    handles = gui._gui_input_handle_from_uuid
 
     async def gui_update(client_id, message) -> None:
-        handle = handles.get(message.uuid)
+        handle = door.widget(message.uuid)
         if handle is not None:
-            problem = update_problem(handle._impl.value, message.updates)
+            problem = update_problem(widget_value(handle), message.updates)
             if problem is not None:
                 warn(f"GUI update dropped: {problem}")
                 return
-        await gui_handler(client_id, message)
+        await door.gui_update(client_id, message)
 
     def refuse_upload(text: str) -> None:
         warn(f"upload refused: {text}")
@@ -96,20 +90,14 @@ def harden(client: viser.ClientHandle, max_upload_bytes: int = MAX_UPLOAD_BYTES)
         if not (0 <= size <= max_upload_bytes and 0 <= parts <= max(1, size)):
             refuse_upload(f"the file is too large ({size} bytes; at most {max_upload_bytes} bytes)")
             return
-        start_handler(client_id, message)
+        door.upload_start(client_id, message)
 
     def upload_part(client_id, message) -> None:
-        state = transfers.get(message.transfer_uuid)
+        state = door.upload_state(message.transfer_uuid)
         if state is not None and state["transferred_bytes"] + len(message.content) > state["total_bytes"]:
-            transfers.pop(message.transfer_uuid, None)
+            door.drop_upload(message.transfer_uuid)
             refuse_upload("the file sent more bytes than it announced")
             return
-        part_handler(client_id, message)
+        door.upload_part(client_id, message)
 
-    for message_type, old, new in (
-        (_messages.GuiUpdateMessage, gui_handler, gui_update),
-        (_messages.FileTransferStartUpload, start_handler, upload_start),
-        (_messages.FileTransferPart, part_handler, upload_part),
-    ):
-        conn.unregister_handler(message_type, old)
-        conn.register_handler(message_type, new)
+    door.replace(gui_update, upload_start, upload_part)

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import html
 import threading
+import time
 import weakref
 from collections import OrderedDict
 
@@ -25,7 +26,7 @@ from tpm_viz import meshes
 from tpm_viz.app.overlays import MAP_KINDS, cached_map, colour_scale, ellipse_polylines, map_rgba
 from tpm_viz.params import Params
 from tpm_viz.ui.guard import guarded
-from tpm_viz.ui.snapshot import Frame
+from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.text import num
 from tpm_viz.ui.worker import Worker
 
@@ -73,8 +74,6 @@ class MapService:
             return self._failed.get(params)
 
     def _compute(self, params: Params) -> dict[str, np.ndarray]:
-        import time
-
         t0 = time.perf_counter()
         ws = cached_map(params, MAP_N)
         images = {kind: map_rgba(ws, kind) for kind in MAP_KINDS if kind != "off"}
@@ -131,7 +130,7 @@ class ExplorerView:
         self._image_key = None
         self._map_drawn = None  # (params, kind) the legend and floor last showed: nothing to send while unchanged
         self._ellipses: dict[str, object] = {}
-        self._frame: Frame | None = None
+        self._frame: Snapshot | None = None
         maps.subscribers.add(self)
 
     def build(self, gui: viser.GuiApi) -> None:
@@ -189,7 +188,7 @@ class ExplorerView:
                 self._draw_map(params)
                 self.view.client.flush()
 
-    def render(self, frame: Frame) -> None:
+    def render(self, frame: Snapshot) -> None:
         """Draw the explorer's part of ``frame`` (under the hub's lock)."""
         self._frame = frame
         self._draw_map(frame.state.params)
@@ -235,7 +234,7 @@ class ExplorerView:
         )
         self._image_key = (params, kind)
 
-    def _draw_ellipses(self, frame: Frame) -> None:
+    def _draw_ellipses(self, frame: Snapshot) -> None:
         state = frame.state
         drawing = None
         if self.ellipses_on:
@@ -266,7 +265,7 @@ class ExplorerView:
                     handle.visible = True
         self.readout.content = self._readout_html(frame, drawing)
 
-    def _readout_html(self, frame: Frame, drawing) -> str:
+    def _readout_html(self, frame: Snapshot, drawing) -> str:
         if not self.ellipses_on:
             return ""
         r = frame.readout

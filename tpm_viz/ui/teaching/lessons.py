@@ -10,16 +10,19 @@ hub's lock, and shown under the paragraph.
 from __future__ import annotations
 
 import html
+from collections.abc import Callable
 
 import numpy as np
 import viser
 
 from tpm_viz.app.lessons import DEMOS, Demo, demo_params, demo_pose, demo_source, effect
 from tpm_viz.app.readouts import Load
+from tpm_viz.app.state import TrajectorySample
 from tpm_viz.errors import TpmVizError
 from tpm_viz.ui.guard import guarded
-from tpm_viz.ui.session import TrajectorySample
-from tpm_viz.ui.snapshot import Frame
+from tpm_viz.ui.session import View
+from tpm_viz.ui.snapshot import Snapshot
+from tpm_viz.ui.teaching.explorer import ExplorerView
 from tpm_viz.ui.teaching.playing import RunHub
 
 __all__ = ["DemosView"]
@@ -55,8 +58,10 @@ def demo_html(demo: Demo, facts: str) -> str:
 class DemosView:
     """Demonstration widgets of one tab."""
 
-    def __init__(self, view, runs: RunHub, explorer) -> None:
+    def __init__(self, view: View, runs: RunHub, explorer: ExplorerView, speed: Callable[[], float]) -> None:
         self.view = view
+        self._speed = speed
+        """The player's playback speed (x real time): *Play the motion* plays at it."""
         self.runs = runs
         self.explorer = explorer
         self.index = 0
@@ -102,7 +107,7 @@ class DemosView:
         if not self._user(event):
             return
         try:
-            self.runs.play(self.view.session, self.view.teaching.player.speed_value(), origin=self.view)
+            self.runs.play(self.view.session, self._speed(), origin=self.view)
         except TpmVizError as exc:
             self._refuse(exc)
 
@@ -151,5 +156,5 @@ class DemosView:
             except TpmVizError as exc:
                 self._refuse(exc)
 
-    def render(self, frame: Frame) -> None:
+    def render(self, frame: Snapshot) -> None:
         """Nothing per frame: the paragraph changes only when a demonstration is applied."""

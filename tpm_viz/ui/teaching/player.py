@@ -19,9 +19,10 @@ from tpm_viz.app.inputs import MAX_UPLOAD_BYTES, read_number, read_upload
 from tpm_viz.app.runs import Source
 from tpm_viz.csvio import format_columns
 from tpm_viz.errors import InputError, TpmVizError
+from tpm_viz.figures import force_plot_png
 from tpm_viz.paper.trajectories import DEFAULT_DURATIONS
 from tpm_viz.ui.guard import guarded
-from tpm_viz.ui.snapshot import Frame
+from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.teaching.charts import Charts
 from tpm_viz.ui.teaching.player_text import summary_html
 from tpm_viz.ui.teaching.playing import RunHub, following
@@ -61,7 +62,7 @@ class PlayerView:
         self._pushes = 0
         self._shown_t = _UNSET
         self.trace = PathTrace(view.client.scene)
-        self._frame: Frame | None = None
+        self._frame: Snapshot | None = None
 
     def build(self, gui: viser.GuiApi) -> None:
         """The *Player* tab's widgets (inside the tab's context)."""
@@ -138,7 +139,7 @@ class PlayerView:
 
     def _choose(self, new_kind: bool) -> None:
         """Load the chosen trajectory: a newly chosen paper trajectory with its default duration
-        (``conventions.md``: line 0.2 s, circle 0.5 s), a typed duration otherwise."""
+        (``docs/conventions.md``: line 0.2 s, circle 0.5 s), a typed duration otherwise."""
         with self.view.hub.lock:
             if self._is_echo(self.choice, self.duration):
                 return
@@ -216,8 +217,6 @@ class PlayerView:
     @guarded(on_error=_internal_error)
     def _on_export_png(self, event) -> None:
         def export() -> None:
-            from tpm_viz.figures import force_plot_png
-
             run = self._run_or_refuse()
             png = force_plot_png(run.t, run.tau, run.tau_ref, title=f"Actuator forces: {run.source.label}")
             self._download(f"tpm-forces-{run.source.kind}-T{run.duration:g}s.png", png)
@@ -232,7 +231,7 @@ class PlayerView:
             self.render(session.frame, force=True)
             self.view.client.flush()
 
-    def render(self, frame: Frame, force: bool = False) -> None:
+    def render(self, frame: Snapshot, force: bool = False) -> None:
         """Draw the player's part of ``frame`` (under the hub's lock); throttled while playing."""
         self._frame = frame
         session = self.session

@@ -23,8 +23,9 @@ from dataclasses import dataclass
 from tpm_viz.app.moves import place
 from tpm_viz.app.readouts import Load
 from tpm_viz.app.runs import Run, Source, build_run
+from tpm_viz.app.state import AppState, TrajectorySample
 from tpm_viz.errors import InputError, TpmVizError
-from tpm_viz.ui.session import AppState, Hub, Session, TrajectorySample
+from tpm_viz.ui.session import Hub, Session
 from tpm_viz.ui.worker import Worker
 
 __all__ = ["FPS", "PlayerSession", "RunHub", "following", "sampled"]
@@ -255,6 +256,4 @@ class RunHub:
     def _refresh(self, session: Session) -> None:
         """Redraw the player panel of every view of ``session`` (status, buttons, charts)."""
         for view in list(session.views):
-            teaching = getattr(view, "teaching", None)
-            if teaching is not None:
-                teaching.player.refresh()
+            view.run_changed()

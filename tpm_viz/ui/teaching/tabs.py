@@ -8,21 +8,19 @@ lock) and :meth:`Teaching.close`; :meth:`Teaching.switched` when the tab moves t
 
 from __future__ import annotations
 
-import threading
-import weakref
 from dataclasses import dataclass
 
 import viser
 
-from tpm_viz.ui.session import Hub, Session
-from tpm_viz.ui.snapshot import Frame
+from tpm_viz.ui.session import Hub, Session, View
+from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.teaching.explorer import ExplorerView, MapService
 from tpm_viz.ui.teaching.lessons import DemosView
 from tpm_viz.ui.teaching.player import PlayerView
 from tpm_viz.ui.teaching.playing import RunHub
 from tpm_viz.ui.worker import Worker
 
-__all__ = ["Services", "Teaching", "services_for"]
+__all__ = ["Services", "Teaching"]
 
 
 @dataclass
@@ -33,30 +31,22 @@ class Services:
     maps: MapService
     runs: RunHub
 
-
-_SERVICES: weakref.WeakKeyDictionary[Hub, Services] = weakref.WeakKeyDictionary()
-_SERVICES_LOCK = threading.Lock()
-
-
-def services_for(hub: Hub) -> Services:
-    """The services of ``hub`` (created at first use)."""
-    with _SERVICES_LOCK:
-        services = _SERVICES.get(hub)
-        if services is None:
-            worker = Worker()
-            services = _SERVICES[hub] = Services(worker, MapService(worker), RunHub(hub, worker))
-        return services
+    @classmethod
+    def create(cls, hub: Hub) -> Services:
+        """The services of ``hub``: one worker thread for slow computations, the floor maps, the runs."""
+        worker = Worker()
+        return cls(worker, MapService(worker), RunHub(hub, worker))
 
 
 class Teaching:
     """Player, explorer and demonstrations of one tab (``view`` is its :class:`~.client.ClientView`)."""
 
-    def __init__(self, view) -> None:
+    def __init__(self, view: View, services: Services) -> None:
         self.view = view
-        self.services = services_for(view.hub)
+        self.services = services
         self.player = PlayerView(view, self.services.runs)
         self.explorer = ExplorerView(view, self.services.maps)
-        self.demos = DemosView(view, self.services.runs, self.explorer)
+        self.demos = DemosView(view, self.services.runs, self.explorer, self.player.speed_value)
 
     def build_tabs(self, tabs: viser.GuiTabGroupHandle) -> None:
         """Add the *Player*, *Explorer* and *Demos* tabs to the panel's tab group."""
@@ -79,7 +69,7 @@ class Teaching:
             self.services.runs.adopt(self.view.session, old)
             self.player.refresh()
 
-    def render(self, frame: Frame) -> None:
+    def render(self, frame: Snapshot) -> None:
         """Draw the teaching layer's part of ``frame`` (under the hub's lock)."""
         self.player.render(frame)
         self.explorer.render(frame)

@@ -1,0 +1,56 @@
+"""The app's state: everything a tab draws, as one frozen value replaced at every change (SI units).
+
+No viser and no maths here: :class:`AppState` is the mechanism's parameters, its pose, the load on it (static or
+dynamic, :class:`~tpm_viz.app.readouts.Load`), the trajectory sample it shows and the note of the last move.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Literal
+
+from tpm_viz.app.moves import Pose
+from tpm_viz.app.poses import home_pose
+from tpm_viz.app.readouts import Load
+from tpm_viz.params import Params
+
+__all__ = ["TRAJECTORY_KINDS", "AppState", "TrajectorySample"]
+
+
+TrajectoryKind = Literal["none", "line", "circle", "file"]
+
+TRAJECTORY_KINDS = ("none", "line", "circle")
+"""Trajectory sample that drives the platform: none, the paper's line (Fig. 4) or circle (Fig. 5)."""
+
+
+@dataclass(frozen=True)
+class TrajectorySample:
+    """Which trajectory sample drives the platform: ``kind``, duration ``T`` [s] and time ``t`` [s]."""
+
+    kind: str = "none"
+    duration: float = 0.2
+    t: float = 0.0
+
+
+@dataclass(frozen=True)
+class AppState:
+    """Everything a view draws (SI units). Replaced, never mutated."""
+
+    params: Params
+    pose: Pose
+    load: Load = field(default_factory=Load)
+    trajectory: TrajectorySample = field(default_factory=TrajectorySample)
+    note: str = ""
+    """Why the last move stopped short (shown to every viewer of the session), or empty."""
+    version: int = 0
+
+    @classmethod
+    def initial(cls, params: Params | None = None) -> AppState:
+        """The paper's prototype at its home pose (``p = 0``), static mode, no load."""
+        params = Params.paper() if params is None else params
+        return cls(params=params, pose=home_pose(params))
+
+    def replace(self, **changes) -> AppState:
+        """A copy with some fields changed and the version bumped."""
+        return dataclasses.replace(self, version=self.version + 1, **changes)

@@ -1,0 +1,83 @@
+"""Gizmo drags waiting to be committed to one session: the latest value wins across the tabs allowed to change it.
+
+A class pulling the shared platform at once must make one commit per round, not one per student. Each tab pushes
+its drag events here (in arrival order, numbered by the hub); the tab that drains takes the whole queue: the latest
+event of any tab that may change the session is committed, on behalf of the tab that sent it; the other tabs whose
+drag ended are told so (their gizmos are written back by that commit). No viser here.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Hashable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["DragQueue", "PendingDrag", "Take"]
+
+
+@dataclass(frozen=True)
+class PendingDrag:
+    """One gizmo event: ``phase`` (``start``, ``update``, ``end``), ``position`` [m] (x, y, z) and its arrival number."""
+
+    phase: str
+    position: np.ndarray
+    arrival: int
+
+
+@dataclass(frozen=True)
+class Take:
+    """What a drain commits: the latest drag (``mover``'s), and the tabs whose drag ended in this round."""
+
+    mover: Hashable
+    latest: PendingDrag
+    ended: tuple = ()
+
+
+@dataclass
+class DragQueue:
+    """The pending drags of one session's tabs (mutated under the hub's lock, or on the event loop for ``push``)."""
+
+    scheduled: bool = False
+    """A drain is scheduled (a drag that arrives meanwhile is taken by it)."""
+    next_at: float = 0.0
+    """``time.monotonic()`` before which no further drag is committed (pacing of a session shown by many tabs)."""
+    _pending: dict[Hashable, list[PendingDrag]] = field(default_factory=dict)
+
+    def push(self, view: Hashable, drag: PendingDrag) -> None:
+        """Queue ``view``'s drag event."""
+        self._pending.setdefault(view, []).append(drag)
+
+    def has(self, view: Hashable) -> bool:
+        """Whether ``view`` has drags waiting."""
+        return bool(self._pending.get(view))
+
+    def waiting(self) -> list[Hashable]:
+        """The views with drags waiting."""
+        return [v for v, drags in self._pending.items() if drags]
+
+    def drop(self, view: Hashable) -> None:
+        """Forget ``view``'s drags (it left the session or closed)."""
+        self._pending.pop(view, None)
+
+    def take(self, origin: Hashable, may_merge: Callable[[Hashable], bool]) -> Take | None:
+        """Remove ``origin``'s drags and, if ``may_merge(origin)``, those of every other view with
+        ``may_merge(view)``; return the latest of them by arrival, or None if ``origin`` has none."""
+        own = self._pending.pop(origin, [])
+        if not own:
+            return None
+        latest, mover = own[-1], origin
+        ended = []
+        if may_merge(origin):
+            for view in list(self._pending):
+                drags = self._pending[view]
+                if not drags or not may_merge(view):
+                    continue
+                del self._pending[view]
+                if any(d.phase == "end" for d in drags):
+                    ended.append(view)
+                if drags[-1].arrival > latest.arrival:
+                    latest, mover = drags[-1], view
+        if mover is not origin and any(d.phase == "end" for d in own):
+            ended.append(origin)
+        return Take(mover, latest, tuple(ended))
