@@ -86,16 +86,14 @@ class TpmApp:
         self,
         server: viser.ViserServer,
         params: Params | None = None,
-        reference: Reference | str | None = "auto",
+        reference: Reference | None = multibody.inverse_dynamics,
         presenter_token: str | None = None,
     ) -> None:
         self.server = server
         self.access = Access(presenter_token)
         state = AppState.initial(params)
         shared_scene = MechanismScene(server.scene, state.params, sink=server)  # drawn once for every tab
-        self.hub = Hub(
-            state, multibody.inverse_dynamics if reference == "auto" else reference, self.access, shared_scene
-        )
+        self.hub = Hub(state, reference, self.access, shared_scene)
         self.hub.evaluate(self.hub.shared.state)  # warm-up: builds the Pinocchio model once
         self.services = Services.create(self.hub)
         """The worker, floor maps and trajectory runs every tab of this app shares."""
@@ -136,7 +134,10 @@ class TpmApp:
         """*Log in as presenter*: check the typed token (cleared at once) and tell this tab only."""
         if getattr(event, "client", None) is None or view.closed:
             return
-        attempt = view.login.take()
+        login = view.login
+        if login is None:
+            return
+        attempt = login.take()
         try:
             ok = self.access.login(view, attempt)
         except TpmVizError as exc:
@@ -147,7 +148,7 @@ class TpmApp:
             view.refuse("wrong presenter token", resync=False)
             return
         log.info("client %s is now a presenter tab", view.client.client_id)
-        view.login.show("**You are the presenter**: your changes go to the shared mechanism.")
+        login.show("**You are the presenter**: your changes go to the shared mechanism.")
         self._class_info()
 
     def _class_info(self) -> None:

@@ -14,6 +14,7 @@ from __future__ import annotations
 import asyncio
 import functools
 import time
+from typing import cast
 
 import numpy as np
 import viser
@@ -26,8 +27,9 @@ from tpm_viz.errors import TpmVizError
 from tpm_viz.params import Params
 from tpm_viz.ui.drags import PendingDrag
 from tpm_viz.ui.guard import guarded
+from tpm_viz.ui.login import LoginPanel
 from tpm_viz.ui.panels import Panel
-from tpm_viz.ui.scene import camera_pose
+from tpm_viz.ui.scene import MechanismScene, camera_pose
 from tpm_viz.ui.session import Hub, Session
 from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.tabscene import TabScene
@@ -87,11 +89,13 @@ class ClientView:
         self.client = client
         self.hub = hub
         self.closed = False
+        self.login: LoginPanel | None = None
+        """The presenter login of this tab (presenter mode only)."""
         self._notified: tuple[str, float] = ("", 0.0)
         self._drawn_at = -1.0  # time.monotonic() of this tab's last render
         with hub.lock:
             state = hub.shared.state
-            self.scene = TabScene(client, hub.shared.scene)
+            self.scene = TabScene(client, cast(MechanismScene, hub.shared.scene))
             self.teaching = Teaching(self, services)  # player, explorer, lessons (ui/teaching/)
             self.panel = Panel(client.gui, state, extra_tabs=self.teaching.build_tabs)
             self._wire()
@@ -259,6 +263,10 @@ class ClientView:
     def drag_ended(self) -> None:
         """This tab's drag ended inside another tab's commit: its gizmo is written back by that commit."""
         self.scene.forget()
+
+    def tell(self, text: str) -> None:
+        """Show ``text`` in this tab's message line (empty: clear it)."""
+        self.panel.tell(text)
 
     def run_changed(self) -> None:
         """The session's run changed: redraw this tab's player."""

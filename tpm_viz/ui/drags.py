@@ -10,10 +10,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
+from typing import Generic, TypeVar
 
 import numpy as np
 
 __all__ = ["DragQueue", "PendingDrag", "Take"]
+
+V = TypeVar("V", bound=Hashable)
+"""A tab (any hashable object: the queue never looks inside it)."""
 
 
 @dataclass(frozen=True)
@@ -26,48 +30,48 @@ class PendingDrag:
 
 
 @dataclass(frozen=True)
-class Take:
+class Take(Generic[V]):
     """What a drain commits: the latest drag (``mover``'s), and the tabs whose drag ended in this round."""
 
-    mover: Hashable
+    mover: V
     latest: PendingDrag
-    ended: tuple = ()
+    ended: tuple[V, ...] = ()
 
 
 @dataclass
-class DragQueue:
+class DragQueue(Generic[V]):
     """The pending drags of one session's tabs (mutated under the hub's lock, or on the event loop for ``push``)."""
 
     scheduled: bool = False
     """A drain is scheduled (a drag that arrives meanwhile is taken by it)."""
     next_at: float = 0.0
     """``time.monotonic()`` before which no further drag is committed (pacing of a session shown by many tabs)."""
-    _pending: dict[Hashable, list[PendingDrag]] = field(default_factory=dict)
+    _pending: dict[V, list[PendingDrag]] = field(default_factory=dict)
 
-    def push(self, view: Hashable, drag: PendingDrag) -> None:
+    def push(self, view: V, drag: PendingDrag) -> None:
         """Queue ``view``'s drag event."""
         self._pending.setdefault(view, []).append(drag)
 
-    def has(self, view: Hashable) -> bool:
+    def has(self, view: V) -> bool:
         """Whether ``view`` has drags waiting."""
         return bool(self._pending.get(view))
 
-    def waiting(self) -> list[Hashable]:
+    def waiting(self) -> list[V]:
         """The views with drags waiting."""
         return [v for v, drags in self._pending.items() if drags]
 
-    def drop(self, view: Hashable) -> None:
+    def drop(self, view: V) -> None:
         """Forget ``view``'s drags (it left the session or closed)."""
         self._pending.pop(view, None)
 
-    def take(self, origin: Hashable, may_merge: Callable[[Hashable], bool]) -> Take | None:
+    def take(self, origin: V, may_merge: Callable[[V], bool]) -> Take[V] | None:
         """Remove ``origin``'s drags and, if ``may_merge(origin)``, those of every other view with
         ``may_merge(view)``; return the latest of them by arrival, or None if ``origin`` has none."""
         own = self._pending.pop(origin, [])
         if not own:
             return None
         latest, mover = own[-1], origin
-        ended = []
+        ended: list[V] = []
         if may_merge(origin):
             for view in list(self._pending):
                 drags = self._pending[view]

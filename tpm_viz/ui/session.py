@@ -66,6 +66,15 @@ class View(Protocol):
     def drag_ended(self) -> None:
         """This tab's drag was merged into another tab's commit and has ended: write its gizmo back."""
 
+    def commit_drag(self, phase: str, position: np.ndarray) -> None:
+        """Commit this tab's drag to ``position`` [m] (under the hub's lock; it may be merged from other tabs)."""
+
+    def drain_drags(self) -> None:
+        """Commit the session's pending drags (a tab that leaves hands the session's drain on to another)."""
+
+    def tell(self, text: str) -> None:
+        """Show ``text`` in this tab's message line (empty: clear it)."""
+
 
 class Session:
     """One mechanism state and the views that show it (mutated only under the hub's lock)."""
@@ -76,9 +85,10 @@ class Session:
         self.scene = scene
         """Where the mechanism is drawn once per commit, or None (each view draws it)."""
         self.views: list[View] = []
-        self.frame = None  # the Snapshot last drawn (tpm_viz.ui.snapshot), None until the first draw
+        self.frame: Snapshot | None = None
+        """The snapshot last drawn, None until the first draw."""
         self.play_token = 0  # a playing trajectory stops when this changes
-        self.drags = DragQueue()
+        self.drags: DragQueue[View] = DragQueue()
         """Gizmo drags waiting to be committed (latest value wins across the tabs, :mod:`.drags`)."""
 
     @property
@@ -169,9 +179,10 @@ class Hub:
     def _draw(self, session: Session, views: list[View], origin: View | None, dragging: bool) -> None:
         if session.frame is None:
             session.frame = self.frame(session.state, dragging)
+        frame = session.frame
         if session.scene is not None:
             try:
-                session.scene.update(session.frame)  # once for every view of the session
+                session.scene.update(frame)  # once for every view of the session
             except Exception as exc:  # e.g. the only tab of a private copy went away mid-push
                 report(exc, f"drawing {type(session.scene).__name__}")
         if origin in views:
@@ -179,7 +190,7 @@ class Hub:
             views.insert(0, origin)
         for view in views:
             try:
-                view.render(session.frame, dragging=dragging and view is origin)
+                view.render(frame, dragging=dragging and view is origin)
             except Exception as exc:  # one broken tab (e.g. gone mid-push) must not stop the others
                 report(exc, f"drawing {type(view).__name__}")
 

@@ -139,7 +139,7 @@ class DemosView:
                     self.runs.of(session).extra = source
                 else:  # a still scene: no trajectory (the previous one may not fit the new parameters)
                     self.runs.unload(session)
-                view.panel.tell("")
+                view.tell("")
                 session.play_token += 1
                 view.hub.commit(session, new, origin=view)
             except TpmVizError as exc:
