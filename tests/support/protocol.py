@@ -104,14 +104,16 @@ def machine_busy_seconds() -> float:
     return (sum(fields[:8]) - fields[3] - fields[4]) / CLK_TCK
 
 
-_decompress = zstandard.ZstdDecompressor()
+_local = threading.local()  # a zstd decompressor is not thread-safe: one per reading thread
 _encode = msgspec.msgpack.encode
 
 
 def decode_batch(raw: bytes) -> list[dict]:
     """The messages of one server -> client websocket frame."""
     size, compressed = int.from_bytes(raw[:8], "little"), int.from_bytes(raw[8:16], "little")
-    inner = _decompress.decompress(raw[16 : 16 + compressed], max_output_size=size)
+    if not hasattr(_local, "zstd"):
+        _local.zstd = zstandard.ZstdDecompressor()
+    inner = _local.zstd.decompress(raw[16 : 16 + compressed], max_output_size=size)
     return msgspec.msgpack.decode(inner)["messages"]
 
 

@@ -13,9 +13,9 @@ import time
 
 import numpy as np
 import pytest
-from test_reliability_app import assert_valid
 
 from tests.support.protocol import ProtocolClient, wait_for
+from tests.ui.test_reliability_app import assert_valid
 from tpm_viz import Params
 from tpm_viz.app import transitions
 from tpm_viz.ui.guard import ACTIVITY, guarded

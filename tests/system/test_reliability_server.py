@@ -24,10 +24,10 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from test_reliability_app import CSV_TEXT, GOOD_ROWS, NASTY_FLOAT, _timed, assert_valid
 
 from tests.support.fake_viser import assert_clean
 from tests.support.protocol import ProtocolClient, wait_for
+from tests.ui.test_reliability_app import CSV_TEXT, GOOD_ROWS, NASTY_FLOAT, _timed, assert_valid
 from tpm_viz.ui.guard import ACTIVITY
 
 INT64 = st.integers(-(2**62), 2**62)

@@ -18,9 +18,8 @@ import threading
 import time
 from pathlib import Path
 
-from test_reliability_app import assert_valid
-
 from tests.support.protocol import ProtocolClient, wait_for
+from tests.ui.test_reliability_app import assert_valid
 from tpm_viz.ui.guard import ACTIVITY
 
 WARM_UP, CYCLES, BATCH = 30, 240, 4
