@@ -3,7 +3,7 @@ and the figures (paper Figs. 4-5, where the authors compared against ADAMS).
 
 Three cases: the line and the circle trajectories (inverse dynamics at every sample, plus the
 forward-dynamics replay of :mod:`tpm_viz.multibody.replay`), and seeded random regular states with random
-velocities, accelerations and external platform forces. "Agree" is ``conventions.md``'s rule:
+velocities, accelerations and external platform forces. "Agree" is ``docs/conventions.md``'s rule:
 ``|Δτ| / (1 N + |τ|) <= 1e-9``, tracking within 0.1 mm and closures within 1e-6 m.
 """
 
@@ -85,7 +85,7 @@ def random_regular_states(params: Params, n: int, seed: int = 0):
 
 @dataclass(frozen=True)
 class Tolerances:
-    """Pass/fail limits of the crosscheck (``conventions.md`` and the issue)."""
+    """Pass/fail limits of the crosscheck (``docs/conventions.md`` and the issue)."""
 
     rel: float = 1e-9  # |Δτ| / (1 N + |τ|)
     tracking: float = 1e-4  # m (0.1 mm)

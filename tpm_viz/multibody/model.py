@@ -13,10 +13,10 @@ contiguous in ``v``), so ``q = (d_1, φ_10, φ_p, φ_11, d_2, φ_20, φ_21)`` (s
                                                       └RZ─ link2_1 (pivot A_2 + s e_1)
 
 ``s`` is the pivot spacing; each link frame has its x axis along the link, so ``φ_1k = θ_1``,
-``φ_2k = -θ_2`` (conventions.md) and ``φ_p = -θ_1`` keeps the platform translating. Loop closures:
+``φ_2k = -θ_2`` (docs/conventions.md) and ``φ_p = -θ_1`` keeps the platform translating. Loop closures:
 three ``RigidConstraintModel(CONTACT_3D, LOCAL_WORLD_ALIGNED)`` joining the tips of link1_1,
 link2_0 and link2_1 to ``B_1 + s e_2``, ``B_2 = P - b e_2`` and ``B_2 + s e_1`` on the platform.
-Masses (conventions.md): sliders ``m_a`` and platform ``m_p`` as point masses (the platform never
+Masses (docs/conventions.md): sliders ``m_a`` and platform ``m_p`` as point masses (the platform never
 rotates, so its rotational inertia does not enter), each link a uniform slender rod of mass
 ``m_b / 2`` along its x axis: ``I_xx = 0``, ``I_yy = I_zz = m l_a² / 12`` about its centre.
 
@@ -32,8 +32,13 @@ defined, not the redundant part of ``λ``; since the null space is the same for 
 independent subset of rows, ``τ`` does not depend on which redundant row one would keep (the tests
 solve the square system for every such subset). Forward dynamics
 (:meth:`MultibodyModel.forward_dynamics`) is our own KKT solve on the null space from the SVD of
-``J_c`` (Gauss's principle) with Pinocchio's ``crba``, ``nle`` and constraint Jacobian; its docstring
-says why not ``pinocchio.constraintDynamics``.
+``J_c`` (Gauss's principle) with Pinocchio's ``crba``, ``nle`` and constraint Jacobian; the docstring
+of :func:`tpm_viz.multibody.forward.forward_dynamics` says why not ``pinocchio.constraintDynamics``.
+
+Split by concept: this module builds the model and holds every Pinocchio evaluation and the inverse
+dynamics; :mod:`tpm_viz.multibody.assembly` (a mixin) the closed-loop kinematics (Newton on the
+closures); :mod:`tpm_viz.multibody.forward` the forward dynamics (KKT solve, projection, and the fast
+2-DOF :class:`~tpm_viz.multibody.forward.PlatformPlant` of the control lab). The public methods are here.
 """
 
 from __future__ import annotations
@@ -41,11 +46,15 @@ from __future__ import annotations
 import functools
 import math
 import threading
+from collections.abc import Callable
 
 import numpy as np
 import pinocchio as pin
 
-from tpm_viz.errors import InputError, SingularConfigurationError, UnreachablePoseError
+from tpm_viz.errors import InputError, SingularConfigurationError
+from tpm_viz.multibody import forward
+from tpm_viz.multibody.assembly import DOF, ClosedLoopAssembly
+from tpm_viz.multibody.locking import locked
 from tpm_viz.multibody.rank import ranked_svd
 from tpm_viz.paper.kinematics import as_xy
 from tpm_viz.params import Params
@@ -55,11 +64,6 @@ __all__ = ["PART_NAMES", "MultibodyModel", "inverse_dynamics", "model_for"]
 PART_NAMES = ("slider1", "slider2", "link1_0", "link1_1", "link2_0", "link2_1", "platform")
 """Keys of :meth:`MultibodyModel.placements`, also the Pinocchio joint names (and frame names)."""
 
-_DOF = 2
-_NEWTON_TOL = 1e-12  # m: accepted residual of the closure and platform/actuator equations ...
-_NEWTON_FLOOR = 1e-15  # m: ... but Newton polishes down to this or until it stops improving
-_NEWTON_MAX_ITER = 40
-_MAX_ANGLE_STEP = 0.5  # rad, Newton step limit on the revolute coordinates
 _SINGULAR_RTOL = 1e-9
 
 
@@ -122,16 +126,7 @@ def _build(params: Params):
     return model, closures, frames
 
 
-def _locked(method):
-    @functools.wraps(method)
-    def wrapper(self, *args, **kwargs):
-        with self._lock:
-            return method(self, *args, **kwargs)
-
-    return wrapper
-
-
-class MultibodyModel:
+class MultibodyModel(ClosedLoopAssembly):
     """The closed-loop Pinocchio model of one parameter set (see the module docstring).
 
     Public methods take platform quantities as ``(2,)`` (or ``(..., 2)`` where stated) arrays in SI
@@ -156,17 +151,17 @@ class MultibodyModel:
         """Position of each joint coordinate in ``q`` (and ``v``): Pinocchio's depth-first order."""
         self._slider_idx = np.array([self.index["slider1"], self.index["slider2"]])
         self._angle_idx = np.array([self.index[n] for n in PART_NAMES[2:]])  # φ_10, φ_11, φ_20, φ_21, φ_p
-        self._s_t = np.zeros((self.model.nv, _DOF))  # Sᵀ: actuator forces -> generalised forces
+        self._s_t = np.zeros((self.model.nv, DOF))  # Sᵀ: actuator forces -> generalised forces
         self._s_t[self._slider_idx, [0, 1]] = 1.0
-        self._select_platform = np.zeros((len(self.constraint_models) * 3 + _DOF, _DOF))  # [0; I]
-        self._select_platform[-_DOF:] = np.eye(_DOF)
-        self._last: tuple[np.ndarray, np.ndarray, np.ndarray | None] | None = None  # warm start (p, q, ∂q/∂p)
+        self._select_platform = np.zeros((len(self.constraint_models) * 3 + DOF, DOF))  # [0; I]
+        self._select_platform[-DOF:] = np.eye(DOF)
+        self._last = None  # warm start (p, q, ∂q/∂p)
 
     # ----------------------------------------------------------------- Pinocchio evaluations
     def _closure_terms(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """World closure residual ``Φ(q)`` (9,) [m] and its Jacobian ``J_c`` (9, 7).
 
-        Order matters (pinocchio-notes.md): joint Jacobians and placements at ``q`` first, then
+        Order matters (docs/pinocchio.md): joint Jacobians and placements at ``q`` first, then
         ``calc`` of each constraint, then the constraint Jacobian (all three in one call).
         """
         m, d = self.model, self.data
@@ -199,165 +194,51 @@ class MultibodyModel:
     def _closure_svd(self, jc: np.ndarray):
         """Rank-revealing SVD of ``J_c``; its null space is the 2 admissible motions (rank 5 expected)."""
         svd = ranked_svd(jc)
-        if self.model.nv - svd.rank != _DOF:
+        if self.model.nv - svd.rank != DOF:
             raise SingularConfigurationError(
-                f"singular configuration: the closure Jacobian has rank {svd.rank}, not {self.model.nv - _DOF} "
+                f"singular configuration: the closure Jacobian has rank {svd.rank}, not {self.model.nv - DOF} "
                 "(a parallelogram is folded, cos θ_i = 0, eq. 11)"
             )
         return svd
 
-    # ----------------------------------------------------------------- closed-loop kinematics
-    def _newton(self, q: np.ndarray, target: np.ndarray, driven: str):
-        """Gauss-Newton on ``[Φ(q); x(q) - target] = 0``, ``x`` = platform P or actuators d.
+    def _mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        """Joint-space mass matrix ``M(q)`` (7, 7) from ``crba`` (symmetrised: C++ fills the upper triangle)."""
+        mass = pin.crba(self.model, self.data, q)
+        return np.triu(mass) + np.triu(mass, 1).T
 
-        ``[J_c; J_x]`` has full column rank away from singularities, so the normal equations give the
-        step. Returns ``(q, converged, J_c, J_x)`` with the Jacobians at the returned ``q``.
-        """
-        q, previous, nc = q.copy(), np.inf, 3 * len(self._cdatas)
-        a, r = np.empty((nc + _DOF, self.model.nv)), np.empty(nc + _DOF)
-        for _ in range(_NEWTON_MAX_ITER):
-            r[:nc], a[:nc] = self._closure_terms(q)
-            if driven == "platform":
-                r[nc:], a[nc:] = self._platform_position_now() - target, self._platform_jacobian()
-            else:
-                r[nc:], a[nc:] = q[self._slider_idx] - target, self._s_t.T
-            err = abs(r).max()
-            if err < _NEWTON_FLOOR or (err < _NEWTON_TOL and err > 0.5 * previous):  # at the rounding floor
-                return q, True, a[:nc].copy(), a[nc:].copy()
-            previous = err
-            try:
-                dq = -np.linalg.solve(a.T @ a, a.T @ r)
-            except np.linalg.LinAlgError:
-                break
-            big = abs(dq[self._angle_idx]).max()
-            if big > _MAX_ANGLE_STEP:
-                dq *= _MAX_ANGLE_STEP / big
-            q += dq
-        return q, False, a[:nc].copy(), a[nc:].copy()
+    def _nle(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Nonlinear effects ``C(q, v) v`` (7,) (no gravity: the plane is horizontal)."""
+        return pin.nle(self.model, self.data, q, v)
 
+    def rnea_function(self) -> Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]:
+        """``rnea(q, v, a)`` (7,) of the tree bound to a *new* Pinocchio ``Data``: for a caller that
+        evaluates many states (:class:`tpm_viz.multibody.forward.PlatformPlant`) without the model lock."""
+        model, data, rnea = self.model, self.model.createData(), pin.rnea
+        return lambda q, v, a: rnea(model, data, q, v, a)
+
+    # ----------------------------------------------------------------- closed-loop kinematics: assembly.py
     def _platform_position_now(self) -> np.ndarray:
         return pin.updateFramePlacement(self.model, self.data, self._frames["platform"]).translation[:2].copy()
 
-    def _is_parallelogram(self, q: np.ndarray) -> bool:
-        """Both links of each leg parallel and the platform translating (``φ_p = -φ_10``)."""
-        f10, f11, f20, f21, fp = q[self._angle_idx].tolist()
-        return all(abs(math.remainder(x, 2 * math.pi)) < 1e-6 for x in (f11 - f10, f21 - f20, fp + f10))
-
-    def _wrap(self, q: np.ndarray) -> np.ndarray:
-        """``q`` with every angle in ``[-π, π]``."""
-        q = q.copy()
-        q[self._angle_idx] = [math.remainder(x, 2 * math.pi) for x in q[self._angle_idx].tolist()]
-        return q
-
-    def _pack(self, d, phi1: float, phi2: float) -> np.ndarray:
-        """``q`` from actuator positions and the link angles ``φ_1 = θ_1``, ``φ_2 = -θ_2`` of a parallelogram."""
-        q = np.empty(self.model.nq)
-        q[self._slider_idx] = d
-        q[self._angle_idx] = [phi1, phi1, phi2, phi2, -phi1]
-        return q
-
-    def _link_angles(self, q: np.ndarray) -> tuple[float, float]:
-        """``(φ_10, φ_20) = (θ_1, -θ_2)``."""
-        return float(q[self.index["link1_0"]]), float(q[self.index["link2_0"]])
-
-    def _guess_from_platform(self, p: np.ndarray, d: np.ndarray | None) -> np.ndarray:
-        """Starting point: the working mode with leg angles ``sin θ_1 = p_2 / l_a``, ``sin θ_2 = p_1 / l_a``
-        (conventions.md), or links pointing at the platform pivots from given actuator positions ``d``.
-        Only a guess: Newton accepts it only once Pinocchio's own closure residual is at the rounding floor."""
-        if d is not None:
-            return self._guess_from_both(p, d)
-        la, k = self.params.l_a, self.params.a - self.params.b
-        theta = (math.asin(float(p[1]) / la), math.asin(float(p[0]) / la))
-        d = (p[0] + k - la * math.cos(theta[0]), p[1] + k - la * math.cos(theta[1]))
-        return self._pack(d, theta[0], -theta[1])
-
-    def _guess_from_both(self, p: np.ndarray, d: np.ndarray) -> np.ndarray:
-        """Links pointing from the slider joints ``A_i`` towards the platform pivots ``B_i``."""
-        a, b = self.params.a, self.params.b
-        u1 = (p[0] - b) - (d[0] - a), p[1]  # B_1 - A_1
-        u2 = p[0], (p[1] - b) - (d[1] - a)  # B_2 - A_2
-        t1 = np.arctan2(u1[1], u1[0])
-        t2 = np.arctan2(-u2[0], u2[1])  # link frame of leg 2 is rotated by +90 deg
-        return self._pack(d, t1, t2)
-
-    @_locked
-    def configuration(self, p, d=None) -> np.ndarray:
-        """Full configuration ``q`` (7,) for platform position ``p`` (2,) [m], by Newton on Pinocchio's
-        closure residual. Working mode (eq. 4: ``cos θ_i > 0``) unless actuator positions ``d`` (2,)
-        are given: they are the starting point and so select the branch."""
-        p = self._one(p, "p")
-        return self._configure(p, None if d is None else self._one(d, "d"))[0]
-
-    def _configure(self, p: np.ndarray, d: np.ndarray | None):
-        """``(q, J_c, J_P)`` at the closed-loop configuration of platform position ``p``."""
-        la, (p1, p2) = self.params.l_a, p.tolist()
-        if max(abs(p1), abs(p2)) >= la:
-            raise UnreachablePoseError(
-                f"platform position ({p1 * 1e3:.1f}, {p2 * 1e3:.1f}) mm is unreachable: "
-                f"each |p_j| must be below l_a = {la * 1e3:.1f} mm"
-            )
-        starts = [lambda: self._guess_from_platform(p, d)]
-        if d is None and self._last is not None:  # fallback: continuation from the last pose, tangent predictor
-            p_last, q_last, dq_dp = self._last
-            starts.append(lambda: q_last if dq_dp is None else q_last + dq_dp @ (p - p_last))
-        for start in starts:
-            q, ok, jc, jp = self._newton(start(), p, "platform")
-            working = min(math.cos(x) for x in self._link_angles(q)) > 0  # c_i = l_a cos θ_i > 0 (eq. 4)
-            if ok and self._is_parallelogram(q) and (d is not None or working):
-                q = self._wrap(q)
-                if d is None:
-                    self._last = (p.copy(), q, None)
-                return q, jc, jp
-        raise SingularConfigurationError(
-            f"no closed-loop configuration found at ({p1 * 1e3:.1f}, {p2 * 1e3:.1f}) mm "
-            "(too close to cos θ_i = 0, eq. 11)"
-        )
-
-    @_locked
-    def configuration_from_actuators(self, d, mode: int = +1) -> np.ndarray:
-        """Full configuration ``q`` (7,) for actuator positions ``d`` (2,) [m] in assembly ``mode``
-        (+1: ``cos(θ1 + θ2) > 0``, the home mode; -1: the other), by Newton on the closures."""
-        if mode not in (1, -1):
-            raise InputError(f"assembly mode must be +1 or -1, got {mode!r}")
-        d = self._one(d, "d")
-        k, la = self.params.a - self.params.b, self.params.l_a
-        c1, c2 = np.array([d[0] - k, 0.0]), np.array([0.0, d[1] - k])  # leg circle centres
-        gap = math.hypot(float(d[0] - k), float(d[1] - k))  # |C_2 - C_1|, no overflow for huge d
-        if not gap < 2 * la or gap == 0:
-            raise UnreachablePoseError(
-                "actuator positions cannot be assembled: the leg circles are more than 2 l_a apart"
-            )
-        normal = np.array([c1[1] - c2[1], c2[0] - c1[0]]) / gap
-        found = []
-        for side in (1.0, -1.0):  # a guess on each side of the line of centres
-            p0 = (c1 + c2) / 2 + side * (la / np.sqrt(2.0)) * normal
-            q, ok, _, _ = self._newton(self._guess_from_both(p0, d), d, "actuators")
-            if ok and self._is_parallelogram(q):
-                found.append(self._wrap(q))
-        for q in found:
-            if np.sign(np.cos(np.subtract(*self._link_angles(q)))) == mode:  # det J_x = cos(θ1 + θ2), eq. 12
-                return q
-        raise SingularConfigurationError(f"assembly mode {mode:+d} not found: d is at or near the direct singularity")
-
-    @_locked
+    @locked
     def platform_position(self, q) -> np.ndarray:
         """Platform position ``P`` (2,) [m] of configuration ``q``."""
         pin.forwardKinematics(self.model, self.data, self._as_q(q))
         return self._platform_position_now()
 
-    @_locked
+    @locked
     def closure_terms(self, q) -> tuple[np.ndarray, np.ndarray]:
         """Loop-closure residual ``Φ(q)`` (9,) [m] (world, 3 rows per closure) and Jacobian ``J_c`` (9, 7)."""
         phi, jc = self._closure_terms(self._as_q(q))
         return phi.copy(), jc.copy()
 
-    @_locked
+    @locked
     def constraint_violation(self, q) -> float:
         """Largest loop-closure gap [m] (distance between the two sides of a closure) at ``q``."""
         phi, _ = self._closure_terms(self._as_q(q))
         return float(np.max(np.linalg.norm(phi.reshape(-1, 3), axis=1)))
 
-    @_locked
+    @locked
     def placements(self, q) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """``{part: (position (3,) [m], quaternion wxyz (4,))}`` for :data:`PART_NAMES`.
 
@@ -380,7 +261,7 @@ class MultibodyModel:
         return q
 
     # ----------------------------------------------------------------- dynamics
-    def _motion(self, p: np.ndarray, dp: np.ndarray, ddp: np.ndarray):
+    def _motion(self, p: np.ndarray, dp: np.ndarray, ddp: np.ndarray) -> tuple[np.ndarray, ...]:
         """``(q, v, a, N, J_P)`` for a prescribed platform motion, with ``J_c v = 0``, ``J_c a + γ = 0``.
 
         ``A = [J_c; J_P]`` (11, 7) must have full column rank (else eq. 11). ``N = A⁺ [0; I]`` (7, 2)
@@ -414,13 +295,13 @@ class MultibodyModel:
         b1, b2 = (n.T @ rhs).tolist()
         return np.array([g22 * b1 - g12 * b2, g11 * b2 - g21 * b1]) / det, rhs
 
-    @_locked
+    @locked
     def constrained_motion(self, p, dp, ddp) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Joint ``(q, v, a)`` (7,) each, consistent with the closures, for one platform state (2,) each."""
         p, dp, ddp = (self._one(x, n) for x, n in ((p, "p"), (dp, "dp"), (ddp, "ddp")))
         return self._motion(p, dp, ddp)[:3]
 
-    @_locked
+    @locked
     def inverse_dynamics(self, p, dp, ddp, f_ext=None) -> np.ndarray:
         """Actuator forces ``τ`` [N], shape ``(..., 2)``, for platform ``p, ṗ, p̈`` [m, m/s, m/s²].
 
@@ -437,12 +318,13 @@ class MultibodyModel:
         tau = np.empty((flat[0].shape[0], 2))
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # huge inputs: checked below
             for k, (pk, dpk, ddpk, fk) in enumerate(zip(*flat, strict=True)):
-                tau[k] = self._tau(*self._motion(pk, dpk, ddpk), fk)[0]
+                q, v, a, n, jp = self._motion(pk, dpk, ddpk)
+                tau[k] = self._tau(q, v, a, n, jp, fk)[0]
         if not np.all(np.isfinite(tau)):
             raise InputError("the actuator forces overflowed: the inputs are too large for finite results")
         return tau.reshape(p.shape)
 
-    @_locked
+    @locked
     def generalized_forces(self, p, dp, ddp, f_ext=None) -> dict[str, np.ndarray]:
         """Every term of ``rnea - J_Pᵀ f_ext = Sᵀ τ + J_cᵀ λ`` at one state (for checks and teaching):
         ``q, v, a, tau, rhs`` (the left side), ``S_T`` (7, 2), ``J_c`` (9, 7), ``lam`` (minimum-norm λ)."""
@@ -454,54 +336,25 @@ class MultibodyModel:
         lam = np.linalg.lstsq(jc.T, rhs - self._s_t @ tau, rcond=None)[0]
         return {"q": q, "v": v, "a": a, "tau": tau, "rhs": rhs, "S_T": self._s_t.copy(), "J_c": jc, "lam": lam}
 
-    @_locked
+    @locked
     def forward_dynamics(self, q, v, tau) -> np.ndarray:
-        """Joint accelerations ``a`` (7,) [m/s², rad/s²] under actuator forces ``τ`` (2,) [N].
+        """Joint accelerations ``a`` (7,) [m/s², rad/s²] under actuator forces ``τ`` (2,) [N]
+        (the KKT solve of :func:`tpm_viz.multibody.forward.forward_dynamics`)."""
+        return forward.forward_dynamics(self, self._as_q(q), self._as_q(v), self._one(tau, "tau"))
 
-        Our own KKT solve (Gauss's principle) on the rank-revealed null space ``N`` of ``J_c``:
-        ``a = a_c + N z`` with ``a_c = -J_c⁺ γ`` and ``(Nᵀ M N) z = Nᵀ (Sᵀ τ - nle - M a_c)``, ``M`` from
-        ``crba`` and ``nle`` from Pinocchio. It is direct and exact with the redundant rows. The proximal
-        ``pinocchio.constraintDynamics`` returns the same ``a`` (the tests check it), but with these
-        redundant rows its reported residual never converges and it often runs to ``max_iter``, so it
-        cannot tell a good step from a bad one.
-        """
-        q, v = self._as_q(q), self._as_q(v)
-        m, d = self.model, self.data
-        svd = self._closure_svd(self._closure_terms(q)[1])
-        n = svd.null_space
-        gamma, _ = self._drifts(q, v)
-        mass = pin.crba(m, d, q)
-        mass = np.triu(mass) + np.triu(mass, 1).T  # C++ crba fills the upper triangle only
-        a_c = -svd.solve(gamma)
-        rhs = self._s_t @ self._one(tau, "tau") - pin.nle(m, d, q, v) - mass @ a_c
-        return a_c + n @ np.linalg.solve(n.T @ mass @ n, n.T @ rhs)
-
-    @_locked
+    @locked
     def project(self, q, v) -> tuple[np.ndarray, np.ndarray]:
-        """Constraint stabilisation: the nearest ``q`` on the closures (minimum-norm Newton steps)
-        and ``v`` projected on the admissible motions ``N Nᵀ v``."""
-        q, v, previous = self._as_q(q).copy(), self._as_q(v), np.inf
-        for _ in range(_NEWTON_MAX_ITER):
-            phi, jc = self._closure_terms(q)
-            err = np.max(np.abs(phi))
-            if err < _NEWTON_FLOOR or (err < _NEWTON_TOL and err > 0.5 * previous):
-                break
-            previous = err
-            # Off the closures the redundant row is not exactly redundant (rank 6, σ_6 ~ the gap):
-            # step on the 5 dominant directions only, the rank the constraints have on the closures.
-            q -= ranked_svd(jc)._replace(rank=self.model.nv - _DOF).solve(phi)
-        else:
-            raise SingularConfigurationError("the closures cannot be re-assembled (constraint drift too large)")
-        n = self._closure_svd(jc).null_space
-        return q, n @ (n.T @ v)
+        """Constraint stabilisation (:func:`tpm_viz.multibody.forward.project`): the nearest ``q`` on the
+        closures and ``v`` projected on the admissible motions ``N Nᵀ v``."""
+        return forward.project(self, self._as_q(q), self._as_q(v))
 
-    @_locked
+    @locked
     def platform_velocity(self, q, v) -> np.ndarray:
         """Platform velocity ``J_P v`` (2,) [m/s]."""
         self._closure_terms(self._as_q(q))
         return self._platform_jacobian() @ self._as_q(v)
 
-    @_locked
+    @locked
     def kinetic_energy(self, q, v) -> float:
         """Total kinetic energy [J] of the tree at ``(q, v)`` (Pinocchio)."""
         return float(pin.computeKineticEnergy(self.model, self.data, self._as_q(q), self._as_q(v)))
