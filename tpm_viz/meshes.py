@@ -12,6 +12,8 @@ Only trimesh and numpy here; the browser app turns these meshes into scene nodes
 
 from __future__ import annotations
 
+from typing import cast
+
 import numpy as np
 import trimesh
 
@@ -91,7 +93,7 @@ def end_stops(params: Params, i: int) -> trimesh.Trimesh:
         lo[across], hi[across] = -0.026, 0.026
         lo[2], hi[2] = RAIL_Z[0], SLIDER_Z[1] + 0.004
         parts.append(_box(lo, hi))
-    return trimesh.util.concatenate(parts)
+    return cast(trimesh.Trimesh, trimesh.util.concatenate(parts))
 
 
 def slider(params: Params, i: int) -> trimesh.Trimesh:
@@ -123,7 +125,7 @@ def link(params: Params) -> trimesh.Trimesh:
         )
         for x in (0.0, params.l_a)
     ]
-    return trimesh.util.concatenate([bar, *ends])
+    return cast(trimesh.Trimesh, trimesh.util.concatenate([bar, *ends]))
 
 
 def link_instances(pose: MechanismPose) -> tuple[np.ndarray, np.ndarray]:

@@ -49,7 +49,8 @@ class Access:
     """The presenter token (or None) and the set of tabs that proved it. Thread-safe."""
 
     def __init__(self, token: str | None = None, clock=time.monotonic) -> None:
-        self._token = None if token is None else check_token(token).encode()
+        checked = None if token is None else check_token(token)
+        self._token = None if checked is None else checked.encode()
         self._presenters: weakref.WeakSet = weakref.WeakSet()
         self._failures: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
         self._lock = threading.Lock()

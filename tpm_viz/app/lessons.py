@@ -197,7 +197,7 @@ def demo_pose(demo: Demo, params: Params) -> Pose:
     if demo.p is not None:
         return Pose.working(params, demo.p)
     if demo.d is not None:
-        return Pose(forward_kinematics(params, demo.d, mode=demo.mode), demo.d)
+        return Pose(forward_kinematics(params, demo.d, mode=demo.mode), np.asarray(demo.d))
     raise InputError(f"demo {demo.key!r} has no pose")
 
 
@@ -210,9 +210,10 @@ def effect(demo: Demo) -> str:
     """One line of numbers that shows the demo's effect (closed form; see the module docstring)."""
     params = demo_params(demo)
     if demo.key == "direct":
-        source = demo_source(demo)
+        source, motion = demo_source(demo), demo.motion
+        assert source is not None and motion is not None  # the direct-singularity demo has a motion
         start, end = _tau_norms(params, source)
-        det = float(jacobians(params, np.array(demo.motion.end)).det_jx)
+        det = float(jacobians(params, np.array(motion.end)).det_jx)
         return (
             f"|τ| at the start {start:.0f} N, at the end {end:.0f} N (×{end / start:.1f}) for the same |p̈|; "
             f"det J_x falls from 1.00 to {det:.2f}"
@@ -234,9 +235,12 @@ def effect(demo: Demo) -> str:
             f"= (T2/T1)² = {(t2 / t1) ** 2:.3f}"
         )
     if demo.key == "agreement":
-        run = build_run(params, demo_source(demo))
+        agreement = demo_source(demo)
+        assert agreement is not None  # the agreement demo plays the paper's line
+        run = build_run(params, agreement)
         return f"closed-form peak |τ| {run.peak:.1f} N; the Pinocchio curves are drawn dotted on top"
     if demo.key == "modes":
+        assert demo.d is not None  # the assembly-modes demo is given by actuator positions
         sol = forward_kinematics_both(params, demo.d)
         mm = 1e3
         dets = [float(jacobians(params, q, demo.d).det_jx) for q in (sol.plus, sol.minus)]

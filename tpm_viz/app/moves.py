@@ -176,7 +176,7 @@ def why_not(params: Params, status: int, p, d, cause: Cause = "path") -> str:
 def _clamp(codes_of, x0: np.ndarray, x1: np.ndarray) -> tuple[np.ndarray, int]:
     """Last valid point of the segment ``x0 -> x1`` and the code that stopped it (``PoseStatus.REGULAR`` if none)."""
     t_ok, t_end = 0.0, 1.0
-    stop = PoseStatus.REGULAR
+    stop: int = PoseStatus.REGULAR
     for _ in range(_ROUNDS):
         ts = np.linspace(t_ok, t_end, _SAMPLES + 1)[1:]
         codes = codes_of(x0 + ts[:, None] * (x1 - x0))

@@ -111,7 +111,19 @@ def _vectorised(params: Params, p, dp, ddp, f_ext, d) -> tuple:
     c, _ = leg_components(params, p, d)
     _check_regular(params, c[..., 0], c[..., 1], p[..., 0], p[..., 1])
     with np.errstate(over="ignore", invalid="ignore"):
-        out = _procedure(params, *(x[..., k] for x in (p, dp, ddp, c) for k in (0, 1)), f[..., 0], f[..., 1])
+        out = _procedure(
+            params,
+            p[..., 0],
+            p[..., 1],
+            dp[..., 0],
+            dp[..., 1],
+            ddp[..., 0],
+            ddp[..., 1],
+            c[..., 0],
+            c[..., 1],
+            f[..., 0],
+            f[..., 1],
+        )
     return p, dp, ddp, d, out
 
 

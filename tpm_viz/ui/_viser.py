@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import inspect
 from collections.abc import Awaitable, Callable
-from typing import Any
+from typing import Any, cast
 
 import viser
 from viser import _messages
@@ -106,8 +106,8 @@ def drop_gizmo_echo(gizmo: Any) -> None:
         aux.sync_cb = None
 
 
-GuiUpdate = Callable[[int, Any], Awaitable[None]]
-Upload = Callable[[int, Any], None]
+GuiUpdate = Callable[[Any, Any], Awaitable[None]]
+Upload = Callable[[Any, Any], None]
 
 
 class ClientDoor:
@@ -116,16 +116,16 @@ class ClientDoor:
     def __init__(self, client: viser.ClientHandle) -> None:
         self._conn = client._websock_connection
         self._gui = client.gui
-        self.gui_update: GuiUpdate = self._gui._handle_gui_updates
+        self.gui_update: GuiUpdate = cast(GuiUpdate, self._gui._handle_gui_updates)
         """viser's own handler of ``GuiUpdateMessage`` (call it to let a message through)."""
-        self.upload_start: Upload = self._gui._handle_file_transfer_start
-        self.upload_part: Upload = self._gui._handle_file_transfer_part
+        self.upload_start: Upload = cast(Upload, self._gui._handle_file_transfer_start)
+        self.upload_part: Upload = cast(Upload, self._gui._handle_file_transfer_part)
 
     def widget(self, uuid: str) -> Any:
         """The GUI handle with this uuid, or None."""
         return self._gui._gui_input_handle_from_uuid.get(uuid)
 
-    def upload_state(self, transfer_uuid: str) -> dict | None:
+    def upload_state(self, transfer_uuid: str) -> Any:
         """viser's state of an upload in progress (``transferred_bytes``, ``total_bytes``), or None."""
         return self._gui._current_file_upload_states.get(transfer_uuid)
 
@@ -135,10 +135,11 @@ class ClientDoor:
 
     def replace(self, gui_update: GuiUpdate, upload_start: Upload, upload_part: Upload) -> None:
         """Route this tab's GUI updates and upload messages to the given handlers instead of viser's."""
-        for message_type, old, new in (
+        pairs: tuple[tuple[Any, Any, Any], ...] = (
             (_messages.GuiUpdateMessage, self.gui_update, gui_update),
             (_messages.FileTransferStartUpload, self.upload_start, upload_start),
             (_messages.FileTransferPart, self.upload_part, upload_part),
-        ):
+        )
+        for message_type, old, new in pairs:
             self._conn.unregister_handler(message_type, old)
             self._conn.register_handler(message_type, new)

@@ -175,8 +175,8 @@ class ClientView:
         panel.home.on_click(self._on_home)
         for kind in DEMO_KINDS:
             panel.demo[kind].on_click(lambda event, kind=kind: self._on_demo(event, kind))
-        for handle in (panel.load_mode, panel.f_ext, panel.dp, panel.ddp):
-            handle.on_update(self._on_load)
+        for load_input in (panel.load_mode, panel.f_ext, panel.dp, panel.ddp):
+            load_input.on_update(self._on_load)
         panel.apply.on_click(self._on_apply)
         panel.paper.on_click(self._on_paper)
         panel.own_copy.on_update(self._on_own_copy)

@@ -11,7 +11,7 @@ import time
 import viser
 
 from tpm_viz.app.poses import DEMO_KINDS
-from tpm_viz.app.readouts import LOAD_MODES
+from tpm_viz.app.readouts import LOAD_MODES, Load
 from tpm_viz.app.state import AppState
 from tpm_viz.params import PARAM_INFO, Params
 from tpm_viz.ui.snapshot import Snapshot
@@ -63,7 +63,7 @@ class Panel:
     def __init__(self, gui: viser.GuiApi, state: AppState, extra_tabs=None) -> None:
         self._gui = gui
         self._shown_params: Params | None = None
-        self._shown_load = None
+        self._shown_load: Load | None = None
         self._written: dict[int, object] = {}
         self._dashboard_at = 0.0
         self._shown_trajectory = None

@@ -86,7 +86,7 @@ class MechanismScene:
         self._sink = sink
         self._flush = flush
         self._sent: dict[str, object] = {}
-        self._drawn = None  # the Snapshot last drawn (a frame is drawn once, whoever asks)
+        self._drawn: Snapshot | None = None  # the snapshot last drawn (a frame is drawn once, whoever asks)
         self.params: Params | None = None
         self.show = dict.fromkeys((*FAMILIES, "region"), True)
         self.slider_bodies: list = [None, None]
@@ -330,8 +330,8 @@ class MechanismScene:
     def _update_forces(self, state: AppState, readout: Readout) -> None:
         tau = readout.forces.tau
         for i in range(2):
-            value = None if tau is None else float(tau[i])
-            visible = self.show["forces"] and value is not None and abs(value) * FORCE_SCALE > 1e-3
+            value = 0.0 if tau is None else float(tau[i])
+            visible = self.show["forces"] and tau is not None and abs(value) * FORCE_SCALE > 1e-3
             self._set(f"force_vis{i}", self.forces[i], "visible", visible)
             if not visible:
                 continue

@@ -50,6 +50,9 @@ class View(Protocol):
 
     closed: bool
     hub: Hub
+
+    def __hash__(self) -> int: ...  # views are dictionary keys (drag queues, presenter sets)
+
     session: Session
     client: Any
     """The tab's ``viser.ClientHandle`` (its own scene, GUI, downloads)."""

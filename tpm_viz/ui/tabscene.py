@@ -41,8 +41,10 @@ class TabScene:
         self.show = dict.fromkeys(FAMILIES, True)
         self.region_hidden = False
         """True while the explorer shows a map on the floor (the workspace region would cover it)."""
-        self._shadows: dict[str, object] = {}  # broadcast node name -> the invisible client frame over it
-        self._cover = None  # the invisible client frame over the shared root while the private copy is shown
+        self._shadows: dict[str, viser.FrameHandle] = {}  # broadcast node name -> the invisible client frame over it
+        self._cover: viser.FrameHandle | None = (
+            None  # the invisible client frame over the shared root while the private copy is shown
+        )
         self._gizmo_at: np.ndarray | None = None
         self.gizmo = self._api.add_transform_controls(
             "/gizmo",

@@ -52,7 +52,8 @@ class Worker:
                     return
                 _key, (fn, done) = self._jobs.popitem(last=False)
                 self._busy = True
-            result, error = None, None
+            result = None
+            error: Exception | None = None  # the TpmVizError refusal, or the bug that was logged
             try:
                 result = fn()
             except TpmVizError as exc:

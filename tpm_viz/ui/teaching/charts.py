@@ -10,6 +10,8 @@ re-sending the (decimated, <= :data:`CHART_POINTS` points) data, which the calle
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import viser
 
@@ -37,14 +39,14 @@ def marker(n: int, k: int | None) -> np.ndarray:
     return out
 
 
-def _series(label: str, colour: str, width: float = 2.0, dash=None) -> dict:
+def _series(label: str, colour: str, width: float = 2.0, dash=None) -> Any:
     s = {"label": label, "stroke": colour, "width": width, "points": {"show": False}}
     if dash is not None:
         s["dash"] = dash
     return s
 
 
-def _marker_series() -> dict:
+def _marker_series() -> Any:
     return {"label": "now", "stroke": MARKER, "width": 2.0, "scale": "c", "points": {"show": False}}
 
 

@@ -127,9 +127,11 @@ class ExplorerView:
         self.kind = "off"
         self.ellipses_on = False
         self._image = None
-        self._image_key = None
-        self._map_drawn = None  # (params, kind) the legend and floor last showed: nothing to send while unchanged
-        self._ellipses: dict[str, object] = {}
+        self._image_key: tuple[Params, str] | None = None
+        self._map_drawn: tuple[Params, str] | None = (
+            None  # (params, kind) the legend and floor last showed: nothing to send while unchanged
+        )
+        self._ellipses: dict[str, viser.LineSegmentsHandle] = {}
         self._frame: Snapshot | None = None
         maps.subscribers.add(self)
 

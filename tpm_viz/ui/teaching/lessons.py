@@ -65,7 +65,7 @@ class DemosView:
         self.runs = runs
         self.explorer = explorer
         self.index = 0
-        self._written = None
+        self._written: str | None = None
 
     def build(self, gui: viser.GuiApi) -> None:
         """The *Demos* tab's widgets (inside the tab's context)."""

@@ -39,8 +39,8 @@ class PathTrace:
 
     def __init__(self, scene: viser.SceneApi) -> None:
         self._scene = scene
-        self.path = None
-        self.trace = None
+        self.path: viser.LineSegmentsHandle | None = None
+        self.trace: viser.LineSegmentsHandle | None = None
 
     def show_run(self, run: Run | None) -> None:
         """Draw the whole path of ``run`` (None hides both nodes)."""
