@@ -38,11 +38,6 @@ def _sub(base: str, index: str) -> str:
     return f"<msub><mi>{base}</mi><mn>{index}</mn></msub>"
 
 
-def _dot(base: str, index: str, dots: int = 1) -> str:
-    accent = "˙" if dots == 1 else "¨"
-    return f'<msub><mover accent="true"><mi>{base}</mi><mo>{accent}</mo></mover><mn>{index}</mn></msub>'
-
-
 def _vec(values, digits: int = 1) -> str:
     rows = "".join(f"<mtr><mtd>{_num(v, digits)}</mtd></mtr>" for v in values)
     return f"<mrow><mo>[</mo><mtable>{rows}</mtable><mo>]</mo></mrow>"

@@ -66,7 +66,6 @@ class Panel:
         self._shown_load: Load | None = None
         self._written: dict[int, object] = {}
         self._dashboard_at = 0.0
-        self._shown_trajectory = None
         stroke_mm = state.params.stroke * 1e3
         self.dashboard = gui.add_html("")
         self.message = gui.add_markdown("")
@@ -139,7 +138,7 @@ class Panel:
 
     def forget(self) -> None:
         """Write every widget again at the next :meth:`show` (after a refused input left the browser's value)."""
-        self._shown_params = self._shown_load = self._shown_trajectory = None
+        self._shown_params = self._shown_load = None
         self._written.clear()
 
     def _put(self, handle, value) -> None:

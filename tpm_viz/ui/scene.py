@@ -17,6 +17,7 @@ import viser
 
 from tpm_viz import meshes
 from tpm_viz.app.overlays import cached_map
+from tpm_viz.app.palette import PALETTE
 from tpm_viz.app.readouts import Readout
 from tpm_viz.app.state import AppState
 from tpm_viz.paper.workspace import direct_singularity_locus, inverse_singularity_loci
@@ -25,28 +26,8 @@ from tpm_viz.ui.snapshot import Snapshot
 
 __all__ = ["COLORS", "FAMILIES", "FORCE_SCALE", "GIZMO_Z", "MechanismScene", "camera_pose"]
 
-COLORS = {
-    "base": (226, 232, 240),
-    "rail": (148, 163, 184),
-    "stop": (71, 85, 105),
-    "slider": (51, 65, 85),
-    "leg1": (13, 148, 136),
-    "leg2": (109, 40, 217),
-    "pin": (30, 41, 59),
-    "platform": (100, 116, 139),
-    "marker": (250, 204, 21),
-    "inverse": (245, 158, 11),
-    "direct": (220, 38, 38),
-    "stroke": (219, 39, 119),
-    "tau_pos": (22, 163, 74),
-    "tau_neg": (220, 38, 38),
-    "load": (71, 85, 105),
-    "circle": (59, 130, 246),
-    "locus_direct": (220, 38, 38),
-    "locus_inverse": (245, 158, 11),
-    "workspace": (34, 197, 94),
-}
-"""RGB colours of the parts, the warning colours (inverse, direct, stroke) and the force arrows."""
+COLORS = PALETTE
+"""RGB colours of the parts, the warning colours and the force arrows (:mod:`tpm_viz.app.palette`)."""
 
 FORCE_SCALE = 1.5e-3
 """Length of a force arrow per newton [m/N] (1.5 mm per N), clipped at :data:`FORCE_MAX`."""

@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 
+from tpm_viz.app.palette import hex_colour
 from tpm_viz.app.readouts import Readout
 from tpm_viz.app.state import AppState
 
@@ -20,14 +21,14 @@ __all__ = ["COLORS_CSS", "banner_level", "dashboard_html", "force_scale", "legen
 DASH = "—"
 
 COLORS_CSS = {
-    "ok": ("#ecfdf5", "#065f46", "#10b981"),
-    "stroke": ("#fdf2f8", "#9d174d", "#db2777"),
-    "inverse": ("#fffbeb", "#92400e", "#f59e0b"),
-    "direct": ("#fef2f2", "#991b1b", "#dc2626"),
+    "ok": ("#ecfdf5", "#065f46", hex_colour("ok")),
+    "stroke": ("#fdf2f8", "#9d174d", hex_colour("stroke")),
+    "inverse": ("#fffbeb", "#92400e", hex_colour("inverse")),
+    "direct": ("#fef2f2", "#991b1b", hex_colour("direct")),
 }
-"""Banner background, text and border colours per level."""
+"""Banner background (a light tint), text (a dark shade) and border (the palette colour) per level."""
 
-TAU_POS, TAU_NEG = "#16a34a", "#dc2626"
+TAU_POS, TAU_NEG = hex_colour("tau_pos"), hex_colour("tau_neg")
 
 
 def num(x, fmt: str = ".1f", scale: float = 1.0) -> str:

@@ -15,15 +15,16 @@ from typing import Any
 import numpy as np
 import viser
 
+from tpm_viz.app.palette import hex_colour
 from tpm_viz.app.runs import Run
 
 __all__ = ["CHART_POINTS", "Charts", "marker"]
 
 CHART_POINTS = 151
 X_LABEL = "time t (s)"
-FORCE_COLOURS = ("#2563eb", "#dc2626")  # τ1, τ2 as in the PNG figures (tab:blue, tab:red)
-LEG_COLOURS = ("#0d9488", "#6d28d9")  # leg 1 teal, leg 2 purple as in the 3D view
-MARKER = "#f59e0b"
+FORCE_COLOURS = (hex_colour("tau1"), hex_colour("tau2"))  # τ1, τ2 as in the PNG figures (blue, red)
+LEG_COLOURS = (hex_colour("leg1"), hex_colour("leg2"))  # leg 1 teal, leg 2 purple as in the 3D view
+MARKER = hex_colour("inverse")
 KINEMATICS = (  # attribute of Run, title, y-axis label, scale SI -> UI
     ("d", "Actuator positions d₁, d₂ (eq. 4)", "position (mm)", 1e3),
     ("dd", "Actuator velocities (eq. 9)", "velocity (mm/s)", 1e3),
