@@ -44,9 +44,16 @@ MAX_ACCEL = 1e5  # m/s²
 
 
 def _moved(state: AppState, move: Move) -> AppState:
-    """``state`` at the move's pose, with its reason; a manual move leaves trajectory playback."""
+    """``state`` at the move's pose, with its reason; a manual move leaves trajectory playback.
+
+    A platform moved by hand is at rest: if its load was a trajectory's sample (``ṗ, p̈`` of the time last played),
+    the load goes back to static (keeping the typed ``f_ext``), so that no stale acceleration is shown. A dynamic
+    load typed by hand stays: it is the question being asked ("what forces at this velocity?")."""
     sample = TrajectorySample("none", state.trajectory.duration, 0.0)
-    return state.replace(pose=move.pose, note=move.reason, trajectory=sample)
+    load = state.load
+    if state.trajectory.kind != "none" and load.mode == "dynamic":
+        load = Load("static", f_ext=load.f_ext)
+    return state.replace(pose=move.pose, note=move.reason, trajectory=sample, load=load)
 
 
 def drag(state: AppState, position) -> AppState:
