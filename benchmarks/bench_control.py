@@ -11,7 +11,7 @@ from __future__ import annotations
 import statistics
 import time
 
-from timing import median_seconds, report
+from timing import median_seconds, p95, report, samples_seconds
 
 import tpm_viz as tv
 from tpm_viz.multibody import model_for
@@ -22,20 +22,6 @@ TARGET = 0.150  # s per simulated second at 1 kHz
 REPEAT = 21
 
 
-def _samples(fn, repeat: int) -> list[float]:
-    out = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t0)
-    return out
-
-
-def _p95(samples: list[float]) -> float:
-    ordered = sorted(samples)
-    return ordered[min(len(ordered) - 1, round(0.95 * (len(ordered) - 1)))]
-
-
 def main() -> None:
     params = tv.Params.paper()
     t0 = time.perf_counter()
@@ -43,15 +29,15 @@ def main() -> None:
     report("first run, 1 s at 1 kHz (cold: builds the Pinocchio model)", time.perf_counter() - t0, None, "ms", 1e3)
     for kind in ("pd", "pdff", "ctc"):
         setup = ControlSetup(controller=kind, payload=1.0, noise=1e-5, force_limit=400.0)
-        samples = _samples(lambda setup=setup: simulate(params, "circle", setup, horizon=1.0), REPEAT)
-        med, p95 = statistics.median(samples), _p95(samples)
+        samples = samples_seconds(lambda setup=setup: simulate(params, "circle", setup, horizon=1.0), REPEAT)
+        med, q95 = statistics.median(samples), p95(samples)
         report(f"{kind}: 1 s of circle + rest at 1 kHz, median", med, TARGET, "ms", 1e3)
-        print(f"{'':<58} p95    {p95 * 1e3:9.2f} ms   ratio to real time {med:.3f} (p95 {p95:.3f})")
+        print(f"{'':<58} p95    {q95 * 1e3:9.2f} ms   ratio to real time {med:.3f} (p95 {q95:.3f})")
     plant = PlatformPlant(model_for(params))
     one = median_seconds(lambda: plant.acceleration(0.02, -0.03, 0.4, 0.2, 50.0, -30.0), repeat=21, inner=500)
     report("plant acceleration p̈(p, ṗ, τ), one call (4 per RK4 step)", one, None, "µs", 1e6)
     fast = ControlSetup(rate=10_000.0)
-    samples = _samples(lambda: simulate(params, "circle", fast), 5)
+    samples = samples_seconds(lambda: simulate(params, "circle", fast), 5)
     report("ctc: circle T = 0.5 s at 10 kHz, median", statistics.median(samples), None, "ms", 1e3)
 
 

@@ -16,7 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository root
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # benchmarks/timing.py
+
+from timing import samples_seconds
 
 from tpm_viz import Params
 from tpm_viz.app import paths
@@ -31,15 +33,6 @@ def _stats(name: str, seconds, target: bool = True) -> None:
         f"  {name:<46} median {np.median(ms):7.2f} ms   p95 {np.percentile(ms, 95):7.2f} ms"
         f"   max {np.max(ms):7.2f} ms   (n={len(ms)}{verdict})"
     )
-
-
-def _times(fn, repeat: int) -> list[float]:
-    out = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t0)
-    return out
 
 
 def main() -> None:
@@ -61,16 +54,19 @@ def main() -> None:
     for kind, path in cases.items():
         _stats(
             f"plan_path {kind} ({path.length * 1e3:.0f} mm)",
-            _times(lambda p=path: planner.plan_path(params, p, limits), repeat),
+            samples_seconds(lambda p=path: planner.plan_path(params, p, limits), repeat),
         )
-    cycle = _times(lambda: planner.plan_cycle(params, cases["pick"], limits), repeat)
+    cycle = samples_seconds(lambda: planner.plan_cycle(params, cases["pick"], limits), repeat)
     _stats("plan_cycle pick (two solves)", cycle, target=False)
     speed = planner.Limits(100.0, speed=1.0, actuator_speed=1.2)
-    _stats("plan_path circle + speed limits", _times(lambda: planner.plan_path(params, cases["circle"], speed), repeat))
+    _stats(
+        "plan_path circle + speed limits",
+        samples_seconds(lambda: planner.plan_path(params, cases["circle"], speed), repeat),
+    )
     for grid in (1000, 3000):
         _stats(
             f"plan_path circle, grid {grid}",
-            _times(lambda g=grid: planner.plan_path(params, cases["circle"], limits, g), max(repeat // 5, 3)),
+            samples_seconds(lambda g=grid: planner.plan_path(params, cases["circle"], limits, g), max(repeat // 5, 3)),
             target=False,
         )
 
