@@ -1,101 +1,391 @@
-"""Strict CSV reading and writing for the command line (numeric columns, SI units).
+"""CSV as spreadsheets write it, read into SI columns; CSV written back losslessly. Rules for users: ``docs/csv.md``.
 
-Reading checks, in this order, and raises :class:`~tpm_viz.errors.InputError` with one line
-naming the problem: empty file, missing column, unknown column, ragged row, non-numeric
-cell, non-finite cell (NaN or inf). Writing uses 17 significant digits (lossless for
-float64) and leaves a cell empty where a value does not exist (e.g. an unreachable pose).
+Reading (the command line and the browser upload share it) is streaming, with stated limits
+(:data:`MAX_ROWS`, :data:`MAX_BYTES`, :data:`MAX_LINE`), and forgives what real files contain: a UTF-8 or UTF-16
+byte-order mark, Windows (cp1252/Latin-1) text, CRLF line ends, Excel's ``sep=;`` first line, comma,
+semicolon or tab delimiters (sniffed from the header), quoted cells, trailing empty columns, blank and ``#``
+comment lines, decimal commas and the other number forms of :func:`tpm_viz.numbers.parse_number`, units in the
+header (``t [s]``, ``p1 (mm)``, ``t_ms``, ``dp1 [mm/s]``) converted to SI, and columns it does not need
+(ignored, whatever they hold). Every refusal is one :class:`~tpm_viz.errors.InputError` line naming the row
+and column, or quoting the header it found.
+
+Writing uses 17 significant digits (lossless for float64) and leaves a cell empty where a value does not exist
+(an unreachable pose). :func:`write_columns` replaces a file atomically (temporary file, then rename).
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import math
+import os
 import sys
-from collections.abc import Mapping, Sequence
+import tempfile
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 
 import numpy as np
 
 from tpm_viz.errors import InputError
+from tpm_viz.numbers import UNITS, parse_number, shorten, unit_factor
 
-__all__ = ["OPTIONAL_COLUMNS", "parse_columns", "read_columns", "read_text", "write_columns"]
+__all__ = [
+    "MAX_BYTES",
+    "MAX_LINE",
+    "MAX_ROWS",
+    "OPTIONAL_COLUMNS",
+    "Table",
+    "decode_text",
+    "format_columns",
+    "parse_columns",
+    "read_columns",
+    "read_text",
+    "time_unit_note",
+    "write_columns",
+]
 
 OPTIONAL_COLUMNS = ("t",)
-"""Columns accepted in any input and passed through to the output (time [s])."""
+"""Columns read when present and passed through to the output (time [s])."""
+MAX_ROWS = 1_000_000
+"""Most data rows in one input (the command line; the upload has its own, smaller limit)."""
+MAX_BYTES = 256 * 1024 * 1024
+"""Largest input [bytes] (256 MiB)."""
+MAX_LINE = 65_536
+"""Longest line of an input [bytes or characters]."""
+CHUNK = 65_536
+"""Rows converted to numbers at a time while reading."""
+DELIMITERS = (";", "\t", ",")
+"""Delimiters sniffed from the header line, in order of preference on a tie."""
+_ALIASES = {"time": "t"}
+_QUANTITIES = "ddp:acceleration ddd:acceleration dp:velocity dd:velocity tau:force theta:angle p:length d:length"
 
 
-def read_columns(path: str, required: Sequence[str]) -> dict[str, np.ndarray]:
-    """Read a CSV file (``-`` for stdin) whose header holds exactly ``required`` (+ optional ``t``)."""
-    return parse_columns(read_text(path), required, source=path)
+class Table(dict):
+    """``{column: float array}`` in SI units, plus ``units``: the unit each column had in the file (``""``: none)."""
+
+    units: dict[str, str]
 
 
-def read_text(path: str) -> str:
-    """The text of a file (``-`` for stdin), BOM-tolerant."""
-    if path == "-":
-        return sys.stdin.read()
-    with open(path, encoding="utf-8-sig") as fh:
-        return fh.read()
+def _quantity(name: str) -> str | None:
+    """The quantity of a known column name (``p1`` length, ``dp1`` velocity, ...), None if unknown."""
+    base = name.split("_", 1)[0]
+    for prefix, quantity in (pair.split(":") for pair in _QUANTITIES.split()):
+        if base.startswith(prefix) and base[len(prefix) :].isdigit():
+            return quantity
+    return "time" if base == "t" else None
 
 
-def parse_columns(text: str, required: Sequence[str], source: str = "input") -> dict[str, np.ndarray]:
-    """Parse CSV text into ``{column: float array}``; see the module docstring for the checks."""
-    rows = [r for r in csv.reader(io.StringIO(text)) if any(cell.strip() for cell in r)]
-    if not rows:
-        raise InputError(f"{source} is empty: expected a header with columns {','.join(required)}")
-    header = [h.strip() for h in rows[0]]
-    missing = [c for c in required if c not in header]
-    if missing:
-        raise InputError(f"{source}: missing column {missing[0]!r} (need {','.join(required)})")
-    unknown = [c for c in header if c not in required and c not in OPTIONAL_COLUMNS]
-    if unknown:
-        raise InputError(f"{source}: unknown column {unknown[0]!r} (expected {','.join(required)})")
-    if len(set(header)) != len(header):
-        raise InputError(f"{source}: a column name appears twice in the header")
-    if len(rows) < 2:
-        raise InputError(f"{source} has a header but no data rows")
-    data = np.empty((len(rows) - 1, len(header)))
-    for r, row in enumerate(rows[1:], start=2):
-        if len(row) != len(header):
-            raise InputError(f"{source}: row {r} has {len(row)} cells, the header has {len(header)}")
-        for k, cell in enumerate(row):
+def _split_header(cell: str) -> tuple[str, str]:
+    """``'t [s]'`` -> ``('t', 's')``; also ``p1 (mm)``, ``p1/mm``, ``t_ms``; the name in lower case."""
+    s = cell.strip().lstrip("\ufeff").strip()
+    name, unit = s, ""
+    if s[-1:] in (")", "]"):
+        i = s.rfind("(" if s[-1] == ")" else "[")
+        if i > 0:
+            name, unit = s[:i].rstrip().rstrip("/"), s[i + 1 : -1]
+    elif "/" in s:
+        name, unit = s.split("/", 1)
+        unit = unit.strip().strip("()[]")
+    elif "_" in s and s.rsplit("_", 1)[1].lower() in UNITS:
+        name, unit = s.rsplit("_", 1)
+    name = name.strip().lower()
+    return _ALIASES.get(name, name), unit.strip()
+
+
+def decode_text(data: bytes, source: str = "input") -> str:
+    """Bytes to text with the reader's rules: BOM (UTF-8/UTF-16), UTF-16 without BOM, UTF-8, else cp1252/Latin-1."""
+    return "".join(_binary_lines(io.BufferedReader(io.BytesIO(data)), source, len(data) + 1))
+
+
+def _binary_lines(raw, source: str, max_bytes: int) -> Iterator[str]:
+    """Decoded lines of a binary stream (see :func:`decode_text`), with the byte and line limits."""
+    head = raw.peek(4)[:4]
+    bom = head[:2] in (b"\xff\xfe", b"\xfe\xff")
+    le = len(head) == 4 and 0 not in (head[0], head[2]) and head[1] == head[3] == 0  # UTF-16-LE without BOM
+    enc = "utf-16" if bom else "utf-16-le" if le else "utf-8"
+    utf16 = enc != "utf-8"
+    errors = "strict" if utf16 else "surrogateescape"  # bytes that are not UTF-8: see _decode_line
+    readline = io.TextIOWrapper(raw, encoding=enc, errors=errors, newline="").readline  # \n, \r\n or \r
+    total, n = 0, 0
+    while True:
+        try:
+            line = readline(MAX_LINE + 1)
+        except UnicodeDecodeError:
+            raise InputError(f"{source}: line {n + 1} is not valid {enc.upper()}; save the file as UTF-8") from None
+        if not line:
+            return
+        n += 1
+        if not line.isascii() and not utf16:
             try:
-                value = float(cell)
-            except ValueError:
-                raise InputError(f"{source}: row {r}, column {header[k]!r}: {cell.strip()!r} is not a number") from None
-            if not math.isfinite(value):
-                raise InputError(f"{source}: row {r}, column {header[k]!r}: {cell.strip()!r} is not finite")
-            data[r - 2, k] = value
-    ordered = [c for c in OPTIONAL_COLUMNS if c in header and c not in required] + list(required)
-    return {c: data[:, header.index(c)] for c in ordered}
+                line.encode("utf-8")
+            except UnicodeEncodeError:
+                line = _decode_line(line.encode("utf-8", "surrogateescape"))
+        total += len(line)
+        if total > max_bytes:
+            raise InputError(f"{source} is larger than {max_bytes // 1048576} MiB (the limit); split the file")
+        if "\x00" in line:
+            raise InputError(f"{source} is not a text CSV file (binary content on line {n})")
+        if len(line) > MAX_LINE:
+            raise InputError(f"{source}: line {n} is longer than {MAX_LINE} characters (the limit)")
+        yield line.lstrip("\ufeff") if n == 1 else line
 
 
-def _cell(x) -> str:
-    if isinstance(x, (str, np.str_)):
-        return str(x)
-    if isinstance(x, (int, np.integer)):
-        return str(int(x))
-    x = float(x)
-    return format(x, ".17g") if math.isfinite(x) else ""
+def _decode_line(b: bytes) -> str:
+    """A line that is not UTF-8: Windows' cp1252, else Latin-1 (only headers hold letters; numbers are ASCII)."""
+    try:
+        return b.decode("cp1252")
+    except UnicodeDecodeError:
+        return b.decode("latin-1")
+
+
+def _open_lines(path: str, max_bytes: int) -> tuple[Iterator[str], object]:
+    """Lines of the file at ``path`` (``-``: stdin), refused at once if a regular file is over ``max_bytes``."""
+    if path == "-":
+        raw = sys.stdin.buffer
+        fh = None
+    else:
+        raw = fh = open(path, "rb")
+        try:
+            if raw.seekable() and raw.seek(0, 2) > max_bytes:
+                raise InputError(
+                    f"{path} is {raw.tell() // 1048576} MiB; inputs are limited to {max_bytes // 1048576} MiB"
+                )
+            raw.seek(0)
+        except BaseException:
+            fh.close()
+            raise
+    return _binary_lines(raw, "stdin" if path == "-" else path, max_bytes), fh
+
+
+def read_text(path: str, max_bytes: int = MAX_BYTES) -> str:
+    """The text of a file (``-`` for stdin) with the reader's decoding rules and size limit."""
+    lines, fh = _open_lines(path, max_bytes)
+    try:
+        return "".join(lines)
+    finally:
+        if fh is not None:
+            fh.close()
+
+
+def read_columns(path: str, required: Sequence[str], max_rows: int = MAX_ROWS, max_bytes: int = MAX_BYTES) -> Table:
+    """Read a CSV file (``-`` for stdin), streaming, into SI columns ``required`` (+ ``t`` if present)."""
+    lines, fh = _open_lines(path, max_bytes)
+    try:
+        return parse_lines(lines, required, source="stdin" if path == "-" else path, max_rows=max_rows)
+    finally:
+        if fh is not None:
+            fh.close()
+
+
+def parse_columns(text: str, required: Sequence[str], source: str = "input", max_rows: int = MAX_ROWS) -> Table:
+    """Parse CSV text into SI columns ``required`` (+ ``t`` if present); rules in the module docstring."""
+    return parse_lines(_text_lines(text, source), required, source, max_rows)
+
+
+def _text_lines(text: str, source: str) -> Iterator[str]:
+    for n, line in enumerate(io.StringIO(text, newline=""), start=1):
+        if len(line) > MAX_LINE:
+            raise InputError(f"{source}: line {n} is longer than {MAX_LINE} characters (the limit)")
+        yield line.lstrip("\ufeff") if n == 1 else line
+
+
+def _sniff(line: str) -> str:
+    counts = [line.count(d) for d in DELIMITERS]
+    best = max(counts)
+    return DELIMITERS[counts.index(best)] if best else ","
+
+
+def parse_lines(
+    lines: Iterable[str], required: Sequence[str], source: str = "input", max_rows: int = MAX_ROWS
+) -> Table:
+    """The streaming core of :func:`parse_columns` and :func:`read_columns` (``lines`` keep their line ends)."""
+    lines = iter(lines)
+    delimiter, skipped, header_line = None, 0, None
+    for line in lines:
+        skipped += 1
+        s = line.strip()
+        if not s or s.startswith("#"):
+            continue
+        if s.lower().startswith("sep=") and delimiter is None and len(s) == 5:
+            delimiter = s[4]
+            continue
+        header_line = line.lstrip("\ufeff")
+        break
+    need = ",".join(required)
+    if header_line is None:
+        raise InputError(f"{source} is empty: expected a header with columns {need}")
+    delimiter = delimiter or _sniff(header_line)
+
+    def chained() -> Iterator[str]:
+        yield header_line
+        yield from lines
+
+    reader = csv.reader(chained(), delimiter=delimiter)
+    try:
+        return _read_records(reader, required, source, max_rows, skipped - 1, header_line)
+    except csv.Error as exc:
+        raise InputError(f"{source}: line {skipped - 1 + reader.line_num}: not valid CSV ({exc})") from None
+
+
+def _read_records(reader, required, source, max_rows, offset, header_line) -> Table:
+    raw_header = next(reader)
+    while raw_header and not raw_header[-1].strip():
+        raw_header.pop()  # trailing empty columns (spreadsheets)
+    shown = shorten(header_line.strip(), 80)
+    names: dict[str, int] = {}
+    units: dict[str, str] = {}
+    for j, cell in enumerate(raw_header):
+        if not cell.strip():
+            continue
+        name, unit = _split_header(cell)
+        if name in names and name in (*required, *OPTIONAL_COLUMNS):
+            raise InputError(f"{source}: column {name!r} appears twice in the header {shown}")
+        names.setdefault(name, j)
+        units.setdefault(name, unit)
+    missing = [c for c in required if c not in names]
+    if missing:
+        raise InputError(f"{source}: missing column {missing[0]!r} (need {','.join(required)}); found header {shown}")
+    used = [c for c in OPTIONAL_COLUMNS if c in names and c not in required] + list(required)
+    idx = [names[c] for c in used]
+    factors = [
+        unit_factor(units[c], _quantity(c), f"{source}: column {shorten(raw_header[names[c]])}", c) for c in used
+    ]
+    width = len(raw_header)
+    chunks: list[np.ndarray] = []
+    buf: list[list[str]] = []
+    where: list[int] = []
+    for row in reader:
+        line = offset + reader.line_num
+        if len(row) != width or not row[0] or row[0][0] in "# \t":  # else: the common case, fast
+            if not row or row[0].lstrip().startswith("#") or not any(c.strip() for c in row):
+                continue  # blank and comment lines
+            if len(row) < width or any(c.strip() for c in row[width:]):
+                raise InputError(f"{source}: row {line} has {len(row)} cells, the header has {width}")
+        buf.append(row)
+        where.append(line)
+        if len(where) + CHUNK * len(chunks) > max_rows:
+            raise InputError(f"{source} has more than {max_rows} data rows (the limit); split the file")
+        if len(buf) == CHUNK:
+            chunks.append(_numbers(buf, where, used, idx, source))
+            buf, where = [], []
+    if buf or not chunks:
+        chunks.append(_numbers(buf, where, used, idx, source))
+    data = np.concatenate(chunks)
+    if len(data) == 0:
+        raise InputError(f"{source} has a header but no data rows")
+    table = Table()
+    for k, (c, (mul, div)) in enumerate(zip(used, factors, strict=True)):
+        col = data[:, k]
+        if div != 1.0:
+            col = col / div
+        table[c] = col * mul if mul != 1.0 else col.copy()
+    table.units = {c: units[c] for c in used}
+    return table
+
+
+def _numbers(rows: list[list[str]], where: list[int], used, idx, source: str) -> np.ndarray:
+    """The used cells of ``rows`` as floats ``(len(rows), len(used))``; one-line errors name row and column."""
+    data = np.empty((len(rows), len(used)))
+    for k, (c, j) in enumerate(zip(used, idx, strict=True)):
+        cells = [r[j] for r in rows]
+        try:
+            data[:, k] = list(map(float, cells))
+        except ValueError:
+            data[:, k] = [
+                parse_number(x, f"{source}: row {n}, column {c!r}") for x, n in zip(cells, where, strict=True)
+            ]
+        bad = ~np.isfinite(data[:, k])
+        if np.any(bad):
+            r = int(np.argmax(bad))
+            what = "is not finite" if any(w in cells[r].lower() for w in ("nan", "inf")) else "is too large"
+            raise InputError(f"{source}: row {where[r]}, column {c!r}: {shorten(cells[r].strip())} {what}")
+    return data
+
+
+def time_unit_note(table: Mapping[str, np.ndarray]) -> str | None:
+    """A one-line hint when a ``t`` column without unit looks like milliseconds (spans 100 s in steps of >= 1 s)."""
+    t = table.get("t")
+    if t is None or getattr(table, "units", {}).get("t") or len(t) < 2:
+        return None
+    span, step = float(t[-1] - t[0]), float(np.median(np.diff(t)))
+    if span >= 100.0 and step >= 1.0:
+        return (
+            f"note: t spans {span:g} s in steps of {step:g} s; if the times are in milliseconds, "
+            "name the column t_ms or 't [ms]'"
+        )
+    return None
 
 
 def format_columns(columns: Mapping[str, np.ndarray]) -> str:
     """Equal-length columns as CSV text (header line, then one line per row), as :func:`write_columns` writes."""
-    names = list(columns)
-    n = len(next(iter(columns.values())))
     out = io.StringIO()
-    writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(names)
-    cols = [columns[c] for c in names]
-    for r in range(n):
-        writer.writerow([_cell(col[r]) for col in cols])
+    write_csv(out, columns)
     return out.getvalue()
 
 
+def _strings(col) -> list[str]:
+    arr = np.asarray(col)
+    if arr.dtype.kind in "biu":
+        return list(map(str, arr.astype(np.int64).tolist()))
+    if arr.dtype.kind == "f":
+        values = arr.tolist()
+        text = list(map("{:.17g}".format, values))
+        if not np.all(np.isfinite(arr)):
+            text = [t if math.isfinite(v) else "" for t, v in zip(text, values, strict=True)]
+        return text
+    return [str(x) for x in arr.tolist()]
+
+
+def write_csv(fh, columns: Mapping[str, np.ndarray]) -> None:
+    """Write equal-length columns as CSV to the text file object ``fh`` (in chunks of rows)."""
+    names = list(columns)
+    n = len(next(iter(columns.values())))
+    writer = csv.writer(fh, lineterminator="\n")
+    writer.writerow(names)
+    cols = [columns[c] for c in names]
+    for start in range(0, n, CHUNK):
+        writer.writerows(zip(*(_strings(col[start : start + CHUNK]) for col in cols), strict=True))
+
+
 def write_columns(path: str | None, columns: Mapping[str, np.ndarray]) -> None:
-    """Write equal-length columns as CSV to ``path`` (stdout when ``None`` or ``-``)."""
-    text = format_columns(columns)
+    """Write columns as CSV to ``path`` (stdout when None or ``-``), atomically: a temporary file in the same
+    directory, renamed over ``path`` once complete, so that a failure leaves any previous file as it was.
+
+    The permissions of an existing file are kept and a symbolic link is followed; a path that is not a regular
+    file (``/dev/null``, a FIFO) is written directly. An ``OSError`` names ``path``, not the temporary file.
+    """
     if path in (None, "-"):
-        sys.stdout.write(text)
-    else:
-        with open(path, "w", encoding="utf-8", newline="") as fh:
-            fh.write(text)
+        write_csv(sys.stdout, columns)
+        return
+    try:
+        _write_atomic(os.path.realpath(path), columns)
+    except OSError as exc:
+        if exc.filename != path:  # disk full names no file, a missing directory the temporary one
+            raise OSError(exc.errno, exc.strerror, path) from None
+        raise
+
+
+def _write_atomic(target: str, columns: Mapping[str, np.ndarray]) -> None:
+    if os.path.exists(target) and not os.path.isfile(target):
+        with open(target, "w", encoding="utf-8", newline="") as fh:
+            write_csv(fh, columns)
+        return
+    directory, name = os.path.split(target)
+    fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".tmp", dir=directory)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
+            write_csv(fh, columns)
+            fh.flush()
+            os.fsync(fh.fileno())
+        try:
+            mode = os.stat(target).st_mode & 0o7777
+        except FileNotFoundError:
+            umask = os.umask(0)
+            os.umask(umask)
+            mode = 0o666 & ~umask
+        os.chmod(tmp, mode)
+        os.replace(tmp, target)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise

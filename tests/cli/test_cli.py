@@ -93,7 +93,7 @@ def test_trajectory_from_a_users_csv_matches_the_paper_circle(tmp_path):
     [
         (["kinematics"], "", "is empty"),
         (["kinematics"], "p1\n0\n", "missing column 'p2'"),
-        (["kinematics"], "p1,p2,p3\n0,0,0\n", "unknown column 'p3'"),
+        (["kinematics"], "p1,p2,p1 [mm]\n0,0,0\n", "'p1' appears twice"),  # extra columns are ignored (issue 13)
         (["kinematics"], "p1,p2\n0,zero\n", "'zero' is not a number"),
         (["kinematics"], "p1,p2\n0,nan\n", "'nan' is not finite"),
         (["dynamics"], "p1,p2,dp1,dp2,ddp1,ddp2\n0.3,0,0,0,0,0\n", "unreachable"),

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import tpm_viz as tv
+from tests.support.cli import parser_for
 from tpm_viz.cli import multibody as cli_multibody
 
 P = tv.Params.paper()
@@ -28,11 +29,7 @@ def table(text: str) -> dict[str, np.ndarray]:
 
 
 def plain_parser() -> argparse.ArgumentParser:
-    common = argparse.ArgumentParser(add_help=False)
-    common.add_argument("--set", action="append", metavar="NAME=VALUE")
-    parser = argparse.ArgumentParser(prog="tpm-viz")
-    cli_multibody.register(parser.add_subparsers(dest="command", required=True), common)
-    return parser
+    return parser_for(cli_multibody)
 
 
 def test_register_works_on_a_plain_argparse_parser(tmp_path):

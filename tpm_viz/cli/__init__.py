@@ -4,7 +4,10 @@ One module per family of subcommands, each with a ``register(subparsers, common)
 
 - :mod:`.paper`: ``kinematics``, ``dynamics``, ``trajectory`` (the paper's closed form);
 - :mod:`.multibody`: ``replay``, ``crosscheck``, ``figures`` (the Pinocchio model);
-- :mod:`.serve`: ``serve`` (the browser app).
+- :mod:`.serve`: ``serve`` (the browser app);
+- :mod:`.plan`: ``plan`` (minimum-time timing within force limits) and ``size`` (the motors a motion needs);
+- :mod:`.control`: ``control`` (a controller tracking a trajectory on the Pinocchio plant);
+- :mod:`.export`: ``export`` (the model as MJCF or URDF).
 
 Import rule (checked by ``tests/test_layering.py``): the command line may import every layer and nothing imports
 it (except ``__main__``).
@@ -12,10 +15,11 @@ it (except ``__main__``).
 
 from __future__ import annotations
 
+import csv
 import sys
 
-from tpm_viz.cli import multibody, paper, serve
-from tpm_viz.cli.common import Parser, common_parent, params_from_args
+from tpm_viz.cli import control, export, multibody, paper, plan, serve
+from tpm_viz.cli.common import Parser, common_parent, one_line, params_from_args
 from tpm_viz.errors import TpmVizError
 
 __all__ = ["build_parser", "main", "params_from_args"]
@@ -26,7 +30,7 @@ def build_parser() -> Parser:
     parser = Parser(prog="tpm-viz", description=(__doc__ or "").splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
     common = common_parent()
-    for family in (paper, serve, multibody):
+    for family in (paper, serve, multibody, control, plan, export):
         family.register(sub, common)
     return parser
 
@@ -37,10 +41,22 @@ def main(argv: list[str] | None = None) -> int:
         args = build_parser().parse_args(argv)
         return int(args.func(args) or 0)
     except TpmVizError as exc:
-        print(f"tpm-viz: error: {exc}", file=sys.stderr)
+        print(f"tpm-viz: error: {one_line(exc)}", file=sys.stderr)
         return 2
     except OSError as exc:
-        print(f"tpm-viz: error: {exc.strerror or exc}: {exc.filename or ''}".rstrip(": "), file=sys.stderr)
+        print(one_line(f"tpm-viz: error: {exc.strerror or exc}: {exc.filename or ''}".rstrip(": ")), file=sys.stderr)
+        return 2
+    except UnicodeDecodeError as exc:
+        print(
+            f"tpm-viz: error: the input is not text in a known encoding (save it as UTF-8): {exc.reason}",
+            file=sys.stderr,
+        )
+        return 2
+    except (OverflowError, csv.Error) as exc:
+        print(one_line(f"tpm-viz: error: a number or a CSV cell is out of range: {exc}"), file=sys.stderr)
+        return 2
+    except MemoryError:
+        print("tpm-viz: error: out of memory: the input is too large; split it", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         return 130

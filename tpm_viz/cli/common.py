@@ -1,23 +1,54 @@
-"""What every ``tpm-viz`` subcommand shares: the one-line-error parser, ``--set NAME=VALUE`` and number checks."""
+"""What every ``tpm-viz`` subcommand shares: the one-line-error parser, ``--set NAME=VALUE``, number checks,
+and the output file: never the input (:func:`check_output`), written atomically (:func:`write_output`).
+"""
 
 from __future__ import annotations
 
 import argparse
 import math
+import os
+import sys
+from collections.abc import Mapping
 
 import numpy as np
 
+from tpm_viz.csvio import write_columns
 from tpm_viz.errors import InputError
+from tpm_viz.numbers import parse_number
 from tpm_viz.params import PARAM_INFO, Params
 
-__all__ = ["Parser", "common_parent", "params_from_args", "positive", "positive_float"]
+__all__ = [
+    "MAX_MESSAGE",
+    "MAX_SECONDS",
+    "MIN_SECONDS",
+    "Parser",
+    "check_output",
+    "common_parent",
+    "one_line",
+    "params_from_args",
+    "port_number",
+    "positive",
+    "positive_float",
+    "write_output",
+]
+
+MAX_MESSAGE = 300
+"""Longest error message printed [characters] (a huge cell or argument is cut, never echoed whole)."""
+MIN_SECONDS, MAX_SECONDS = 1e-9, 1e6
+"""Bounds of every duration and time step on the command line [s]."""
+
+
+def one_line(message: str) -> str:
+    """``message`` on one line, cut to :data:`MAX_MESSAGE` characters."""
+    text = " ".join(str(message).split())
+    return text if len(text) <= MAX_MESSAGE else text[: MAX_MESSAGE - 3] + "..."
 
 
 class Parser(argparse.ArgumentParser):
     """An argparse parser whose usage errors are one line and exit status 2."""
 
     def error(self, message: str):  # pragma: no cover - exercised through main()
-        raise InputError(f"{self.prog}: {message}")
+        raise InputError(one_line(f"{self.prog}: {message}"))
 
 
 def common_parent() -> argparse.ArgumentParser:
@@ -40,7 +71,9 @@ def params_from_args(args: argparse.Namespace) -> Params:
         name, sep, value = item.partition("=")
         if not sep:
             raise InputError(f"--set expects NAME=VALUE, got {item!r}")
-        overrides[name.strip()] = value.strip()
+        name = name.strip()
+        info = PARAM_INFO.get(name)
+        overrides[name] = parse_number(value, name, info.get("unit", "")) if info else value.strip()
     return Params.paper().with_overrides(overrides)
 
 
@@ -52,11 +85,62 @@ def positive(value: float | None, name: str) -> float | None:
 
 
 def positive_float(text: str) -> float:
-    """argparse type: a positive, finite number of seconds."""
+    """argparse type: a number of seconds from :data:`MIN_SECONDS` to :data:`MAX_SECONDS` (numbers as typed:
+    ``2e-1``, ``0,2``; :func:`tpm_viz.numbers.parse_number`)."""
     try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
-    if not np.isfinite(value) or value <= 0:
-        raise argparse.ArgumentTypeError(f"expected a positive, finite number of seconds, got {text!r}")
+        value = parse_number(text, "value", "s")
+    except InputError as exc:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds: {exc}") from None
+    if not MIN_SECONDS <= value <= MAX_SECONDS:
+        raise argparse.ArgumentTypeError(
+            f"expected a positive number of seconds from {MIN_SECONDS:g} to {MAX_SECONDS:g}, got {value:g}"
+        )
     return value
+
+
+def port_number(text: str) -> int:
+    """argparse type: a TCP port from 0 to 65535 (0: any free port)."""
+    try:
+        value = int(text.strip())
+    except ValueError:
+        raise argparse.ArgumentTypeError("expected a whole number from 0 to 65535") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"expected a port from 0 to 65535, got {value}")
+    return value
+
+
+def _same_file(a: os.stat_result, b: os.stat_result) -> bool:
+    return (a.st_dev, a.st_ino) == (b.st_dev, b.st_ino)
+
+
+def check_output(output: str | None, input_path: str | None) -> None:
+    """Refuse an ``--output`` that is the ``--input`` file (the same file by any path or link, or the file that
+    stdin reads when ``--input -``)."""
+    if output in (None, "-") or input_path is None:
+        return
+    try:
+        out = os.stat(output)
+        if input_path == "-":
+            src = os.fstat(sys.stdin.fileno())
+            if not os.path.isfile(output) or not _same_file(out, src):
+                return
+        else:
+            src = os.stat(input_path)
+    except (OSError, ValueError):  # output does not exist yet (or no stdin): cannot be the input
+        return
+    if _same_file(out, src):
+        raise InputError(f"--output {output!r} is the input file; write to another file (the input is kept)")
+
+
+def write_output(path: str | None, columns: Mapping[str, np.ndarray]) -> None:
+    """:func:`tpm_viz.csvio.write_columns` (atomic replacement of ``path``), and a quiet exit with status 141
+    when the reader of stdout goes away (``tpm-viz ... | head``), as other Unix tools do."""
+    if path not in (None, "-"):
+        write_columns(path, columns)
+        return
+    try:
+        write_columns(None, columns)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        raise SystemExit(141) from None

@@ -1,18 +1,19 @@
 """``tpm-viz replay | crosscheck | figures``: the Pinocchio model on the command line.
 
-:func:`register` adds the subcommands to the ``tpm-viz`` parser (:mod:`tpm_viz.cli`). The heavy layers (Pinocchio, matplotlib) are imported by
-the handler that runs, so that the file commands start fast (``tests/test_layering.py``). Handlers return
-the exit status and raise :class:`~tpm_viz.errors.TpmVizError` for bad input (``cli.main`` prints
-one line and exits with 2).
+:func:`register` adds the subcommands to the ``tpm-viz`` parser (:mod:`tpm_viz.cli`). The heavy layers
+(Pinocchio, matplotlib) are imported by the handler that runs, so that the file commands start fast
+(``tests/test_layering.py``). Handlers return the exit status and raise :class:`~tpm_viz.errors.TpmVizError` for
+bad input (``cli.main`` prints one line and exits with 2). Durations and steps: 1e-9 to 1e6 s; the CSV output is
+replaced atomically (:func:`tpm_viz.cli.common.write_output`).
 """
 
 from __future__ import annotations
 
 import argparse
+import pathlib
 import sys
 
-from tpm_viz.cli.common import params_from_args, positive
-from tpm_viz.csvio import write_columns
+from tpm_viz.cli.common import params_from_args, positive, positive_float, write_output
 from tpm_viz.errors import InputError
 
 __all__ = ["REPLAY_COLUMNS", "register"]
@@ -31,7 +32,7 @@ def _cmd_replay(args) -> int:
         cols[f"p1_{name}"], cols[f"p2_{name}"] = arr[:, 0], arr[:, 1]
     cols["tau1"], cols["tau2"] = res.tau[:, 0], res.tau[:, 1]
     cols["constraint_violation"] = res.constraint_violation
-    write_columns(args.output, cols)
+    write_output(args.output, cols)
     return 0
 
 
@@ -60,21 +61,25 @@ def _cmd_crosscheck(args) -> int:
 
 
 def _cmd_figures(args) -> int:
-    from tpm_viz.figures import write_paper_figures  # matplotlib and the Pinocchio model
+    from tpm_viz.figures import FILE_NAMES, plot_forces  # matplotlib
+    from tpm_viz.multibody.crosscheck import compare_forces  # the Pinocchio model
 
     params = params_from_args(args)
     if args.samples < 2:
         raise InputError(f"--samples must be at least 2, got {args.samples}")
+    durations = {
+        "line": positive(args.duration_line, "--duration-line"),
+        "circle": positive(args.duration_circle, "--duration-circle"),
+    }
+    out = pathlib.Path(args.output_dir)
     try:
-        paths = write_paper_figures(
-            params,
-            args.output_dir,
-            positive(args.duration_line, "--duration-line"),
-            positive(args.duration_circle, "--duration-circle"),
-            args.samples,
-        )
+        out.mkdir(parents=True, exist_ok=True)
     except (FileExistsError, NotADirectoryError) as exc:
         raise InputError(f"cannot write into --output-dir {args.output_dir!r}: {exc.strerror}") from None
+    paths = [
+        plot_forces(compare_forces(params, kind, duration, args.samples), out / FILE_NAMES[kind])
+        for kind, duration in durations.items()
+    ]
     for path in paths:
         print(path, file=sys.stdout)
     return 0
@@ -93,8 +98,8 @@ def register(subparsers, common_parent: argparse.ArgumentParser) -> None:
         "Pinocchio closed-loop model and integrate; CSV columns " + ",".join(REPLAY_COLUMNS) + " (SI).",
     )
     r.add_argument("--trajectory", required=True, choices=["line", "circle"], help="the paper's Fig. 4 or Fig. 5 path")
-    r.add_argument("--duration", type=float, metavar="T", help="duration [s] (default: line 0.2, circle 0.5)")
-    r.add_argument("--dt", type=float, help="RK4 step [s] (default: 0.001 s or duration / 200 if smaller)")
+    r.add_argument("--duration", type=positive_float, metavar="T", help="duration [s] (default: line 0.2, circle 0.5)")
+    r.add_argument("--dt", type=positive_float, help="RK4 step [s] (default: 0.001 s or duration / 200 if smaller)")
     r.add_argument("--output", help="output CSV (default: stdout)")
     r.set_defaults(func=_cmd_replay)
 
@@ -103,11 +108,11 @@ def register(subparsers, common_parent: argparse.ArgumentParser) -> None:
         parents=[common_parent],
         help="paper closed form vs Pinocchio: forces, replay tracking, closures (exit 1 on failure)",
     )
-    c.add_argument("--duration-line", type=float, metavar="T", help="line duration [s] (default 0.2)")
-    c.add_argument("--duration-circle", type=float, metavar="T", help="circle duration [s] (default 0.5)")
+    c.add_argument("--duration-line", type=positive_float, metavar="T", help="line duration [s] (default 0.2)")
+    c.add_argument("--duration-circle", type=positive_float, metavar="T", help="circle duration [s] (default 0.5)")
     c.add_argument("--random", type=int, default=200, metavar="N", help="number of random regular states (200)")
     c.add_argument("--seed", type=int, default=0, help="seed of the random states (0)")
-    c.add_argument("--dt", type=float, help="RK4 step of the replays [s] (0.001 or duration / 200)")
+    c.add_argument("--dt", type=positive_float, help="RK4 step of the replays [s] (0.001 or duration / 200)")
     c.add_argument("--rel-tol", type=float, default=1e-9, help="tolerance on |Δτ|/(1 N + |τ|) (1e-9)")
     c.add_argument("--tracking-tol", type=float, default=0.1, metavar="MM", help="replay tracking [mm] (0.1)")
     c.add_argument("--violation-tol", type=float, default=1e-6, metavar="M", help="closure gap [m] (1e-6)")
@@ -119,7 +124,7 @@ def register(subparsers, common_parent: argparse.ArgumentParser) -> None:
         help="PNG plots of the paper's Figs. 4-5: forces by both models and their difference",
     )
     f.add_argument("--output-dir", required=True, metavar="DIR", help="directory for fig4_line.png, fig5_circle.png")
-    f.add_argument("--duration-line", type=float, metavar="T", help="line duration [s] (default 0.2)")
-    f.add_argument("--duration-circle", type=float, metavar="T", help="circle duration [s] (default 0.5)")
+    f.add_argument("--duration-line", type=positive_float, metavar="T", help="line duration [s] (default 0.2)")
+    f.add_argument("--duration-circle", type=positive_float, metavar="T", help="circle duration [s] (default 0.5)")
     f.add_argument("--samples", type=int, default=201, help="samples per trajectory (201)")
     f.set_defaults(func=_cmd_figures)

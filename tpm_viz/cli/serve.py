@@ -2,27 +2,112 @@
 
 The UI layer (viser, trimesh: ~1.5 s to import) is imported when the command runs, not when the parser is built,
 so that ``tpm-viz kinematics`` and the other file commands start in a fraction of that.
+
+Before the app starts, :func:`check_bind` binds a socket to ``(host, port)`` once: a port outside 0..65535 is
+refused by the parser, and a host that is not an address of this machine (or cannot be resolved within
+:data:`RESOLVE_SECONDS`) fails at once with one line, instead of a server that never prints its URL.
+A busy port is fine: the app moves to the next free one.
 """
 
 from __future__ import annotations
 
 import argparse
+import errno
+import socket
+import threading
+from pathlib import Path
 
-__all__ = ["register"]
+from tpm_viz.cli.common import port_number
+from tpm_viz.errors import InputError
+from tpm_viz.numbers import shorten
+
+__all__ = ["RESOLVE_SECONDS", "check_bind", "register"]
+
+RESOLVE_SECONDS = 4.0
+"""Longest wait for the host name to resolve [s]."""
+
+
+def _resolve(host: str, port: int) -> list:
+    result: list = []
+
+    def work() -> None:
+        try:
+            result.append(socket.getaddrinfo(host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE))
+        except (OSError, UnicodeError) as exc:
+            result.append(exc)
+
+    thread = threading.Thread(target=work, daemon=True)
+    thread.start()
+    thread.join(RESOLVE_SECONDS)
+    if not result:
+        raise InputError(f"--host {shorten(host)} did not resolve within {RESOLVE_SECONDS:g} s")
+    if isinstance(result[0], BaseException):
+        raise InputError(f"--host {shorten(host)} is not a known address or name of this machine")
+    return result[0]
+
+
+def check_bind(host: str, port: int) -> None:
+    """One bind to ``(host, port)`` and close; one-line :class:`InputError` if this machine cannot serve there."""
+    family, kind, proto, _, address = _resolve(host, port)[0]
+    with socket.socket(family, kind, proto) as sock:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            sock.bind(address)
+        except OSError as exc:
+            if exc.errno == errno.EADDRINUSE:
+                return  # the app takes the next free port
+            if exc.errno == errno.EADDRNOTAVAIL:
+                raise InputError(
+                    f"--host {shorten(host)} is not an address of this machine; use 127.0.0.1 (this machine only) "
+                    "or 0.0.0.0 (all its addresses)"
+                ) from None
+            raise InputError(f"cannot serve on {shorten(host)} port {port}: {exc.strerror or exc}") from None
 
 
 def _cmd_serve(args) -> int:
+    host = args.host if args.host is not None else "0.0.0.0" if args.classroom else "127.0.0.1"
+    check_bind(host, args.port)
     from tpm_viz.ui.app import main as serve  # start-up speed of the other commands (module docstring)
+    from tpm_viz.ui.continuity import default_path
 
-    serve(host=args.host, port=args.port, presenter_token=args.presenter_token)
+    serve(
+        host=host,
+        port=args.port,
+        presenter_token=args.presenter_token,
+        classroom=args.classroom,
+        session=args.session if args.session is not None else default_path(),
+        fresh=args.fresh,
+    )
     return 0
 
 
 def register(sub, common: argparse.ArgumentParser) -> None:
     """Add ``serve`` to the ``tpm-viz`` subparsers (``common`` is unused: the app edits parameters itself)."""
     s = sub.add_parser("serve", help="start the browser app")
-    s.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1, loopback only)")
-    s.add_argument("--port", type=int, default=8080, help="port (default 8080; the next free one if busy)")
+    s.add_argument(
+        "--host",
+        default=None,
+        help="address to bind (default 127.0.0.1, loopback only; 0.0.0.0 with --classroom: every network address)",
+    )
+    s.add_argument(
+        "--classroom",
+        action="store_true",
+        help="serve the room's network: print the URLs and a QR code for students; only the presenter (a tab on "
+        "this computer, or another device with the printed token) changes the shared mechanism",
+    )
+    s.add_argument(
+        "--session",
+        type=Path,
+        metavar="FILE",
+        help="session file: read at start, saved on every change (default: session.json in the user data folder)",
+    )
+    s.add_argument("--fresh", action="store_true", help="start with the defaults (the session file is overwritten)")
+    s.add_argument(
+        "--port",
+        type=port_number,
+        default=8080,
+        help="port 0-65535 (default 8080; the next free one if busy; 0: any free port)",
+    )
     s.add_argument(
         "--presenter-token",
         metavar="TOKEN",

@@ -1,6 +1,6 @@
 """Platform trajectories: the paper's cubic line and circle (Figs. 4-5) and users' CSV paths.
 
-Time law (``conventions.md``): the path parameter follows the cubic polynomial
+Time law (``docs/conventions.md``): the path parameter follows the cubic polynomial
 ``s(τ) = 3τ² - 2τ³`` with ``τ = t / T``, so velocity is zero at both ends.
 
 - Line (Fig. 4): from (-100, -50) mm to (+100, +50) mm, default ``T = 0.2 s``.
@@ -36,13 +36,15 @@ __all__ = [
 ]
 
 DEFAULT_DURATIONS = {"line": 0.2, "circle": 0.5}
-"""Default durations [s] of the paper's trajectories (``conventions.md``)."""
+"""Default durations [s] of the paper's trajectories (``docs/conventions.md``)."""
 
 LINE_START = (-0.100, -0.050)
 LINE_END = (0.100, 0.050)
 CIRCLE_CENTRE = (0.0, 0.0)
 CIRCLE_RADIUS = 0.100
 MAX_SAMPLES = 1_000_000
+MAX_CSV_ROWS = 100_000
+"""Most data rows in a trajectory CSV (a natural cubic spline through them)."""
 
 
 @dataclass(frozen=True)
@@ -146,9 +148,8 @@ def trajectory_from_samples(t, p, name: str = "custom") -> Trajectory:
     return Trajectory(name, t0, p.copy(), spline(t, 1), spline(t, 2))
 
 
-def parse_trajectory_csv(text: str, name: str = "custom", max_rows: int = 100_000) -> Trajectory:
-    """A trajectory from CSV text with header columns ``t,p1,p2`` (s, m, m); one-line errors."""
-    if text.count("\n") > max_rows + 1:
-        raise InputError(f"the trajectory CSV has more than {max_rows} rows")
-    cols = parse_columns(text, ["t", "p1", "p2"], source="the trajectory CSV")
+def parse_trajectory_csv(text: str, name: str = "custom", max_rows: int = MAX_CSV_ROWS) -> Trajectory:
+    """A trajectory from CSV text with columns ``t,p1,p2`` (s, m, m unless the header gives units, ``t [ms]``);
+    the dialects and limits of :mod:`tpm_viz.csvio` (``docs/csv.md``); one-line errors."""
+    cols = parse_columns(text, ["t", "p1", "p2"], source="the trajectory CSV", max_rows=max_rows)
     return trajectory_from_samples(cols["t"], np.stack([cols["p1"], cols["p2"]], -1), name)

@@ -1,0 +1,98 @@
+"""``tpm-viz export --format mjcf|urdf --output FILE``: the mechanism as a model file for other tools.
+
+:func:`register` adds the subcommand to the ``tpm-viz`` parser (:mod:`tpm_viz.cli`). The text comes from
+:mod:`tpm_viz.exchange` (no MuJoCo or Pinocchio needed to write it). The file is written atomically: a
+temporary file in the same directory, then ``os.replace``, so a reader never sees half a model. ``--output -``
+prints to stdout. The handler returns the exit status and raises :class:`~tpm_viz.errors.TpmVizError` for bad
+input (``cli.main`` prints one line and exits with 2).
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import dataclasses
+import os
+import sys
+import tempfile
+
+from tpm_viz.cli.common import params_from_args, positive
+from tpm_viz.errors import InputError
+
+__all__ = ["FORMATS", "register", "write_atomically"]
+
+FORMATS = ("mjcf", "urdf")
+"""Export formats: MJCF (MuJoCo, Pinocchio's MJCF reader) and URDF."""
+
+
+def _file_mode(path: str) -> int:
+    """The existing file's permission bits, or ``0o666`` less the process umask for a new file."""
+    try:
+        return os.stat(path).st_mode & 0o777
+    except FileNotFoundError:
+        umask = os.umask(0)
+        os.umask(umask)
+        return 0o666 & ~umask
+
+
+def write_atomically(path: str, text: str) -> None:
+    """Write ``text`` (UTF-8) to ``path`` through a temporary file in the same directory and ``os.replace``."""
+    directory = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(directory):
+        raise InputError(f"cannot write --output {path!r}: directory {directory!r} does not exist")
+    fd, tmp = tempfile.mkstemp(prefix=".tpm-viz-export-", suffix=".tmp", dir=directory)
+    try:
+        os.fchmod(fd, _file_mode(path))  # mkstemp makes 0600; give the file the mode a plain open() would
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+
+
+def _cmd_export(args) -> int:
+    from tpm_viz.exchange.mjcf import DEFAULT_SETTINGS, mjcf_text
+    from tpm_viz.exchange.urdf import urdf_text
+
+    params = params_from_args(args)
+    if args.format == "mjcf":
+        settings = DEFAULT_SETTINGS
+        if args.timestep is not None:
+            dt = positive(args.timestep, "--timestep")
+            settings = dataclasses.replace(settings, timestep=dt, solref=(2.0 * dt, settings.solref[1]))
+        text = mjcf_text(params, settings)
+    else:
+        if args.timestep is not None:
+            raise InputError("--timestep applies to --format mjcf only")
+        text = urdf_text(params)
+    if args.output == "-":
+        sys.stdout.write(text)
+    else:
+        write_atomically(args.output, text)
+    return 0
+
+
+def register(subparsers, common_parent: argparse.ArgumentParser) -> None:
+    """Add ``export`` to the ``tpm-viz`` subparsers (``common_parent`` provides ``--set NAME=VALUE``)."""
+    e = subparsers.add_parser(
+        "export",
+        parents=[common_parent],
+        help="write the mechanism as an MJCF (MuJoCo, Pinocchio) or URDF model file",
+        description="Write every body of the 2-PPa TPM with the paper's mass model. MJCF: loop closures as "
+        "<equality><connect> with stiff solver settings and the recommended time step (read by MuJoCo and by "
+        "pinocchio.buildModelsAndConstraintsFromMJCF). URDF: a tree, the parallelograms as mimic joints, the "
+        "leg closure documented in an XML comment.",
+    )
+    e.add_argument("--format", required=True, choices=FORMATS, help="mjcf or urdf")
+    e.add_argument("--output", required=True, metavar="FILE", help="output file, replaced atomically ('-': stdout)")
+    e.add_argument(
+        "--timestep",
+        type=float,
+        metavar="S",
+        help="MJCF only: MuJoCo time step [s] (default 0.0002; the closures' solref time constant is 2x it)",
+    )
+    e.set_defaults(func=_cmd_export)
