@@ -23,6 +23,7 @@ import os
 import sys
 import tempfile
 from collections.abc import Iterable, Iterator, Mapping, Sequence
+from typing import IO
 
 import numpy as np
 
@@ -138,7 +139,7 @@ def _decode_line(b: bytes) -> str:
         return b.decode("latin-1")
 
 
-def _open_lines(path: str, max_bytes: int) -> tuple[Iterator[str], object]:
+def _open_lines(path: str, max_bytes: int) -> tuple[Iterator[str], IO[bytes] | None]:
     """Lines of the file at ``path`` (``-``: stdin), refused at once if a regular file is over ``max_bytes``."""
     if path == "-":
         raw = sys.stdin.buffer

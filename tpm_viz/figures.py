@@ -28,11 +28,16 @@ FILE_NAMES = {"line": "fig4_line.png", "circle": "fig5_circle.png"}
 class ForceCurves(Protocol):
     """Forces along one trajectory by both models, e.g. :class:`tpm_viz.multibody.crosscheck.ForceComparison`."""
 
-    kind: str
-    duration: float  # [s]
-    t: np.ndarray  # (n,) [s]
-    tau_paper: np.ndarray  # (n, 2) [N]
-    tau_pinocchio: np.ndarray  # (n, 2) [N]
+    @property
+    def kind(self) -> str: ...
+    @property
+    def duration(self) -> float: ...  # [s]
+    @property
+    def t(self) -> np.ndarray: ...  # (n,) [s]
+    @property
+    def tau_paper(self) -> np.ndarray: ...  # (n, 2) [N]
+    @property
+    def tau_pinocchio(self) -> np.ndarray: ...  # (n, 2) [N]
 
 
 def _force_figure(t, tau_paper, tau_ref, title: str, dpi: int):

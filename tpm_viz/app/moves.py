@@ -119,7 +119,7 @@ _CODE_OF_COLUMN = np.array([PoseStatus.OUT_OF_STROKE] * 2 + [PoseStatus.NEAR_INV
 
 
 def pose_codes(params: Params, p, d, mode: int, branch=None, limits: SingularityThresholds = MOVE_LIMITS) -> np.ndarray:
-    """Validity code per pose (``PoseStatus.REGULAR`` or the first failing rule: stroke, inverse, direct), shape ``(...)``.
+    """Validity per pose, shape ``(...)``: ``PoseStatus.REGULAR`` or the first failing rule (stroke, inverse, direct).
 
     ``mode`` is the required sign of ``det J_x``; ``branch`` (optional) the required sign of each ``c_i``.
     Non-finite ``p`` or ``d`` count as ``PoseStatus.UNREACHABLE``.

@@ -149,7 +149,7 @@ class GeometricPath:
 
 def _chain(kind: PathKind, name: str, pieces: list[tuple]) -> GeometricPath:
     """Build a path from pieces ``("line", start, end)`` or ``("arc", centre, radius, phi0, sweep)``."""
-    rows = []
+    rows: list[tuple] = []
     for piece in pieces:
         if piece[0] == "line":
             start, end = np.asarray(piece[1], float), np.asarray(piece[2], float)

@@ -285,7 +285,8 @@ class Plan:
 
     def samples(self, rate: float = CHECK_RATE) -> PlanSamples:
         """The states at ``t = k / rate`` [s], plus the start and end of every move (exact times)."""
-        rate = _limit(rate, "the sample rate", "Hz")
+        checked = _limit(rate, "the sample rate", "Hz")
+        rate = CHECK_RATE if checked is None else checked
         n = math.floor(self.duration * rate) + 1
         if n > MAX_SAMPLES:
             raise InputError(f"{n} samples are too many: lower the sample rate (at most {MAX_SAMPLES} samples)")

@@ -75,9 +75,9 @@ class Sizing:
         if self.motor_constant is not None:
             rows += [
                 ("motor constant", "N/sqrt(W)", self.motor_constant, self.motor_constant),
-                ("peak copper loss", "W", *self.peak_copper_loss),
-                ("mean copper loss", "W", *self.mean_copper_loss),
-                ("copper loss energy per cycle", "J", *self.copper_energy),
+                ("peak copper loss", "W", *_pair(self.peak_copper_loss)),
+                ("mean copper loss", "W", *_pair(self.mean_copper_loss)),
+                ("copper loss energy per cycle", "J", *_pair(self.copper_energy)),
             ]
         return [(q, u, float(a), float(b)) for q, u, a, b in rows]
 
@@ -186,3 +186,9 @@ def sizing_columns(sizing: Sizing) -> dict[str, list]:
     """The table as columns :data:`SIZING_COLUMNS` (for :func:`tpm_viz.csvio.write_columns`)."""
     rows = sizing.rows()
     return {name: [r[k] for r in rows] for k, name in enumerate(SIZING_COLUMNS)}
+
+
+def _pair(values: np.ndarray | None) -> tuple[float, float]:
+    """Both actuators' values of a quantity that exists when a motor constant is given."""
+    assert values is not None, "copper losses need a motor constant"
+    return float(values[0]), float(values[1])

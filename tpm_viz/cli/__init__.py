@@ -41,7 +41,7 @@ def main(argv: list[str] | None = None) -> int:
         args = build_parser().parse_args(argv)
         return int(args.func(args) or 0)
     except TpmVizError as exc:
-        print(f"tpm-viz: error: {one_line(exc)}", file=sys.stderr)
+        print(f"tpm-viz: error: {one_line(str(exc))}", file=sys.stderr)
         return 2
     except OSError as exc:
         print(one_line(f"tpm-viz: error: {exc.strerror or exc}: {exc.filename or ''}".rstrip(": ")), file=sys.stderr)

@@ -9,6 +9,7 @@ import math
 import os
 import sys
 from collections.abc import Mapping
+from typing import overload
 
 import numpy as np
 
@@ -73,10 +74,16 @@ def params_from_args(args: argparse.Namespace) -> Params:
             raise InputError(f"--set expects NAME=VALUE, got {item!r}")
         name = name.strip()
         info = PARAM_INFO.get(name)
-        overrides[name] = parse_number(value, name, info.get("unit", "")) if info else value.strip()
+        overrides[name] = str(parse_number(value, name, info.get("unit", ""))) if info else value.strip()
     return Params.paper().with_overrides(overrides)
 
 
+@overload
+def positive(value: float, name: str) -> float: ...
+@overload
+def positive(value: None, name: str) -> None: ...
+@overload
+def positive(value: float | None, name: str) -> float | None: ...
 def positive(value: float | None, name: str) -> float | None:
     """``value`` if None or positive and finite; else :class:`~tpm_viz.errors.InputError` naming ``name``."""
     if value is not None and (not math.isfinite(value) or value <= 0):

@@ -80,13 +80,13 @@ def _plan_columns(smp) -> dict[str, np.ndarray]:
     return cols
 
 
-def _read_motion(path: str) -> tuple:
+def _read_motion(path: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
     """``(t, p, dp, ddp, tau)`` from a CSV holding one of :data:`SIZE_INPUTS` (``tau`` None: closed form)."""
     text = read_text(path)
-    cols = None
+    cols: dict[str, np.ndarray] = {}
     for required in SIZE_INPUTS:  # the richest set first: forces and derivatives from the file when it has them
         try:
-            cols = parse_columns(text, required, source=path)
+            cols = dict(parse_columns(text, required, source=path))
             break
         except InputError as exc:
             if "missing column" not in str(exc) or required is SIZE_INPUTS[-1]:
@@ -112,7 +112,7 @@ def _cmd_size(args) -> int:
     sizing = size_trajectory(params, t, p, dp, ddp, dwell, args.motor_constant, tau=tau)
     print(format_sizing(sizing))
     if args.output:
-        write_columns(args.output, sizing_columns(sizing))
+        write_columns(args.output, {k: np.asarray(v) for k, v in sizing_columns(sizing).items()})
     return 0
 
 

@@ -102,8 +102,8 @@ class ClosedLoopAssembly:
             return self._guess_from_both(p, d)
         la, k = self.params.l_a, self.params.offset
         theta = (math.asin(float(p[1]) / la), math.asin(float(p[0]) / la))
-        d = (p[0] + k - la * math.cos(theta[0]), p[1] + k - la * math.cos(theta[1]))
-        return self._pack(d, theta[0], -theta[1])
+        d_guess = (p[0] + k - la * math.cos(theta[0]), p[1] + k - la * math.cos(theta[1]))
+        return self._pack(d_guess, theta[0], -theta[1])
 
     def _guess_from_both(self, p: np.ndarray, d: np.ndarray) -> np.ndarray:
         """Links pointing from the slider joints ``A_i`` towards the platform pivots ``B_i``."""

@@ -299,7 +299,8 @@ class MultibodyModel(ClosedLoopAssembly):
     def constrained_motion(self, p, dp, ddp) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Joint ``(q, v, a)`` (7,) each, consistent with the closures, for one platform state (2,) each."""
         p, dp, ddp = (self._one(x, n) for x, n in ((p, "p"), (dp, "dp"), (ddp, "ddp")))
-        return self._motion(p, dp, ddp)[:3]
+        q, v, a, _, _ = self._motion(p, dp, ddp)
+        return q, v, a
 
     @locked
     def inverse_dynamics(self, p, dp, ddp, f_ext=None) -> np.ndarray:

@@ -22,7 +22,7 @@ V = TypeVar("V", bound=Hashable)
 
 @dataclass(frozen=True)
 class PendingDrag:
-    """One gizmo event: ``phase`` (``start``, ``update``, ``end``), ``position`` [m] (x, y, z) and its arrival number."""
+    """One gizmo event: ``phase`` (``start``, ``update``, ``end``), ``position`` [m] (x, y, z), arrival number."""
 
     phase: str
     position: np.ndarray
