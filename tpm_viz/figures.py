@@ -16,7 +16,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-__all__ = ["FILE_NAMES", "TITLES", "ForceCurves", "force_plot_png", "plot_forces"]
+__all__ = ["FILE_NAMES", "PRINT_DPI", "TITLES", "ForceCurves", "force_plot_png", "force_plot_svg", "plot_forces"]
 
 TITLES = {
     "line": "Fig. 4: line from (-100, -50) to (+100, +50) mm",
@@ -84,10 +84,22 @@ def plot_forces(cmp: ForceCurves, path: str | pathlib.Path, dpi: int = 100) -> p
     return path
 
 
-def force_plot_png(t, tau_paper, tau_ref=None, title: str = "actuator forces", dpi: int = 100) -> bytes:
+PRINT_DPI = 240
+"""Resolution of the downloadable figures: 7 in wide at 240 dpi = 1680 px (print size)."""
+
+
+def force_plot_png(t, tau_paper, tau_ref=None, title: str = "actuator forces", dpi: int = PRINT_DPI) -> bytes:
     """PNG bytes of the force figure for any trajectory (e.g. the app's player): ``t`` (n,) [s], forces (n, 2)
     [N]; the reference model (Pinocchio) dotted with a difference panel when ``tau_ref`` is given."""
-    fig = _force_figure(t, tau_paper, tau_ref, title, dpi)
+    return _save(_force_figure(t, tau_paper, tau_ref, title, dpi), "png", dpi)
+
+
+def force_plot_svg(t, tau_paper, tau_ref=None, title: str = "actuator forces") -> bytes:
+    """The same figure as :func:`force_plot_png`, as SVG (vector: any size, editable)."""
+    return _save(_force_figure(t, tau_paper, tau_ref, title, PRINT_DPI), "svg", PRINT_DPI)
+
+
+def _save(fig: Figure, fmt: str, dpi: int) -> bytes:
     out = io.BytesIO()
-    fig.savefig(out, format="png", dpi=dpi)
+    fig.savefig(out, format=fmt, dpi=dpi)
     return out.getvalue()

@@ -10,7 +10,7 @@ from tpm_viz import InputError, Params, actuator_acceleration, actuator_velocity
 from tpm_viz.app.inputs import read_upload
 from tpm_viz.app.runs import RUN_SAMPLES, Source, build_run, check_path
 from tpm_viz.csvio import format_columns, parse_columns
-from tpm_viz.figures import force_plot_png
+from tpm_viz.figures import force_plot_png, force_plot_svg
 from tpm_viz.paper.trajectories import circle_state, line_state
 
 P = Params.paper()
@@ -148,11 +148,15 @@ def test_the_csv_export_round_trips_and_leaves_missing_reference_cells_empty():
     np.testing.assert_array_equal(cols["ddd2"], run.ddd[:, 1])
 
 
-def test_the_force_plot_is_a_png_with_or_without_the_reference():
+def test_the_force_plot_is_a_print_size_png_or_an_svg_with_or_without_the_reference():
     run = build_run(P, Source.paper("line"))
     for ref in (None, run.tau + 1e-13):
         png = force_plot_png(run.t, run.tau, ref, title="line")
-        assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
+        assert png[:8] == b"\x89PNG\r\n\x1a\n"
+        width = int.from_bytes(png[16:20], "big")  # the IHDR chunk: width, then height, big-endian
+        assert width >= 1600  # issue 13: print size
+        svg = force_plot_svg(run.t, run.tau, ref, title="line")
+        assert svg.lstrip().startswith(b"<?xml") and b"<svg" in svg[:2000]
 
 
 def test_trace_segments_and_the_summary_never_show_nan():

@@ -19,7 +19,7 @@ from tpm_viz.app.inputs import MAX_UPLOAD_BYTES, read_number, read_upload
 from tpm_viz.app.runs import Source
 from tpm_viz.csvio import format_columns
 from tpm_viz.errors import InputError, TpmVizError
-from tpm_viz.figures import force_plot_png
+from tpm_viz.figures import force_plot_png, force_plot_svg
 from tpm_viz.paper.trajectories import DEFAULT_DURATIONS
 from tpm_viz.ui.guard import guarded
 from tpm_viz.ui.snapshot import Snapshot
@@ -84,6 +84,7 @@ class PlayerView:
         self.charts = Charts(gui)
         self.export_csv = gui.add_button("Download the run (CSV)", icon=viser.Icon.DOWNLOAD, color="gray")
         self.export_png = gui.add_button("Download the force plot (PNG)", icon=viser.Icon.PHOTO, color="gray")
+        self.export_svg = gui.add_button("Download the force plot (SVG)", icon=viser.Icon.VECTOR, color="gray")
         self.charts.show_run(None, None)
         self.choice.on_update(self._on_choice)
         self.duration.on_update(self._on_duration)
@@ -92,6 +93,7 @@ class PlayerView:
         self.time.on_update(self._on_time)
         self.export_csv.on_click(self._on_export_csv)
         self.export_png.on_click(self._on_export_png)
+        self.export_svg.on_click(self._on_export_svg)
 
     # -- helpers -------------------------------------------------------------------------------------------
     @property
@@ -220,6 +222,15 @@ class PlayerView:
             run = self._run_or_refuse()
             png = force_plot_png(run.t, run.tau, run.tau_ref, title=f"Actuator forces: {run.source.label}")
             self._download(f"tpm-forces-{run.source.kind}-T{run.duration:g}s.png", png)
+
+        self._guard(event, export)
+
+    @guarded(on_error=_internal_error)
+    def _on_export_svg(self, event) -> None:
+        def export() -> None:
+            run = self._run_or_refuse()
+            svg = force_plot_svg(run.t, run.tau, run.tau_ref, title=f"Actuator forces: {run.source.label}")
+            self._download(f"tpm-forces-{run.source.kind}-T{run.duration:g}s.svg", svg)
 
         self._guard(event, export)
 
