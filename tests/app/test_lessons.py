@@ -1,4 +1,5 @@
-"""The guided demonstrations (tpm_viz.app.lessons): every scene is valid, and the effect each one states is true."""
+"""The guided demonstrations (assets/lessons/*.toml, read by tpm_viz.app.lessons): every scene is valid, and the
+effect each one states is true (the files and their [checks]: test_lesson_files.py)."""
 
 from __future__ import annotations
 

@@ -1,263 +1,227 @@
-"""Guided demonstrations for a lecture: pure data (frozen dataclasses) and the numbers behind each one.
+"""Guided demonstrations for a lecture: the packaged tour (``assets/lessons/*.toml``) and the numbers behind it.
 
-Each :class:`Demo` sets the mechanism (parameter overrides of the paper's prototype, a pose or the start of a
-motion, the assembly mode), the camera, the explorer map and the ellipses, and explains what to watch in one
-paragraph. :func:`effect` computes, with the closed form only, the numbers that make the stated effect true
-(forces growing towards the direct singularity, the workspace area shrinking, the 1/T² law, ...); the test
-suite checks each of them, so the text cannot drift from the maths. No viser, no Pinocchio here.
+The lessons are data files (format: ``assets/lessons/README.md``), read by :mod:`tpm_viz.app.lesson_files` into
+the frozen dataclasses of :mod:`tpm_viz.app.demos`; :data:`DEMOS` is the packaged tour and :data:`PROBLEMS` says
+which packaged file was refused, if any (a lecturer's folder is read with :func:`load_lessons`). Each lesson may
+state numbers in ``[checks]``; :func:`check_values` recomputes them from its scene with the closed form only and
+:func:`verify` compares (the test suite runs it on every lesson, so the text cannot drift from the maths).
+:func:`effect` is the line of numbers shown under a lesson's paragraph. No viser, no Pinocchio here (the reference
+model is passed in as a function).
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
+from collections.abc import Callable, Iterable
+from functools import cached_property
 
 import numpy as np
 
-from tpm_viz.app.moves import Pose
+from tpm_viz.app.demos import CHECK_NAMES, Camera, Check, Demo, Motion, demo_params, demo_pose, demo_source
+from tpm_viz.app.lesson_files import assets_dir, load_lesson, load_lessons, load_preset
 from tpm_viz.app.overlays import cached_map
-from tpm_viz.app.runs import Source, build_run
+from tpm_viz.app.readouts import Reference
+from tpm_viz.app.runs import Run, build_run
 from tpm_viz.errors import InputError
 from tpm_viz.paper.ellipses import manipulability_ellipses
 from tpm_viz.paper.jacobians import condition_number, jacobians
-from tpm_viz.paper.kinematics import forward_kinematics, forward_kinematics_both
+from tpm_viz.paper.kinematics import forward_kinematics_both
 from tpm_viz.paper.workspace import workspace_area
 from tpm_viz.params import Params
 
-__all__ = ["DEMOS", "Camera", "Demo", "Motion", "demo_by_key", "demo_params", "demo_pose", "demo_source", "effect"]
+__all__ = [
+    "CHECKS",
+    "DEMOS",
+    "PROBLEMS",
+    "Camera",
+    "Check",
+    "Demo",
+    "Motion",
+    "assets_dir",
+    "check_values",
+    "demo_by_key",
+    "demo_params",
+    "demo_pose",
+    "demo_source",
+    "effect",
+    "load_lesson",
+    "load_lessons",
+    "load_preset",
+    "tolerance",
+    "verify",
+]
+
+DEMOS, PROBLEMS = load_lessons(assets_dir() / "lessons")
+"""The guided tour, in file-name order, and the packaged files refused (empty when the package is sound)."""
+
+CM2 = 1e4  # cm² per m²
 
 
-@dataclass(frozen=True)
-class Camera:
-    """Camera position and look-at point [m] (Z up), centred on what the demo shows (the app shifts both
-    sideways so that the scene is not hidden by its panel)."""
+class _Scene:
+    """What the checks of one lesson are computed from, each part computed once and only if asked for."""
 
-    position: tuple[float, float, float]
-    look_at: tuple[float, float, float]
+    def __init__(self, demo: Demo, reference: Reference | None) -> None:
+        self.demo = demo
+        self.params = demo_params(demo)
+        self.reference = reference
 
+    @cached_property
+    def pose(self):
+        return demo_pose(self.demo, self.params)
 
-@dataclass(frozen=True)
-class Motion:
-    """A trajectory for the player: the paper's ``"line"``/``"circle"`` or a ``"segment"`` start -> end [m]."""
+    @cached_property
+    def run(self) -> Run:
+        source = demo_source(self.demo)
+        if source is None:
+            raise InputError(f"lesson {self.demo.key!r} has no motion to check")
+        return build_run(self.params, source, self.reference)
 
-    kind: str
-    duration: float  # s
-    start: tuple[float, float] | None = None
-    end: tuple[float, float] | None = None
+    def peak_at(self, index: int) -> float:
+        if len(self.demo.compare) != 2:
+            raise InputError(f"lesson {self.demo.key!r}: peak_ratio needs motion.compare = [T1, T2]")
+        source = demo_source(self.demo, self.demo.compare[index])
+        assert source is not None  # compare needs a motion (lesson_files)
+        return build_run(self.params, source).peak
 
+    @cached_property
+    def jac(self):
+        return jacobians(self.params, self.pose.p, self.pose.d)
 
-@dataclass(frozen=True)
-class Demo:
-    """One scene of the guided tour (SI units)."""
+    @cached_property
+    def ellipses(self):
+        return manipulability_ellipses(self.params, self.pose.p)
 
-    key: str
-    title: str
-    text: str
-    camera: Camera
-    params: tuple[tuple[str, float], ...] = ()  # overrides of Params.paper()
-    p: tuple[float, float] | None = None  # platform position, working mode (eq. 4)
-    d: tuple[float, float] | None = None  # or actuator positions, with the assembly mode below
-    mode: int = 1
-    motion: Motion | None = None  # the pose is then the motion's start
-    map_kind: str = "off"
-    ellipses: bool = False
-    compare: tuple[float, ...] = ()  # durations whose force peaks the effect compares
+    @cached_property
+    def other(self) -> np.ndarray:
+        sol = forward_kinematics_both(self.params, self.pose.d)
+        return np.asarray(sol.minus if self.pose.mode(self.params) > 0 else sol.plus, dtype=float)
 
+    def reference_gap(self) -> float:
+        if self.reference is None:
+            raise InputError("reference_gap needs the reference (Pinocchio) model")
+        run = self.run
+        assert run.tau_ref is not None, run.ref_note
+        return float(np.max(np.abs(run.tau_ref - run.tau)))
 
-_Q3 = (-math.sqrt(0.5), -math.sqrt(0.5))  # unit vector towards the tangent-circle arc of eq. (12)
-_LA = 0.260
-
-DEMOS: tuple[Demo, ...] = (
-    Demo(
-        key="direct",
-        title="1. Approach the direct singularity",
-        text=(
-            "The platform moves in a straight line from the centre towards the red quarter circle of the third "
-            "quadrant, where cos(θ1+θ2) = 0 (eq. 12) and the two assembly modes merge. The cubic time law gives "
-            "the same magnitude of acceleration at the start and at the end, so the difference between the "
-            "forces there is the Jacobian's doing: as det J_x falls towards 0 the matrix of eq. (29) becomes "
-            "nearly singular, the Lagrange multipliers grow and the actuators push several times harder for the "
-            "same motion. Press Play and watch τ in the chart, the colour under the platform (det J_x map) and "
-            "the velocity ellipse stretching along the direction the actuators no longer control."
-        ),
-        camera=Camera((-0.09, -0.42, 0.68), (-0.09, -0.1, 0.0)),
-        motion=Motion("segment", 0.5, (0.0, 0.0), (0.95 * _LA * _Q3[0], 0.95 * _LA * _Q3[1])),
-        map_kind="det_jx",
-        ellipses=True,
-    ),
-    Demo(
-        key="workspace",
-        title="2. Shorter links, smaller workspace",
-        text=(
-            "The links are shortened from l_a = 260 mm to 200 mm. Every leg confines the platform to a circle of "
-            "radius l_a about its slider, so the reachable square |p1|, |p2| < l_a shrinks with l_a², and the "
-            "part of it the 300 mm stroke can serve (green) shrinks too. The red arcs and the amber square, the "
-            "singularity loci, move inwards with l_a. (Between 260 and 240 mm the in-stroke area hardly changes: "
-            "there the stroke, not the links, is the limit.) Parameters -> Paper values brings the prototype back."
-        ),
-        camera=Camera((-0.08, -0.33, 0.92), (-0.08, -0.06, 0.0)),
-        params=(("l_a", 0.200),),
-        p=(0.0, 0.0),
-        map_kind="workspace",
-    ),
-    Demo(
-        key="speed",
-        title="3. The circle at two speeds",
-        text=(
-            "The circle of Fig. 5 is loaded with T = 0.5 s. Play it and note the force peak; then set the "
-            "duration to 1.0 s in the Player and play again. The path is the same; every velocity is halved and "
-            "every acceleration quartered. With no gravity and no friction every term of eqs. (29) and (31) is "
-            "either an acceleration or a product of two velocities, so every force is divided by exactly 4: the "
-            "peak force goes as 1/T². The Player's summary line keeps the previous run's peak for comparison."
-        ),
-        camera=Camera((-0.05, -0.5, 0.72), (-0.05, -0.1, 0.0)),
-        motion=Motion("circle", 0.5),
-        compare=(0.5, 1.0),
-    ),
-    Demo(
-        key="agreement",
-        title="4. Paper vs Pinocchio",
-        text=(
-            "The line of Fig. 4 (T = 0.2 s). Solid curves: the paper's closed form, eqs. (29)-(31). Dotted: an "
-            "independent closed-loop multibody model built with Pinocchio from the same masses and lengths (all "
-            "four parallelogram links, loop-closure constraints), playing the role ADAMS played in the paper. The "
-            "paper reports agreement within 9 N; here the two agree to about 1e-13 N, once the paper's sign "
-            "error in eq. (15) is corrected (see the Equations tab, errata): the dotted curves lie exactly on the "
-            "solid ones."
-        ),
-        camera=Camera((-0.05, -0.5, 0.72), (-0.05, -0.1, 0.0)),
-        motion=Motion("line", 0.2),
-    ),
-    Demo(
-        key="modes",
-        title="5. The two assembly modes",
-        text=(
-            "With both actuators at d = 50 mm the two leg circles (blue) meet twice: the mechanism can be "
-            "assembled in two ways. The platform P is in the working mode (det J_x > 0); the translucent P′ is "
-            "the other one (det J_x < 0), mirrored across the red arc. Move -> Switch assembly mode jumps between "
-            "them. Drive both actuators down towards 22 mm (d1, d2 sliders): P and P′ approach each other and "
-            "merge on the red arc, where the forward kinematics has a double root: the direct singularity, "
-            "eq. (12). The det J_x map shows the sign change across the arc."
-        ),
-        camera=Camera((-0.17, -0.42, 0.75), (-0.17, -0.15, 0.0)),
-        d=(0.050, 0.050),
-        mode=1,
-        map_kind="det_jx",
-    ),
-    Demo(
-        key="inverse",
-        title="6. Near an inverse singularity",
-        text=(
-            "Leg 1's links are almost perpendicular to its rail: cos θ1 → 0 (eq. 11), so J = J_q⁻¹ J_x blows up. "
-            "Along leg 1's links (nearly along e2) a large slider speed buys only a small platform speed (the "
-            "velocity ellipse, blue, collapses in that direction) while a small actuator force holds a large "
-            "platform force (the force ellipse, orange, grows). With the paper's 300 mm stroke the only poses "
-            "this close to an inverse singularity are in the corner of the third quadrant, beyond the "
-            "direct-singularity arc; the condition-number map shows where the mechanism is well conditioned "
-            "(light) and where it is not."
-        ),
-        camera=Camera((-0.2, -0.52, 0.74), (-0.2, -0.2, 0.0)),
-        p=(-0.2252, -0.2582),
-        map_kind="cond",
-        ellipses=True,
-    ),
-)
-"""The guided tour, in order."""
+    def area(self, params: Params, which: str) -> float:
+        return workspace_area(cached_map(params), which) * CM2
 
 
-def demo_by_key(key: str) -> Demo:
-    """The demo with this key."""
-    for demo in DEMOS:
+def _tau(run: Run, k: int) -> float:
+    return float(np.linalg.norm(run.tau[k]))
+
+
+CHECKS: dict[str, Callable[[_Scene], float]] = {
+    "det_jx_start": lambda s: float(jacobians(s.params, s.run.p[0]).det_jx),
+    "det_jx_end": lambda s: float(jacobians(s.params, s.run.p[-1]).det_jx),
+    "force_start": lambda s: _tau(s.run, 0),
+    "force_end": lambda s: _tau(s.run, -1),
+    "force_ratio": lambda s: _tau(s.run, -1) / _tau(s.run, 0),
+    "peak_force": lambda s: s.run.peak,
+    "peak_ratio": lambda s: s.peak_at(0) / s.peak_at(1),
+    "reference_gap": _Scene.reference_gap,
+    "det_jx": lambda s: float(s.jac.det_jx),
+    "cos_theta1": lambda s: float(s.jac.jq[0, 0]),
+    "cos_theta2": lambda s: float(s.jac.jq[1, 1]),
+    "cond": lambda s: float(condition_number(s.params, s.pose.p)),
+    "velocity_min": lambda s: float(s.ellipses.velocity.radii.min()),
+    "velocity_max": lambda s: float(s.ellipses.velocity.radii.max()),
+    "force_ellipse_min": lambda s: float(s.ellipses.force.radii.min()),
+    "force_ellipse_max": lambda s: float(s.ellipses.force.radii.max()),
+    "p1_mm": lambda s: float(s.pose.p[0]) * 1e3,
+    "p2_mm": lambda s: float(s.pose.p[1]) * 1e3,
+    "other_p1_mm": lambda s: float(s.other[0]) * 1e3,
+    "other_p2_mm": lambda s: float(s.other[1]) * 1e3,
+    "other_det_jx": lambda s: float(jacobians(s.params, s.other, s.pose.d).det_jx),
+    "workspace_cm2": lambda s: s.area(s.params, "in_stroke"),
+    "reachable_cm2": lambda s: s.area(s.params, "reachable"),
+    "paper_workspace_cm2": lambda s: s.area(Params.paper(), "in_stroke"),
+    "paper_reachable_cm2": lambda s: s.area(Params.paper(), "reachable"),
+}
+"""How each number a lesson may state (:data:`~tpm_viz.app.demos.CHECK_NAMES`) is computed from its scene."""
+
+
+def check_values(demo: Demo, names: Iterable[str] | None = None, reference: Reference | None = None) -> dict:
+    """The numbers ``names`` (default: the lesson's ``[checks]``) recomputed from the lesson's scene (closed form;
+    ``reference`` only for ``reference_gap``)."""
+    scene = _Scene(demo, reference)
+    wanted = [c.name for c in demo.checks] if names is None else list(names)
+    for name in wanted:
+        if name not in CHECKS:
+            raise InputError(f"unknown check {name!r}; known: {', '.join(CHECKS)}")
+    return {name: CHECKS[name](scene) for name in wanted}
+
+
+def tolerance(check: Check) -> float:
+    """The accepted absolute difference: the check's ``tol``, else 0.5 % of the stated value or 0.005."""
+    return check.tol if check.tol is not None else max(0.005 * abs(check.value), 0.005)
+
+
+def verify(demo: Demo, reference: Reference | None = None) -> list[str]:
+    """One line per stated number that the scene does not bear out (``reference_gap`` is skipped without
+    ``reference``); empty when the lesson is right."""
+    checks = [c for c in demo.checks if reference is not None or c.name != "reference_gap"]
+    values = check_values(demo, [c.name for c in checks], reference)
+    return [
+        f"{demo.source or demo.key}: checks.{c.name} states {c.value:g}, the scene gives {values[c.name]:.6g} "
+        f"(tolerance {tolerance(c):g})"
+        for c in checks
+        if not abs(values[c.name] - c.value) <= tolerance(c)
+    ]
+
+
+def demo_by_key(key: str, lessons: Iterable[Demo] = DEMOS) -> Demo:
+    """The lesson with this key."""
+    lessons = tuple(lessons)
+    for demo in lessons:
         if demo.key == key:
             return demo
-    raise InputError(f"unknown demo {key!r}; known: {', '.join(d.key for d in DEMOS)}")
+    raise InputError(f"unknown demo {key!r}; known: {', '.join(d.key for d in lessons)}")
 
 
-def demo_params(demo: Demo) -> Params:
-    """The paper's prototype with the demo's overrides (validated)."""
-    return Params.paper().replace(**dict(demo.params))
-
-
-def demo_source(demo: Demo) -> Source | None:
-    """The demo's trajectory for the player, if it has one."""
-    m = demo.motion
-    if m is None:
-        return None
-    if m.kind == "segment":
-        return Source.segment(m.start, m.end, m.duration, label=f"{demo.title[3:].lower()}, T = {m.duration:g} s")
-    return Source.paper(m.kind, m.duration)
-
-
-def demo_pose(demo: Demo, params: Params) -> Pose:
-    """The pose the demo starts from: the motion's start, ``p`` (working mode) or ``d`` in ``mode``."""
-    source = demo_source(demo)
-    if source is not None:
-        p, _, _ = source.motion(np.array([0.0]))
-        return Pose.working(params, p[0])
-    if demo.p is not None:
-        return Pose.working(params, demo.p)
-    if demo.d is not None:
-        return Pose(forward_kinematics(params, demo.d, mode=demo.mode), np.asarray(demo.d))
-    raise InputError(f"demo {demo.key!r} has no pose")
-
-
-def _tau_norms(params: Params, source: Source) -> tuple[float, float]:
-    run = build_run(params, source, samples=201)
-    return float(np.linalg.norm(run.tau[0])), float(np.linalg.norm(run.tau[-1]))
+def _stated(demo: Demo) -> str:
+    """A lesson of a lecturer's own: its stated numbers, as recomputed."""
+    checks = [c for c in demo.checks if c.name != "reference_gap"]
+    values = check_values(demo, [c.name for c in checks])
+    return "; ".join(f"{CHECK_NAMES[c.name].split(' [')[0]}: {values[c.name]:.4g}" for c in checks)
 
 
 def effect(demo: Demo) -> str:
-    """One line of numbers that shows the demo's effect (closed form; see the module docstring)."""
-    params = demo_params(demo)
-    if demo.key == "direct":
-        source, motion = demo_source(demo), demo.motion
-        assert source is not None and motion is not None  # the direct-singularity demo has a motion
-        start, end = _tau_norms(params, source)
-        det = float(jacobians(params, np.array(motion.end)).det_jx)
+    """One line of numbers that shows the lesson's effect (closed form; see the module docstring)."""
+    s = _Scene(demo, None)
+    key, mm = demo.key, 1e3
+    if key == "direct" and demo.motion is not None:
+        start, end = _tau(s.run, 0), _tau(s.run, -1)
         return (
             f"|τ| at the start {start:.0f} N, at the end {end:.0f} N (×{end / start:.1f}) for the same |p̈|; "
-            f"det J_x falls from 1.00 to {det:.2f}"
+            f"det J_x falls from {CHECKS['det_jx_start'](s):.2f} to {CHECKS['det_jx_end'](s):.2f}"
         )
-    if demo.key == "workspace":
-        before, after = cached_map(Params.paper()), cached_map(params)
-        cm2 = 1e4
+    if key == "workspace":
+        paper = Params.paper()
         return (
-            f"in-stroke workspace {workspace_area(before) * cm2:.0f} → {workspace_area(after) * cm2:.0f} cm²; "
-            f"reachable square {workspace_area(before, 'reachable') * cm2:.0f} → "
-            f"{workspace_area(after, 'reachable') * cm2:.0f} cm² (l_a {Params.paper().l_a * 1e3:.0f} → "
-            f"{params.l_a * 1e3:.0f} mm)"
+            f"in-stroke workspace {s.area(paper, 'in_stroke'):.0f} → {s.area(s.params, 'in_stroke'):.0f} cm²; "
+            f"reachable square {s.area(paper, 'reachable'):.0f} → {s.area(s.params, 'reachable'):.0f} cm² "
+            f"(l_a {paper.l_a * mm:.0f} → {s.params.l_a * mm:.0f} mm)"
         )
-    if demo.key == "speed":
-        t1, t2 = demo.compare
-        p1, p2 = (build_run(params, Source.paper("circle", t), samples=401).peak for t in (t1, t2))
+    if key == "speed" and len(demo.compare) == 2:
+        (t1, t2), p1, p2 = demo.compare, s.peak_at(0), s.peak_at(1)
         return (
             f"peak |τ| {p1:.1f} N at T = {t1:g} s, {p2:.1f} N at T = {t2:g} s: ratio {p1 / p2:.3f} "
             f"= (T2/T1)² = {(t2 / t1) ** 2:.3f}"
         )
-    if demo.key == "agreement":
-        agreement = demo_source(demo)
-        assert agreement is not None  # the agreement demo plays the paper's line
-        run = build_run(params, agreement)
-        return f"closed-form peak |τ| {run.peak:.1f} N; the Pinocchio curves are drawn dotted on top"
-    if demo.key == "modes":
-        assert demo.d is not None  # the assembly-modes demo is given by actuator positions
-        sol = forward_kinematics_both(params, demo.d)
-        mm = 1e3
-        dets = [float(jacobians(params, q, demo.d).det_jx) for q in (sol.plus, sol.minus)]
+    if key == "agreement" and demo.motion is not None:
+        return f"closed-form peak |τ| {s.run.peak:.1f} N; the Pinocchio curves are drawn dotted on top"
+    if key == "modes" and demo.d is not None:
+        p, q = s.pose.p * mm, s.other * mm
         return (
-            f"d = ({demo.d[0] * mm:.0f}, {demo.d[1] * mm:.0f}) mm: P = ({sol.plus[0] * mm:.1f}, {sol.plus[1] * mm:.1f})"
-            f" mm with det J_x = {dets[0]:+.2f}, P′ = ({sol.minus[0] * mm:.1f}, {sol.minus[1] * mm:.1f}) mm with "
-            f"det J_x = {dets[1]:+.2f}"
+            f"d = ({demo.d[0] * mm:.0f}, {demo.d[1] * mm:.0f}) mm: P = ({p[0]:.1f}, {p[1]:.1f}) mm with "
+            f"det J_x = {CHECKS['det_jx'](s):+.2f}, P′ = ({q[0]:.1f}, {q[1]:.1f}) mm with "
+            f"det J_x = {CHECKS['other_det_jx'](s):+.2f}"
         )
-    if demo.key == "inverse":
-        pose = demo_pose(demo, params)
-        jac = jacobians(params, pose.p)
-        cos = np.array([jac.jq[0, 0], jac.jq[1, 1]])
-        cond = float(condition_number(params, pose.p))
-        ell = manipulability_ellipses(params, pose.p)
-        v, f = ell.velocity.radii, ell.force.radii
+    if key == "inverse" and demo.motion is None:
+        v, f = s.ellipses.velocity.radii, s.ellipses.force.radii
         return (
-            f"cos θ1 = {cos[0]:.3f}, cond J = {cond:.1f}; velocity ellipse {v.min():.2f} × {v.max():.2f}, "
-            f"force ellipse {f.min():.2f} × {f.max():.2f} (per unit actuator speed / force)"
+            f"cos θ1 = {CHECKS['cos_theta1'](s):.3f}, cond J = {CHECKS['cond'](s):.1f}; velocity ellipse "
+            f"{v.min():.2f} × {v.max():.2f}, force ellipse {f.min():.2f} × {f.max():.2f} (per unit actuator "
+            "speed / force)"
         )
-    return ""
+    return _stated(demo)

@@ -1,25 +1,28 @@
 """The guided demonstrations of one tab: choose a scene (or step with Previous / Next), read its paragraph,
 play its motion.
 
-A demonstration (:data:`tpm_viz.app.lessons.DEMOS`, pure data) sets the session's mechanism (parameters, pose and
-its trajectory, loaded into the player), this tab's camera and this tab's explorer settings (map, ellipses).
-The numbers that back its claim (:func:`tpm_viz.app.lessons.effect`) are computed when it is applied, outside the
-hub's lock, and shown under the paragraph.
+A demonstration (a lesson file read by :mod:`tpm_viz.app.lesson_files`: the packaged tour
+:data:`tpm_viz.app.lessons.DEMOS`, or a lecturer's folder given to ``tpm-viz serve --lessons DIR``) sets the
+session's mechanism (parameters, pose and its trajectory, loaded into the player), this tab's camera and this
+tab's explorer settings (map, ellipses). The numbers that back its claim (:func:`tpm_viz.app.lessons.effect`)
+are computed when it is applied, outside the hub's lock, and shown under the paragraph. Lesson files that were
+refused are listed under the tab's introduction, one line each.
 """
 
 from __future__ import annotations
 
 import html
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import viser
 
-from tpm_viz.app.lessons import DEMOS, Demo, demo_params, demo_pose, demo_source, effect
+from tpm_viz.app.lessons import DEMOS, PROBLEMS, Demo, demo_params, demo_pose, demo_source, effect
 from tpm_viz.app.readouts import Load
 from tpm_viz.app.state import TrajectorySample
 from tpm_viz.errors import TpmVizError
 from tpm_viz.ui.guard import guarded
+from tpm_viz.ui.scene import camera_pose
 from tpm_viz.ui.session import View
 from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.teaching.explorer import ExplorerView
@@ -27,7 +30,7 @@ from tpm_viz.ui.teaching.playing import RunHub
 
 __all__ = ["DemosView"]
 
-TITLES = tuple(d.title for d in DEMOS)
+NONE = "(no lessons)"
 PANEL_SHIFT = 0.25
 """Sideways shift of a demo's camera per metre of viewing distance: the control panel covers the right of the
 canvas, so the camera looks a little right of the subject (as :func:`.scene.camera_pose` does)."""
@@ -44,22 +47,49 @@ def _internal_error(owner, exc: Exception) -> None:
     owner.view.refuse(f"internal error ({type(exc).__name__}), logged on the server", resync=False)
 
 
+def problems_html(problems: Sequence[str]) -> str:
+    """The lesson files that were refused, one line each (``file:line: what is wrong``)."""
+    lines = "".join(f"<li>{html.escape(p)}</li>" for p in problems)
+    return (
+        f'<div data-q="demo-problems" style="font-size:0.8em;color:#b91c1c"><b>{len(problems)} lesson file(s) '
+        f'refused:</b><ul style="margin:2px 0 0 16px;padding:0">{lines}</ul></div>'
+    )
+
+
 def demo_html(demo: Demo, facts: str) -> str:
     """The paragraph of a demonstration and the line of numbers that backs it."""
     esc = html.escape
     return (
         f'<div data-q="demo" style="font-size:0.85em;color:#1e293b;line-height:1.45">'
         f"<p style='margin:0 0 6px 0'>{esc(demo.text)}</p>"
-        f'<div data-q="demo-effect" style="background:#f1f5f9;border-left:3px solid #0d9488;padding:4px 6px;'
-        f'border-radius:3px;font-variant-numeric:tabular-nums">{esc(facts)}</div></div>'
+        + (
+            f'<div data-q="demo-effect" style="background:#f1f5f9;border-left:3px solid #0d9488;padding:4px 6px;'
+            f'border-radius:3px;font-variant-numeric:tabular-nums">{esc(facts)}</div>'
+            if facts
+            else ""
+        )
+        + "</div>"
     )
 
 
 class DemosView:
     """Demonstration widgets of one tab."""
 
-    def __init__(self, view: View, runs: RunHub, explorer: ExplorerView, speed: Callable[[], float]) -> None:
+    def __init__(
+        self,
+        view: View,
+        runs: RunHub,
+        explorer: ExplorerView,
+        speed: Callable[[], float],
+        lessons: Sequence[Demo] | None = None,
+        problems: Sequence[str] = (),
+    ) -> None:
+        """``lessons``: the tour (default: the packaged one, with its own ``problems``); ``problems``: the lesson
+        files refused (:func:`tpm_viz.app.lessons.load_lessons`), shown under the introduction."""
         self.view = view
+        self.lessons = tuple(DEMOS if lessons is None else lessons)
+        self.problems = tuple(PROBLEMS if lessons is None else problems)
+        self.titles = tuple(d.title for d in self.lessons)
         self._speed = speed
         """The player's playback speed (x real time): *Play the motion* plays at it."""
         self.runs = runs
@@ -73,10 +103,16 @@ class DemosView:
             "A guided tour for a lecture. Each scene sets the mechanism (shared with the class unless you work on "
             "your own copy), your camera and your floor map; *Play the motion* runs its trajectory in the Player."
         )
-        self.choice = gui.add_dropdown("Demonstration", TITLES, initial_value=TITLES[0])
+        if self.problems:
+            self.problems_note = gui.add_html(problems_html(self.problems))
+        titles = self.titles or (NONE,)
+        self.choice = gui.add_dropdown("Demonstration", titles, initial_value=titles[0])
         self.steps = gui.add_button_group("Step", ("Previous", "Show this one", "Next"))
         self.play = gui.add_button("Play the motion", icon=viser.Icon.PLAYER_PLAY)
-        self.text = gui.add_html(demo_html(DEMOS[0], "Press 'Show this one' to set up the scene."))
+        first = demo_html(self.lessons[0], "Press 'Show this one' to set up the scene.") if self.lessons else ""
+        self.text = gui.add_html(first or "<p>No lessons to show.</p>")
+        if not self.lessons:
+            self.choice.disabled = self.steps.disabled = self.play.disabled = True
         self.choice.on_update(self._on_choice)
         self.steps.on_click(self._on_step)
         self.play.on_click(self._on_play)
@@ -92,15 +128,15 @@ class DemosView:
     def _on_choice(self, event) -> None:
         if not self._user(event) or self.choice.value == self._written:
             return
-        if self.choice.value in TITLES:
-            self.show(TITLES.index(self.choice.value))
+        if self.choice.value in self.titles:
+            self.show(self.titles.index(self.choice.value))
 
     @guarded(on_error=_internal_error)
     def _on_step(self, event) -> None:
-        if not self._user(event):
+        if not self._user(event) or not self.lessons:
             return
         step = {"Previous": -1, "Show this one": 0, "Next": 1}.get(self.steps.value, 0)
-        self.show((self.index + step) % len(DEMOS))
+        self.show((self.index + step) % len(self.lessons))
 
     @guarded(on_error=_internal_error)
     def _on_play(self, event) -> None:
@@ -113,15 +149,16 @@ class DemosView:
 
     def show(self, index: int) -> None:
         """Apply demonstration ``index``: mechanism, trajectory, camera, explorer; explain it."""
-        demo = DEMOS[index]
+        demo = self.lessons[index]
         try:
             params = demo_params(demo)
             pose = demo_pose(demo, params)
             source = demo_source(demo)
             facts = effect(demo)
-        except TpmVizError as exc:  # pragma: no cover - the demos are tested
+        except TpmVizError as exc:  # pragma: no cover - a lesson is checked when it is loaded
             self._refuse(exc)
             return
+        camera = (demo.camera.position, demo.camera.look_at) if demo.camera is not None else camera_pose(params)
         view = self.view
         with view.hub.lock:
             self.index = index
@@ -145,7 +182,7 @@ class DemosView:
             except TpmVizError as exc:
                 view.refuse(str(exc))
                 return
-            position, look_at = beside_panel(demo.camera.position, demo.camera.look_at)
+            position, look_at = beside_panel(*camera)
             view.client.camera.position = position
             view.client.camera.look_at = look_at
             self.explorer.set(kind=demo.map_kind, ellipses=demo.ellipses)
