@@ -1,5 +1,6 @@
-"""The teaching layer of one tab, in one object: the trajectory player, the singularity explorer and the guided
-demonstrations, and the per-hub services they share (background worker, map cache, trajectory runs).
+"""The teaching layer of one tab, in one object: the trajectory player, the singularity explorer, the guided
+demonstrations, the control lab and the motion planner, and the per-hub services they share (background workers,
+map cache, trajectory runs).
 
 :class:`~.client.ClientView` needs four calls: :meth:`Teaching.build_tabs` while its panel builds the tab group,
 :meth:`Teaching.attach` once it has joined a session, :meth:`Teaching.render` for every frame (under the hub's
@@ -14,8 +15,10 @@ import viser
 
 from tpm_viz.ui.session import Hub, Session, View
 from tpm_viz.ui.snapshot import Snapshot
+from tpm_viz.ui.teaching.control import ControlView
 from tpm_viz.ui.teaching.explorer import ExplorerView, MapService
 from tpm_viz.ui.teaching.lessons import DemosView
+from tpm_viz.ui.teaching.planner import PlannerView
 from tpm_viz.ui.teaching.player import PlayerView
 from tpm_viz.ui.teaching.playing import RunHub
 from tpm_viz.ui.worker import Worker
@@ -30,12 +33,15 @@ class Services:
     worker: Worker
     maps: MapService
     runs: RunHub
+    plans: Worker
+    """The planner's own worker: a slider's re-plan never waits behind a map, a run or a control simulation."""
 
     @classmethod
     def create(cls, hub: Hub) -> Services:
-        """The services of ``hub``: one worker thread for slow computations, the floor maps, the runs."""
+        """The services of ``hub``: one worker thread for slow computations (maps, runs, control simulations), the
+        floor maps, the runs, and one worker for the planner's live re-plans."""
         worker = Worker()
-        return cls(worker, MapService(worker), RunHub(hub, worker))
+        return cls(worker, MapService(worker), RunHub(hub, worker), Worker("tpm-viz-planner"))
 
 
 class Teaching:
@@ -47,9 +53,11 @@ class Teaching:
         self.player = PlayerView(view, self.services.runs)
         self.explorer = ExplorerView(view, self.services.maps)
         self.demos = DemosView(view, self.services.runs, self.explorer, self.player.speed_value)
+        self.control = ControlView(view, self.services.worker, self.services.runs)
+        self.planner = PlannerView(view, self.services.plans)
 
     def build_tabs(self, tabs: viser.GuiTabGroupHandle) -> None:
-        """Add the *Player*, *Explorer* and *Demos* tabs to the panel's tab group."""
+        """Add the *Player*, *Explorer*, *Demos*, *Control* and *Planner* tabs to the panel's tab group."""
         gui = self.view.client.gui
         with tabs.add_tab("Player", icon=viser.Icon.PLAYER_PLAY):
             self.player.build(gui)
@@ -57,11 +65,17 @@ class Teaching:
             self.explorer.build(gui)
         with tabs.add_tab("Demos", icon=viser.Icon.SCHOOL):
             self.demos.build(gui)
+        with tabs.add_tab("Control", icon=viser.Icon.ADJUSTMENTS):
+            self.control.build(gui)
+        with tabs.add_tab("Planner", icon=viser.Icon.ROUTE):
+            self.planner.build(gui)
 
     def attach(self) -> None:
         """The tab has joined its session: draw the session's run (the first render came before that)."""
         with self.view.hub.lock:
             self.player.refresh()
+        self.control.attach()
+        self.planner.attach()
 
     def switched(self, old: Session) -> None:
         """The tab moved from ``old`` to its current session (own copy on / off)."""
@@ -74,8 +88,12 @@ class Teaching:
         self.player.render(frame)
         self.explorer.render(frame)
         self.demos.render(frame)
+        self.control.render(frame)
+        self.planner.render(frame)
 
     def close(self) -> None:
         """The tab went away."""
         self.player.close()
         self.explorer.close()
+        self.control.player.stop()
+        self.planner.player.stop()

@@ -1,0 +1,361 @@
+"""The *Control* tab of one browser tab (issue 14): simulate a controller tracking a reference on the Pinocchio
+plant, play the run, compare the controllers.
+
+Widgets: controller (PD, PD + feedforward, computed torque), ω_n and ζ (gains shown), mismatch (payload, mass
+error), limits (force limit, controller rate, position noise), reference (the paper's line or circle, the Player's
+uploaded CSV). *Simulate* runs :func:`tpm_viz.multibody.control.simulate` in the background worker (off the hub's
+lock); the run is then played on the tab's session by a :class:`~.motion.MotionPlayer`: the mechanism follows the
+*actual* platform path (drawn at ``p_ref + k (p - p_ref)`` with the error magnified ``k`` times on request), a
+translucent ghost platform in the tab's own scope follows the reference. Charts: tracking error (µm) and the
+applied forces against the feedforward. The comparison table collects the controllers run on the same setup;
+*Why computed torque?* runs all three at once and words the lesson from their numbers.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import numpy as np
+import viser
+
+from tpm_viz import meshes
+from tpm_viz.errors import InputError, TpmVizError
+from tpm_viz.multibody.control import ControlRun, ControlSetup
+from tpm_viz.paper.control import ControllerKind, axis_masses, model_with_errors
+from tpm_viz.params import Params
+from tpm_viz.ui.guard import guarded
+from tpm_viz.ui.snapshot import Snapshot
+from tpm_viz.ui.teaching.control_run import (
+    PAPER,
+    ControlMotion,
+    all_three,
+    lab_reference,
+    lab_setup,
+    timed,
+    upload_label,
+)
+from tpm_viz.ui.teaching.control_text import LABELS, comparison_html, gains_html, lesson_html, run_html
+from tpm_viz.ui.teaching.motion import MotionPlayer, TimeChart
+from tpm_viz.ui.teaching.player import SPEEDS
+from tpm_viz.ui.teaching.playing import RunHub
+from tpm_viz.ui.teaching.trace import TRACE_Z, segments
+from tpm_viz.ui.worker import Worker
+
+__all__ = ["CONTROLLERS", "MAGNIFY", "ControlView"]
+
+CONTROLLERS = {label: kind for kind, label in LABELS.items()}
+MAGNIFY = {"×1 (true error)": 1.0, "×10": 10.0, "×100": 100.0, "×1000": 1000.0}
+LESSON_PAYLOAD = 1.0  # kg, set by the lesson when the payload slider is at zero
+GHOST_COLOUR = (34, 197, 94)
+REF_COLOUR, ACTUAL_COLOUR = (34, 197, 94), (220, 38, 38)
+CHART_HZ = 4.0
+
+
+def _internal_error(owner, exc: Exception) -> None:
+    owner.view.refuse(f"internal error ({type(exc).__name__}), logged on the server", resync=False)
+
+
+class ControlView:
+    """Control-lab widgets, scene nodes and runs of one tab."""
+
+    def __init__(self, view, worker: Worker, runs: RunHub) -> None:
+        self.view = view
+        self.worker = worker
+        self.runs = runs
+        self.player = MotionPlayer(view, "control", on_stop=self._refresh_status)
+        self.run: ControlRun | None = None
+        self.seconds: float | None = None
+        self.busy = ""
+        self.status = ""
+        self.table: dict[ControllerKind, ControlRun] = {}
+        self._table_key: tuple | None = None
+        self._ghost: viser.BoxHandle | None = None
+        self._paths: dict[str, viser.LineSegmentsHandle] = {}
+        self._last_push = 0.0
+        self._request = 0
+
+    def build(self, gui: viser.GuiApi) -> None:
+        """The *Control* tab's widgets (inside the tab's context)."""
+        gui.add_markdown(
+            "Track a reference with a controller on the multibody plant (Pinocchio). The green ghost is the "
+            "reference, the mechanism the actual platform; magnify the error to see it. Playback moves the "
+            "mechanism you are on (shared with the class unless you work on your own copy)."
+        )
+        self.controller = gui.add_dropdown("Controller", tuple(CONTROLLERS), initial_value=LABELS[ControllerKind.CTC])
+        self.wn = gui.add_slider("ω_n (Hz)", 1.0, 60.0, 0.5, 20.0)
+        self.zeta = gui.add_slider("ζ", 0.1, 2.0, 0.05, 1.0)
+        self.gains = gui.add_html("")
+        with gui.add_folder("Mismatch and limits"):
+            self.payload = gui.add_slider(
+                "Payload (kg)", 0.0, 5.0, 0.1, 0.0, hint="On the platform, unknown to the controller"
+            )
+            self.mass_error = gui.add_slider(
+                "Mass error (%)", -50.0, 50.0, 1.0, 0.0, hint="Of m_a, m_b, m_p in the model"
+            )
+            self.force_limit = gui.add_slider("Force limit (N, 0 = none)", 0.0, 1000.0, 10.0, 0.0)
+            self.rate = gui.add_slider("Controller rate (Hz)", 100.0, 5000.0, 100.0, 1000.0)
+            self.noise = gui.add_slider("Position noise (µm)", 0.0, 50.0, 1.0, 0.0)
+        self.reference = gui.add_dropdown("Reference", tuple(PAPER), initial_value="line (Fig. 4)")
+        self.simulate = gui.add_button("Simulate", icon=viser.Icon.PLAYER_TRACK_NEXT)
+        self.lesson = gui.add_button("Why computed torque? (run all three)", icon=viser.Icon.SCHOOL, color="teal")
+        self.summary = gui.add_html(run_html(None, None))
+        self.controls = gui.add_button_group("Playback", ("Play", "Pause", "To start"))
+        self.time = gui.add_slider("Time t (s)", 0.0, 0.2, 0.001, 0.0)
+        self.speed = gui.add_dropdown("Speed", tuple(SPEEDS), initial_value="0.05×")
+        self.magnify = gui.add_dropdown("Magnify the error", tuple(MAGNIFY), initial_value="×1 (true error)")
+        self.error_chart = TimeChart(
+            gui,
+            "Tracking error e = p_ref − p",
+            "error (µm)",
+            (("e₁", "#2563eb", None), ("e₂", "#dc2626", None), ("|e|", "#0f172a", (4.0, 3.0))),
+        )
+        self.force_chart = TimeChart(
+            gui,
+            "Actuator forces: applied (solid) vs feedforward (dashed)",
+            "force (N)",
+            (
+                ("τ₁", "#2563eb", None),
+                ("τ₂", "#dc2626", None),
+                ("τ₁ ff", "#93c5fd", (4.0, 3.0)),
+                ("τ₂ ff", "#fca5a5", (4.0, 3.0)),
+            ),
+        )
+        self.table_html = gui.add_html("")
+        self.lesson_text = gui.add_html("")
+        self._show_gains()
+        for handle in (self.controller, self.wn, self.zeta, self.mass_error):
+            handle.on_update(self._on_gains)
+        self.simulate.on_click(self._on_simulate)
+        self.lesson.on_click(self._on_lesson)
+        self.controls.on_click(self._on_controls)
+        self.time.on_update(self._on_time)
+        self.magnify.on_update(self._on_magnify)
+
+    # -- reading the widgets -------------------------------------------------------------------------------
+    def _kind(self) -> ControllerKind:
+        if self.controller.value not in CONTROLLERS:
+            raise InputError(f"unknown controller {self.controller.value!r}")
+        return CONTROLLERS[self.controller.value]
+
+    def _setup(self, kind: ControllerKind | None = None) -> ControlSetup:
+        kind = self._kind() if kind is None else kind
+        w = (self.wn, self.zeta, self.payload, self.mass_error, self.force_limit, self.rate, self.noise)
+        return lab_setup(kind, *(h.value for h in w))
+
+    def _user(self, event, fn, *args) -> None:
+        """Run ``fn`` for a user event (not a server echo); a refusal is told to this tab only."""
+        if getattr(event, "client", None) is None or self.view.closed or getattr(self.view, "session", None) is None:
+            return
+        try:
+            fn(*args)
+        except TpmVizError as exc:
+            with self.view.hub.lock:
+                self.view.refuse(str(exc), resync=False)
+
+    def _show_gains(self) -> None:
+        try:
+            setup = self._setup()
+            masses = axis_masses(model_with_errors(self.view.session.state.params, *setup.mass_error))
+        except (TpmVizError, AttributeError):
+            return
+        self.gains.content = gains_html(setup.controller, setup.gains, masses)
+
+    def attach(self) -> None:
+        """The tab joined its session: show the gains for its mechanism."""
+        with self.view.hub.lock:
+            self._show_gains()
+
+    # -- callbacks -----------------------------------------------------------------------------------------
+    @guarded(on_error=_internal_error)
+    def _on_gains(self, event) -> None:
+        self._user(event, self._gains_changed)
+
+    def _gains_changed(self) -> None:
+        with self.view.hub.lock:
+            self._show_gains()
+            self.view.client.flush()
+
+    @guarded(on_error=_internal_error)
+    def _on_simulate(self, event) -> None:
+        self._user(event, self._start, False)
+
+    @guarded(on_error=_internal_error)
+    def _on_lesson(self, event) -> None:
+        self._user(event, self._start, True)
+
+    def _start(self, lesson: bool) -> None:
+        """Read the widgets and simulate in the worker (the lesson: all three controllers, with a payload)."""
+        with self.view.hub.lock:
+            if lesson and float(self.payload.value) == 0.0:
+                self.payload.value = LESSON_PAYLOAD
+            setup = self._setup()
+            params = self.view.session.state.params
+            reference = lab_reference(self.reference.value, self.runs.of(self.view.session).uploaded)
+            self._request += 1
+            request = self._request
+            self.busy = "Simulating all three controllers…" if lesson else f"Simulating {LABELS[setup.controller]}…"
+            self._refresh_status()
+        if lesson:
+            job = lambda: all_three(params, reference, setup)  # noqa: E731
+        else:
+            job = lambda: {setup.controller: timed(params, reference, setup)}  # noqa: E731
+        self.worker.submit(
+            ("control", id(self)), job, lambda result, error: self._done(request, params, setup, lesson, result, error)
+        )
+
+    def _done(self, request: int, params: Params, setup: ControlSetup, lesson: bool, result, error) -> None:
+        with self.view.hub.lock:
+            if self.view.closed or request != self._request:
+                return
+            self.busy = ""
+            if error is not None:
+                self.status = f"Simulation refused: {error}"
+                self._refresh_status()
+                self.view.refuse(str(error), resync=False)
+                return
+            self.status = ""
+            key = (
+                params,
+                next(iter(result.values()))[0].name,
+                dataclasses.replace(setup, controller=ControllerKind.PD),
+            )
+            if key != self._table_key:
+                self._table_key, self.table = key, {}
+            for kind, (run, _seconds) in result.items():
+                self.table[kind] = run
+            run, seconds = result.get(setup.controller, next(iter(result.values())))
+            self._load(params, run, seconds)
+            self.table_html.content = comparison_html(self.table, self._setup_text(run))
+            if lesson:
+                self.lesson_text.content = lesson_html(self.table, setup.payload, setup.mass_error[0])
+            try:
+                self.player.seek(0.0)
+            except TpmVizError as exc:
+                self.view.refuse(str(exc), resync=False)
+            self._refresh_status()
+
+    def _setup_text(self, run: ControlRun) -> str:
+        s = run.setup
+        limit = "no force limit" if s.force_limit is None else f"limit {s.force_limit:g} N"
+        return (
+            f"{run.name}, ω_n {s.gains.wn:g} Hz, ζ {s.gains.zeta:g}, payload {s.payload:g} kg, mass error "
+            f"{s.mass_error[0] * 100:+g} %, {limit}, {s.rate:g} Hz, noise {s.noise * 1e6:g} µm"
+        )
+
+    def _load(self, params: Params, run: ControlRun, seconds: float) -> None:
+        """Make ``run`` the one played and charted (under the lock)."""
+        self.run, self.seconds = run, seconds
+        self.player.motion = ControlMotion(params, run, MAGNIFY.get(self.magnify.value, 1.0))
+        e = run.error * 1e6
+        self.error_chart.show(run.t, (e[:, 0], e[:, 1], run.error_norm * 1e6))
+        self.force_chart.show(run.t, (run.tau[:, 0], run.tau[:, 1], run.tau_ff[:, 0], run.tau_ff[:, 1]))
+        self.time.max = max(float(run.t[-1]), 1e-3)
+        self.time.step = max(float(run.t[-1]) / 400.0, 1e-4)
+        self._draw_paths(params)
+
+    def _draw_paths(self, params: Params) -> None:
+        motion = self.player.motion
+        if not isinstance(motion, ControlMotion):
+            return
+        scene = self.view.client.scene
+        for name, pts, colour in (
+            ("reference", motion.run.p_ref, REF_COLOUR),
+            ("actual", motion.shown_path(), ACTUAL_COLOUR),
+        ):
+            z = TRACE_Z + (0.001 if name == "actual" else 0.0)
+            self._paths[name] = scene.add_line_segments(
+                f"/control/{name}", segments(pts, z, 400), colour, thickness=2.5, thickness_units="screen"
+            )
+        half = meshes.platform_half_size(params)
+        thick = meshes.PLATFORM_Z[1] - meshes.PLATFORM_Z[0]
+        self._ghost = scene.add_box(
+            "/control/ghost",
+            GHOST_COLOUR,
+            (2 * half, 2 * half, thick),
+            opacity=0.45,
+            cast_shadow=False,
+            receive_shadow=False,
+            position=(0.0, 0.0, float(np.mean(meshes.PLATFORM_Z)) + 0.002),
+            visible=False,
+        )
+
+    @guarded(on_error=_internal_error)
+    def _on_controls(self, event) -> None:
+        self._user(event, self._control, self.controls.value)
+
+    def _control(self, what: str) -> None:
+        if what == "Play":
+            self.player.play(SPEEDS.get(self.speed.value, 0.05))
+        elif what == "Pause":
+            self.player.pause()
+        elif what == "To start":
+            self.player.seek(0.0)
+        with self.view.hub.lock:
+            self._refresh_status()
+
+    @guarded(on_error=_internal_error)
+    def _on_time(self, event) -> None:
+        self._user(event, self._seek)
+
+    def _seek(self) -> None:
+        with self.view.hub.lock:
+            t = self.player.at(self.view.session.state)
+            if t is not None and abs(t - float(self.time.value)) < 1e-9:
+                return  # the echo of a value written by playback
+            self.player.seek(float(self.time.value))
+
+    @guarded(on_error=_internal_error)
+    def _on_magnify(self, event) -> None:
+        self._user(event, self._magnified)
+
+    def _magnified(self) -> None:
+        with self.view.hub.lock:
+            motion = self.player.motion
+            if not isinstance(motion, ControlMotion):
+                return
+            motion.magnify = MAGNIFY.get(self.magnify.value, 1.0)
+            self._draw_paths(motion.params)
+            t = self.player.at(self.view.session.state)
+            if t is not None and not self.player.playing:
+                self.player.seek(t)
+            self.view.client.flush()
+
+    # -- drawing -------------------------------------------------------------------------------------------
+    def _refresh_status(self) -> None:
+        if self.view.closed:
+            return
+        self.summary.content = run_html(self.run, self.seconds, self.busy, self.status) + (
+            "<div style='font-size:0.85em;color:#334155'>playing…</div>" if self.player.playing else ""
+        )
+        self.view.client.flush()
+
+    def render(self, frame: Snapshot) -> None:
+        """Draw the control tab's part of ``frame`` (under the hub's lock): ghost, chart markers, time slider."""
+        session = getattr(self.view, "session", None)
+        if session is None:
+            return
+        uploaded = self.runs.of(session).uploaded
+        options = (*PAPER, upload_label(uploaded)) if uploaded is not None else tuple(PAPER)
+        if tuple(self.reference.options) != options:
+            self.reference.options = options
+        t = self.player.at(frame.state)
+        motion = self.player.motion
+        ghost = self._ghost
+        if ghost is not None:
+            if t is None or not isinstance(motion, ControlMotion):
+                if ghost.visible:
+                    ghost.visible = False
+            else:
+                x, y = motion.reference_at(t)
+                ghost.position = (float(x), float(y), ghost.position[2])
+                if not ghost.visible:
+                    ghost.visible = True
+        now = time.monotonic()
+        if frame.in_drag and now - self._last_push < 1.0 / CHART_HZ:
+            return
+        self._last_push = now
+        self.error_chart.mark(t)
+        self.force_chart.mark(t)
+        if t is not None and abs(float(self.time.value) - t) > 1e-9:
+            self.time.value = float(np.clip(round(t, 4), 0.0, self.time.max))
