@@ -9,10 +9,12 @@ lock) and :meth:`Teaching.close`; :meth:`Teaching.switched` when the tab moves t
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import viser
 
+from tpm_viz.app.lessons import DEMOS, PROBLEMS, Demo
 from tpm_viz.ui.session import Hub, Session, View
 from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.teaching.control import ControlView
@@ -35,13 +37,18 @@ class Services:
     runs: RunHub
     plans: Worker
     """The planner's own worker: a slider's re-plan never waits behind a map, a run or a control simulation."""
+    lessons: tuple[Demo, ...] = DEMOS
+    """The lessons of the *Demos* tab: the packaged ones, or a lecturer's (``tpm-viz serve --lessons DIR``)."""
+    problems: tuple[str, ...] = PROBLEMS
+    """One line per lesson file that was refused (``file:line: what is wrong``), shown in the tab."""
 
     @classmethod
-    def create(cls, hub: Hub) -> Services:
+    def create(cls, hub: Hub, lessons: Sequence[Demo] = DEMOS, problems: Sequence[str] = PROBLEMS) -> Services:
         """The services of ``hub``: one worker thread for slow computations (maps, runs, control simulations), the
-        floor maps, the runs, and one worker for the planner's live re-plans."""
+        floor maps, the runs, one worker for the planner's live re-plans, and the lessons."""
         worker = Worker()
-        return cls(worker, MapService(worker), RunHub(hub, worker), Worker("tpm-viz-planner"))
+        plans = Worker("tpm-viz-planner")
+        return cls(worker, MapService(worker), RunHub(hub, worker), plans, tuple(lessons), tuple(problems))
 
 
 class Teaching:
@@ -52,7 +59,9 @@ class Teaching:
         self.services = services
         self.player = PlayerView(view, self.services.runs)
         self.explorer = ExplorerView(view, self.services.maps)
-        self.demos = DemosView(view, self.services.runs, self.explorer, self.player.speed_value)
+        self.demos = DemosView(
+            view, services.runs, self.explorer, self.player.speed_value, services.lessons, services.problems
+        )
         self.control = ControlView(view, self.services.worker, self.services.runs)
         self.planner = PlannerView(view, self.services.plans)
 
