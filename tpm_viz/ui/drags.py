@@ -46,6 +46,8 @@ class DragQueue(Generic[V]):
     """A drain is scheduled (a drag that arrives meanwhile is taken by it)."""
     next_at: float = 0.0
     """``time.monotonic()`` before which no further drag is committed (pacing of a session shown by many tabs)."""
+    taken: int = -1
+    """Arrival number of the drag last taken: an older one that is queued late is dropped."""
     _pending: dict[V, list[PendingDrag]] = field(default_factory=dict)
 
     def push(self, view: V, drag: PendingDrag) -> None:
@@ -66,11 +68,12 @@ class DragQueue(Generic[V]):
 
     def take(self, origin: V, may_merge: Callable[[V], bool]) -> Take[V] | None:
         """Remove ``origin``'s drags and, if ``may_merge(origin)``, those of every other view with
-        ``may_merge(view)``; return the latest of them by arrival, or None if ``origin`` has none."""
+        ``may_merge(view)``; return the latest of them by arrival, or None if there is none newer than the drag last
+        taken (a drag that arrived while its tab was being built is queued late: it must not undo a newer one)."""
         own = self._pending.pop(origin, [])
         if not own:
             return None
-        latest, mover = own[-1], origin
+        latest, mover = max(own, key=lambda d: d.arrival), origin
         ended: list[V] = []
         if may_merge(origin):
             for view in list(self._pending):
@@ -80,8 +83,12 @@ class DragQueue(Generic[V]):
                 del self._pending[view]
                 if any(d.phase == "end" for d in drags):
                     ended.append(view)
-                if drags[-1].arrival > latest.arrival:
-                    latest, mover = drags[-1], view
+                newest = max(drags, key=lambda d: d.arrival)
+                if newest.arrival > latest.arrival:
+                    latest, mover = newest, view
         if mover is not origin and any(d.phase == "end" for d in own):
             ended.append(origin)
+        if latest.arrival <= self.taken:
+            return None
+        self.taken = latest.arrival
         return Take(mover, latest, tuple(ended))
