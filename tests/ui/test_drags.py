@@ -19,7 +19,7 @@ def test_the_latest_arrival_wins_across_the_tabs_that_may_merge():
     q.push("a", _drag(2))
     take = q.take("a", lambda v: v != "c")
     assert take is not None and take.mover == "b" and take.latest.arrival == 3
-XX
+    assert take.ended == ("b",)  # b's drag ended: its gizmo is written back by this commit
     assert q.waiting() == ["c"] and not q.has("a") and not q.has("b")
 
 
