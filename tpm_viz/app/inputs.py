@@ -7,7 +7,9 @@ for the user who sent it. Out-of-range numbers that are merely *too large* are c
 end); values that are not numbers at all (NaN, inf, text, wrong length) are refused.
 
 The CSV trajectory upload goes through :func:`read_upload` only (size, encoding, row count, finiteness, timing),
-whichever widget receives it.
+whichever widget receives it. :func:`value_problem` is the first, kind-level check of any widget value, applied to
+every GUI message before a callback runs (``ui/transport.py``): a number for a number, a boolean for a checkbox,
+text of at most :data:`MAX_TEXT` characters, a tuple of the widget's length.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from tpm_viz.paper.trajectories import Trajectory, parse_trajectory_csv
 from tpm_viz.params import PARAM_INFO, Params
 
 __all__ = [
+    "MAX_TEXT",
     "MAX_UPLOAD_BYTES",
     "MAX_UPLOAD_ROWS",
     "read_choice",
@@ -30,6 +33,7 @@ __all__ = [
     "read_params",
     "read_upload",
     "read_vec2",
+    "value_problem",
 ]
 
 MAX_UPLOAD_BYTES = 1 << 20
@@ -41,6 +45,36 @@ MAX_UPLOAD_SECONDS = 3600.0
 MAX_UPLOAD_POSITION = 10.0
 """Largest accepted ``|p_i|`` in an upload [m] (reachability is checked by whoever plays it)."""
 _MAX_NAME = 80
+MAX_TEXT = 1000
+"""Longest text a text input accepts [characters] (the presenter token is far shorter)."""
+
+
+def value_problem(current, value, max_text: int = MAX_TEXT) -> str | None:
+    """Why ``value`` is not a value of the same kind as a widget's ``current`` value (None if it is): a finite
+    number (not a boolean, not text) for a number, a boolean for a boolean, text of at most ``max_text`` characters
+    for text, a sequence of the same length, item by item, for a tuple."""
+    if current is None:
+        return "this widget takes no value"
+    if isinstance(current, bool):
+        return None if isinstance(value, bool) else f"on or off is due, got {type(value).__name__}"
+    if isinstance(current, (int, float)):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            return f"a number is due, got {type(value).__name__}"
+        try:
+            ok = math.isfinite(value)
+        except OverflowError:  # an int beyond float range
+            ok = False
+        return None if ok else "not a finite number"
+    if isinstance(current, str):
+        if not isinstance(value, str):
+            return f"text is due, got {type(value).__name__}"
+        return None if len(value) <= max_text else f"text longer than {max_text} characters"
+    if isinstance(current, tuple):
+        if not isinstance(value, (list, tuple)) or len(value) != len(current):
+            return f"{len(current)} values are due"
+        problems = (value_problem(c, v, max_text) for c, v in zip(current, value, strict=True))
+        return next((p for p in problems if p is not None), None)
+    return f"a value of the wrong type for this widget ({type(value).__name__})"
 
 
 def read_number(value, name: str, scale: float = 1.0, lo: float = -math.inf, hi: float = math.inf) -> float:

@@ -10,6 +10,10 @@ business and never reach the guard.
 :func:`guard_executor` applies the guard to every task of viser's callback pool as a safety net, so a callback
 that forgot the decorator is still logged and counted.
 
+:func:`log_fault` is the log of what a tab does wrong (malformed messages, refused uploads, wrong presenter tokens,
+floods): at most one line per second per tab and kind of fault, the next line saying how many were suppressed, so
+a hostile tab cannot fill the log.
+
 :data:`ACTIVITY` counts guarded calls: how many ran, failed and are running now. The soak test and the load
 benchmark read it ("no exception in the server log"); protocol-level tests wait on it
 (:meth:`Activity.wait_idle`) instead of sleeping.
@@ -23,7 +27,7 @@ import logging
 import threading
 import time
 
-__all__ = ["ACTIVITY", "Activity", "guard_executor", "guarded", "log", "report"]
+__all__ = ["ACTIVITY", "FAULTS", "Activity", "Faults", "guard_executor", "guarded", "log", "log_fault", "report"]
 
 log = logging.getLogger("tpm_viz.ui")
 
@@ -69,6 +73,51 @@ class Activity:
 
 
 ACTIVITY = Activity()
+
+
+class Faults:
+    """Rate-limited warnings: one line per ``interval`` seconds per ``(tab, kind)``, with the count suppressed."""
+
+    MAX_KEYS = 10_000
+    """Most ``(tab, kind)`` pairs remembered (older ones are forgotten first: tabs that left)."""
+
+    def __init__(self, interval: float = 1.0, clock=time.monotonic) -> None:
+        self.interval, self._clock = interval, clock
+        self._lock = threading.Lock()
+        self._last: dict[tuple[object, str], list] = {}  # key -> [time of the last line, suppressed since]
+        self.lines = 0
+        self.suppressed = 0
+
+    def __call__(self, client_id: object, kind: str, text: str) -> bool:
+        """Log ``text`` for this tab and kind unless one was logged less than ``interval`` ago (then count it).
+        Returns whether a line was written."""
+        now = self._clock()
+        with self._lock:
+            entry = self._last.get((client_id, kind))
+            if entry is not None and now - entry[0] < self.interval:
+                entry[1] += 1
+                self.suppressed += 1
+                return False
+            dropped = entry[1] if entry is not None else 0
+            self._last.pop((client_id, kind), None)
+            self._last[(client_id, kind)] = [now, 0]
+            if len(self._last) > self.MAX_KEYS:
+                del self._last[next(iter(self._last))]
+            self.lines += 1
+        more = f" (+{dropped} more in the last {now - entry[0]:.1f} s)" if entry is not None and dropped else ""
+        log.warning("client %s: %s%s", client_id, text, more)
+        return True
+
+    def forget(self, client_id: object) -> None:
+        """A tab left: drop its entries."""
+        with self._lock:
+            for key in [k for k in self._last if k[0] == client_id]:
+                del self._last[key]
+
+
+FAULTS = Faults()
+log_fault = FAULTS
+"""``log_fault(client_id, kind, text)``: the rate-limited warning of :class:`Faults` (one shared instance)."""
 
 
 def report(exc: BaseException, what: str) -> None:

@@ -1,103 +1,193 @@
-"""Hardening of viser's message handling for one connected tab: malformed GUI updates and oversized uploads.
+"""Hardening of viser's message handling: malformed messages, wrong-kind widget updates and uploads.
 
-A browser only ever sends ``GuiUpdateMessage(uuid, {"value": v})`` with a ``v`` of the widget's type, and uploads
-files no larger than the user picked. A hand-written client can send anything, and viser 1.1.1 then
+A browser only ever sends messages of the declared shape, ``GuiUpdateMessage(uuid, {"value": v})`` with a ``v`` of
+the widget's kind, and uploads files no larger than the user picked, to an upload button. A hand-written client can
+send anything, and viser 1.1.1 then
 
-- casts the value with the widget's Python type in its event loop (``float("abc")``, ``float(None)``, ``tuple(3.0)``
-  raise there and print a traceback per message; ``float("nan")`` and ``float("1e999")`` succeed), and lets a
-  client rewrite any property of its own widgets (label, min, max, disabled);
-- buffers every upload part in memory until the declared size has arrived, with no limit of its own.
+- builds any message whose fields have the wrong type or length (a 2-element gizmo position reaches every redraw
+  of that tab; a text ``owner`` where a string is due raises in a task nobody awaits);
+- casts a GUI value with the widget's Python type in its event loop (``float("abc")`` raises there, ``float("nan")``
+  and ``float("1e999")`` succeed, any string is a dropdown choice), and lets a client rewrite any property of its own
+  widgets (label, min, max, disabled);
+- accepts an upload aimed at any widget (a slider's value becomes an ``UploadedFile``) and buffers every upload
+  part until the declared size has arrived, with no limit of its own.
 
-:func:`harden` wraps both handlers on the tab's own connection: a GUI update must carry exactly ``value`` and cast
-like viser casts it, into finite numbers, else it is dropped with one warning line (at most one per second per
-tab); an upload larger than :data:`~.validate.MAX_UPLOAD_BYTES` is refused before any byte is buffered, and a
-transfer that sends more than it declared is dropped. What passes still goes through the callbacks' own
-validation (:mod:`tpm_viz.app.inputs`). viser's internals are reached through :class:`~._viser.ClientDoor`.
+:func:`message_problem` checks every incoming message against its declared field types (right types, tuple lengths,
+finite numbers, bounded text); :mod:`.limits` drops the bad ones before viser dispatches them. :func:`harden` wraps
+a tab's GUI and upload handlers: a GUI update must carry exactly ``value``, of the widget's kind (a number for a
+number, one of the options for a dropdown or a button group, ``True`` for a button, a boolean for a checkbox, text of
+at most :data:`MAX_TEXT` characters for a text input), finite; uploads go to upload buttons only, at most
+:data:`~tpm_viz.app.inputs.MAX_UPLOAD_BYTES` each (refused before any byte is buffered), at most
+:data:`MAX_UPLOADS` in flight per tab, each freed after :data:`UPLOAD_TIMEOUT` seconds if unfinished. Every drop is a
+rate-limited log line (:func:`~.guard.log_fault`). What passes still goes through the callbacks' own validation
+(:mod:`tpm_viz.app.inputs`). viser's internals are reached through :class:`~._viser.ClientDoor`.
 """
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
+import dataclasses
 import math
 import time
+import types
+import typing
+from typing import Any
 
 import viser
 
-from tpm_viz.app.inputs import MAX_UPLOAD_BYTES
-from tpm_viz.ui._viser import ClientDoor, widget_value
-from tpm_viz.ui.guard import log
+from tpm_viz.app.inputs import MAX_TEXT, MAX_UPLOAD_BYTES, value_problem
+from tpm_viz.ui._viser import ClientDoor, Malformed, widget_value
+from tpm_viz.ui.guard import log_fault
 
-__all__ = ["harden", "update_problem"]
+__all__ = ["MAX_UPLOADS", "UPLOAD_TIMEOUT", "harden", "message_problem", "update_problem"]
+
+MAX_UPLOADS = 2
+"""Uploads one tab may have in flight at once."""
+UPLOAD_TIMEOUT = 30.0
+"""Seconds an upload may take before its buffered parts are freed [s]."""
+_MAX_FIELD_TEXT = 4096
+"""Longest string in any field of an incoming message other than a GUI value (names, uuids, file names)."""
+_SKIP = {"excluded_self_client"}
 
 
-def update_problem(current, updates) -> str | None:
-    """Why a GUI update would be refused (viser's own cast of ``updates["value"]`` to ``type(current)``), or None."""
+def update_problem(current, updates, handle=None, max_text: int = MAX_TEXT) -> str | None:
+    """Why a GUI update would be refused, or None. ``current`` is the widget's value, ``handle`` the widget (its
+    kind and options; None: judged by the value's type only, as viser casts it)."""
     if not isinstance(updates, dict) or set(updates) != {"value"}:
         return f"only the value of a widget may change, got {sorted(map(str, updates))[:4]}"
     value = updates["value"]
-    try:
-        if isinstance(current, tuple):
-            items = tuple(value)
-            cast = tuple(type(current[0])(item) for item in items) if current else items
-        elif current is not None:
-            cast = (type(current)(value),)
-        else:
-            return "this widget takes no value"
-    except (TypeError, ValueError, OverflowError):
-        return f"a value of the wrong type for this widget ({type(value).__name__})"
-    if any(isinstance(x, float) and not math.isfinite(x) for x in cast):
-        return "not a finite number"  # no browser input yields NaN or inf; viser would cast "nan" to one
-    return None
-
-
-class _Warner:
-    """One warning line per tab and second at most (a flood of bad messages must not flood the log)."""
-
-    def __init__(self, client_id: int) -> None:
-        self.client_id, self.last, self.dropped = client_id, 0.0, 0
-
-    def __call__(self, text: str) -> None:
-        now = time.monotonic()
-        if now - self.last < 1.0:
-            self.dropped += 1
-            return
-        more = f" (+{self.dropped} more dropped)" if self.dropped else ""
-        log.warning("client %s: %s%s", self.client_id, text, more)
-        self.last, self.dropped = now, 0
+    if isinstance(handle, viser.GuiUploadButtonHandle):
+        return "an upload button takes files, not values"
+    if isinstance(handle, viser.GuiButtonHandle):
+        return None if value is True else "a button click is True"
+    if isinstance(handle, (viser.GuiDropdownHandle, viser.GuiButtonGroupHandle)):
+        return None if isinstance(value, str) and value in handle.options else "not one of the widget's options"
+    return value_problem(current, value, max_text)
 
 
 def harden(client: viser.ClientHandle, max_upload_bytes: int = MAX_UPLOAD_BYTES) -> None:
     """Install the filters of the module docstring on ``client``'s connection (call once, on connect)."""
     door = ClientDoor(client)
-    warn = _Warner(client.client_id)
+    cid = client.client_id
+    in_flight: dict[str, float] = {}  # transfer uuid -> start time, this tab's unfinished uploads
 
     async def gui_update(client_id, message) -> None:
         handle = door.widget(message.uuid)
         if handle is not None:
-            problem = update_problem(widget_value(handle), message.updates)
+            problem = update_problem(widget_value(handle), message.updates, handle)
             if problem is not None:
-                warn(f"GUI update dropped: {problem}")
+                log_fault(cid, "gui", f"GUI update dropped: {problem}")
                 return
         await door.gui_update(client_id, message)
 
     def refuse_upload(text: str) -> None:
-        warn(f"upload refused: {text}")
-        with contextlib.suppress(Exception):
-            client.add_notification("Upload refused", text, color="red", auto_close_seconds=8.0)
+        if log_fault(cid, "upload", f"upload refused: {text}"):  # at most one notification per second as well
+            with contextlib.suppress(Exception):
+                client.add_notification("Upload refused", text, color="red", auto_close_seconds=8.0)
+
+    def expire(transfer: str) -> None:
+        if in_flight.pop(transfer, None) is not None and door.upload_state(transfer) is not None:
+            door.drop_upload(transfer)
+            refuse_upload(f"the upload did not finish within {UPLOAD_TIMEOUT:g} s")
 
     def upload_start(client_id, message) -> None:
         size, parts = message.size_bytes, message.part_count
+        for transfer in [t for t in in_flight if door.upload_state(t) is None]:  # finished ones
+            del in_flight[transfer]
+        if not isinstance(door.widget(message.source_component_uuid), viser.GuiUploadButtonHandle):
+            log_fault(cid, "upload", "upload dropped: not aimed at an upload button")
+            return
         if not (0 <= size <= max_upload_bytes and 0 <= parts <= max(1, size)):
             refuse_upload(f"the file is too large ({size} bytes; at most {max_upload_bytes} bytes)")
             return
+        if len(in_flight) >= MAX_UPLOADS or message.transfer_uuid in in_flight:
+            refuse_upload(f"at most {MAX_UPLOADS} uploads at a time")
+            return
+        in_flight[message.transfer_uuid] = time.monotonic()
+        with contextlib.suppress(RuntimeError):  # called on the server's event loop
+            asyncio.get_running_loop().call_later(UPLOAD_TIMEOUT, expire, message.transfer_uuid)
         door.upload_start(client_id, message)
 
     def upload_part(client_id, message) -> None:
         state = door.upload_state(message.transfer_uuid)
-        if state is not None and state["transferred_bytes"] + len(message.content) > state["total_bytes"]:
+        if state is None or message.transfer_uuid not in in_flight:
+            return  # not this tab's upload in progress (or already refused): nothing is buffered
+        if state["transferred_bytes"] + len(message.content) > state["total_bytes"]:
             door.drop_upload(message.transfer_uuid)
+            in_flight.pop(message.transfer_uuid, None)
             refuse_upload("the file sent more bytes than it announced")
             return
         door.upload_part(client_id, message)
+        if door.upload_state(message.transfer_uuid) is None:
+            in_flight.pop(message.transfer_uuid, None)
 
     door.replace(gui_update, upload_start, upload_part)
+
+
+def message_problem(message: Any) -> str | None:
+    """Why an incoming message does not match its declared field types (None if it does)."""
+    if isinstance(message, Malformed):
+        return message.problem
+    for name, annotation, finite in _schema(type(message)):
+        problem = _value_problem(getattr(message, name, None), annotation, finite)
+        if problem is not None:
+            return f"{type(message).__name__}.{name}: {problem}"
+    return None
+
+
+_SCHEMAS: dict[type, tuple[tuple[str, Any, bool], ...]] = {}
+
+
+def _schema(cls: type) -> tuple[tuple[str, Any, bool], ...]:
+    """``(field, annotation, must be finite)`` of a message class (empty if its annotations cannot be read)."""
+    schema = _SCHEMAS.get(cls)
+    if schema is None:
+        try:
+            hints = typing.get_type_hints(cls)
+            names = [f.name for f in dataclasses.fields(cls)]
+        except Exception:  # an unknown message shape: viser alone decides
+            names, hints = [], {}
+        finite = cls.__name__ != "ViewerCameraMessage"  # a browser's camera is never dropped (the tab would not start)
+        schema = _SCHEMAS[cls] = tuple((n, hints[n], finite) for n in names if n in hints and n not in _SKIP)
+    return schema
+
+
+def _value_problem(value: Any, annotation: Any, finite: bool) -> str | None:
+    origin, args = typing.get_origin(annotation), typing.get_args(annotation)
+    if annotation is Any or annotation is object:
+        return None
+    if annotation in (float, int):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            return f"a number is due, got {type(value).__name__}"
+        if finite and isinstance(value, float) and not math.isfinite(value):
+            return "not a finite number"
+        return None
+    if annotation is bool:
+        return None if isinstance(value, bool) else f"a boolean is due, got {type(value).__name__}"
+    if annotation is str:
+        if not isinstance(value, str):
+            return f"text is due, got {type(value).__name__}"
+        return None if len(value) <= _MAX_FIELD_TEXT else "text too long"
+    if annotation is bytes:
+        return None if isinstance(value, (bytes, bytearray, memoryview)) else "bytes are due"
+    if annotation is type(None):
+        return None if value is None else "None is due"
+    if origin in (typing.Union, types.UnionType):
+        found = [_value_problem(value, a, finite) for a in args]
+        return None if any(p is None for p in found) else next(p for p in found if p)
+    if origin is typing.Literal:
+        return None if value in args else "not one of the allowed values"
+    if origin is tuple:
+        if not isinstance(value, (tuple, list)):
+            return f"a sequence is due, got {type(value).__name__}"
+        items = args[:1] * len(value) if len(args) == 2 and args[1] is Ellipsis else args
+        if len(items) != len(value):
+            return f"{len(items)} items are due, got {len(value)}"
+        problems = (_value_problem(v, a, finite) for v, a in zip(value, items, strict=True))
+        return next((p for p in problems if p is not None), None)
+    if origin is dict:
+        return None if isinstance(value, dict) else "a map is due"
+    if origin is list:
+        return None if isinstance(value, (list, tuple)) else "a list is due"
+    return None  # nested props and anything else: viser's own decoding decides

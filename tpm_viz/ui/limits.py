@@ -1,0 +1,352 @@
+"""Server-level limits: one tab cannot freeze or fill the server (issue 12).
+
+:func:`harden_server` (called once by ``build_server``) installs, on one viser server:
+
+- **Bounded work per tab** (:class:`Gate`, in front of viser's callback thread pool): a tab's callbacks run one at a
+  time (a flooding tab holds one pool thread, not 32); meanwhile each callback has at most one call waiting
+  (repeated clicks on an export coalesce into it, latest event wins), at most :attr:`Limits.max_callbacks_per_tab`
+  in all, the rest are dropped with a rate-limited log line. Connect and disconnect callbacks are never gated.
+- **Bounded memory**: websocket messages over :attr:`Limits.max_frame_bytes` close that connection (viser accepts
+  50 MiB; the largest thing a browser sends is a 512 KiB upload part); a watchdog thread drops a connection whose
+  outgoing backlog (messages queued and not yet written: a tab that stopped reading) stays over
+  :attr:`Limits.max_backlog_bytes` for :attr:`Limits.backlog_grace` seconds, and meanwhile runs none of its callbacks;
+  after tabs leave it returns freed heap to the system (``malloc_trim``); at most :attr:`Limits.max_connections`
+  tabs (the next one is told so in a notification, then closed). Uploads are bounded per tab in :mod:`.transport`.
+- **Well-formed messages only**: every incoming message is checked against its declared field types
+  (:func:`~.transport.message_problem`) before viser dispatches it; a handler that still fails is one log line.
+- **HTTP**: a path the app does not serve is a 404 (414 for an over-long one), never a 500.
+
+All drops are logged through :func:`~.guard.log_fault` (one line per second per tab and kind, with counts).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import concurrent.futures
+import ctypes
+import dataclasses
+import errno
+import functools
+import http
+import threading
+import time
+import weakref
+from typing import Any
+
+import viser
+
+from tpm_viz.ui._viser import ServerDoor, quiet_decoding, thread_pool, ws_server
+from tpm_viz.ui.guard import FAULTS, log_fault
+from tpm_viz.ui.transport import message_problem
+
+__all__ = [
+    "DEFAULT_MAX_CONNECTIONS",
+    "Gate",
+    "Limits",
+    "ServerGuard",
+    "guard_of",
+    "harden_server",
+    "set_max_connections",
+]
+
+DEFAULT_MAX_CONNECTIONS = 200
+
+
+@dataclasses.dataclass
+class Limits:
+    """The limits of one server (see the module docstring)."""
+
+    max_connections: int = DEFAULT_MAX_CONNECTIONS
+    max_frame_bytes: int = 1 << 20
+    max_callbacks_per_tab: int = 8
+    max_backlog_bytes: int = 32 << 20
+    max_backlog_messages: int = 20_000
+    backlog_grace: float = 5.0
+    check_interval: float = 0.25
+    refuse_close_delay: float = 1.0
+
+
+def _client_of(args: tuple) -> int | None:
+    """The tab a pool task works for (its event's ``client_id``), or None (connect/disconnect, server tasks)."""
+    event = args[0] if args else None
+    if event is None or isinstance(event, viser.ClientHandle):
+        return None
+    client_id = getattr(event, "client_id", None)
+    return client_id if isinstance(client_id, int) and not isinstance(client_id, bool) else None
+
+
+def _done() -> concurrent.futures.Future:
+    future: concurrent.futures.Future = concurrent.futures.Future()
+    future.set_result(None)
+    return future
+
+
+class Gate:
+    """Per-tab admission in front of an executor's ``submit`` (see the module docstring): one call of a tab runs at a
+    time; while it runs, each callback of that tab has at most one call waiting (a repeated call replaces the
+    waiting one's event: latest wins), at most ``max_per_tab`` waiting in all; waiting calls run in arrival order."""
+
+    def __init__(self, submit, max_per_tab: int = 8) -> None:
+        self._submit, self.max_per_tab = submit, max_per_tab
+        self._lock = threading.Lock()
+        self._waiting: dict[int, dict[Any, tuple]] = {}  # tab -> callback -> (args, kwargs); present = one running
+        self.blocked: set[int] = set()
+        self.merged = 0
+        self.dropped = 0
+
+    def submit(self, fn, /, *args, **kwargs) -> concurrent.futures.Future:
+        client_id = _client_of(args)
+        if client_id is None:
+            return self._submit(fn, *args, **kwargs)
+        with self._lock:
+            waiting = self._waiting.get(client_id)
+            if client_id in self.blocked:
+                reason = "the tab is not reading what it is sent"
+            elif waiting is None:
+                self._waiting[client_id] = {}
+                reason = ""
+            elif fn in waiting:
+                waiting[fn] = (args, kwargs)
+                self.merged += 1
+                return _done()
+            elif len(waiting) < self.max_per_tab:
+                waiting[fn] = (args, kwargs)
+                return _done()
+            else:
+                reason = "too many of its callbacks are queued"
+            if reason:
+                self.dropped += 1
+        if reason:
+            log_fault(client_id, "flood", f"callback dropped: {reason}")
+            return _done()
+        return self._start(client_id, fn, args, kwargs)
+
+    def _start(self, client_id: int, fn, args, kwargs) -> concurrent.futures.Future:
+        @functools.wraps(fn)
+        def run(*a, **k):
+            try:
+                return fn(*a, **k)
+            finally:
+                self._next(client_id)
+
+        try:
+            return self._submit(run, *args, **kwargs)
+        except RuntimeError:  # the pool is shut down: forget this tab's calls
+            with self._lock:
+                self._waiting.pop(client_id, None)
+            raise
+
+    def _next(self, client_id: int) -> None:
+        with self._lock:
+            waiting = self._waiting.get(client_id)
+            if not waiting:
+                self._waiting.pop(client_id, None)
+                return
+            fn = next(iter(waiting))
+            args, kwargs = waiting.pop(fn)
+        self._start(client_id, fn, args, kwargs)
+
+    def forget(self, client_id: int) -> None:
+        """A tab left: its waiting calls are dropped (a running one finishes)."""
+        with self._lock:
+            self.blocked.discard(client_id)
+            if client_id in self._waiting:
+                self._waiting[client_id] = {}
+
+    def pending(self, client_id: int) -> int:
+        """Calls of this tab running or waiting."""
+        with self._lock:
+            waiting = self._waiting.get(client_id)
+            return 0 if waiting is None else 1 + len(waiting)
+
+
+@functools.cache
+def _libc() -> Any:
+    try:
+        return ctypes.CDLL("libc.so.6")
+    except OSError:
+        return None
+
+
+def _malloc_trim() -> None:
+    """Give freed heap back to the system (glibc; a no-op elsewhere)."""
+    trim = getattr(_libc(), "malloc_trim", None)
+    if trim is not None:
+        trim(0)
+
+
+class ServerGuard:
+    """The limits of one server, installed by :func:`harden_server`."""
+
+    def __init__(self, server: viser.ViserServer, limits: Limits) -> None:
+        self.limits = limits
+        self.door = ServerDoor(server)
+        pool = thread_pool(server)
+        self.gate = Gate(pool.submit, limits.max_callbacks_per_tab)
+        pool.submit = self.gate.submit
+        self.accepted: set[int] = set()
+        self.refused: set[int] = set()
+        self.aborted = 0
+        self.trims = 0
+        limit_frames(server, limits.max_frame_bytes)
+        quiet_decoding(lambda text: log_fault("server", "garbage", text))
+        self.door.on_connect(self._connected, self._wrap(log=True))
+        self.door.on_disconnect(self._disconnected)
+        self.door.wrap_server_dispatch(self._wrap(log=False))
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._watch, name="tpm-viz-limits", daemon=True)
+        self._thread.start()
+
+    # -- connections ---------------------------------------------------------------------------------------------
+    def _connected(self, client_id: int) -> None:
+        if len(self.accepted) < self.limits.max_connections:
+            self.accepted.add(client_id)
+            return
+        self.refused.add(client_id)
+        n = self.limits.max_connections
+        log_fault("server", "full", f"connection {client_id} refused: {n} tabs are connected (max_connections)")
+        self.door.notify(client_id, "Too many tabs", f"This server takes at most {n} tabs. Try again later.")
+        loop = self.door.loop
+        if loop is not None:
+            loop.call_later(self.limits.refuse_close_delay, self.door.close, client_id, 1013, "too many tabs")
+
+    def _disconnected(self, client_id: int) -> None:
+        self.accepted.discard(client_id)
+        self.refused.discard(client_id)
+        self.gate.forget(client_id)
+        FAULTS.forget(client_id)
+
+    def _wrap(self, log: bool):
+        def wrap(dispatch):
+            async def handle(client_id, message) -> None:
+                if client_id in self.refused:
+                    return
+                problem = message_problem(message)
+                if problem is not None:
+                    if log:
+                        log_fault(client_id, "message", f"message dropped: {problem}")
+                    return
+                try:
+                    await dispatch(client_id, message)
+                except Exception as exc:  # viser's own handler choked on a message: one line, not a traceback
+                    name = type(message).__name__
+                    log_fault(client_id, "handler", f"{name} failed in viser: {type(exc).__name__}: {exc}")
+
+            return handle
+
+        return wrap
+
+    # -- the watchdog --------------------------------------------------------------------------------------------
+    def _watch(self) -> None:
+        over: dict[int, float] = {}
+        known: set[int] = set()
+        trim_at = 0.0
+        while not self._stop.wait(self.limits.check_interval):
+            loop = self.door.loop
+            if loop is None or loop.is_closed():
+                return
+            now = time.monotonic()
+            live = set(self.door.live())
+            for client_id in live:
+                if self._over(client_id):
+                    since = over.setdefault(client_id, now)
+                    self.gate.blocked.add(client_id)
+                    if now - since >= self.limits.backlog_grace:
+                        mb = self.limits.max_backlog_bytes / 2**20
+                        log_fault(client_id, "backlog", f"connection dropped: over {mb:g} MiB unsent for a while")
+                        self.door.abort(client_id)
+                        self.aborted += 1
+                        del over[client_id]
+                elif over.pop(client_id, None) is not None:
+                    self.gate.blocked.discard(client_id)
+            for client_id in set(over) - live:
+                del over[client_id]
+            if known - live:
+                trim_at = trim_at or now + 1.0  # once the departed tabs' teardown has run
+            known = live
+            if trim_at and now >= trim_at:
+                _malloc_trim()
+                self.trims += 1
+                trim_at = 0.0
+
+    def _over(self, client_id: int) -> bool:
+        _count, size = self.door.backlog(client_id, self.limits.max_backlog_messages)
+        return size < 0 or size > self.limits.max_backlog_bytes
+
+    def stop(self) -> None:
+        self._stop.set()
+
+
+_FRAME_LIMITS: weakref.WeakKeyDictionary[asyncio.AbstractEventLoop, int] = weakref.WeakKeyDictionary()
+
+
+class _LimitedServerProtocol(ws_server.ServerProtocol):
+    """viser's per-connection websocket protocol with, on the event loops of hardened servers, a smaller frame limit
+    and no HTTP 500: a path the file server cannot even look up (a segment too long for the file system) is a 414
+    or a 404."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        try:
+            limit = _FRAME_LIMITS.get(asyncio.get_running_loop())
+        except RuntimeError:
+            limit = None
+        if limit is not None:
+            size = kwargs.get("max_size")
+            kwargs["max_size"] = limit if not isinstance(size, int) else min(size, limit)
+        super().__init__(*args, **kwargs)
+
+    def fail(self, code: Any, reason: str = "") -> None:
+        super().fail(code, reason)
+        self.failed = True
+
+    def receive_data(self, data: bytes | bytearray) -> None:
+        if getattr(self, "failed", False):
+            return  # the rest of a refused 50 MiB frame: dropped as it arrives, not parsed
+        super().receive_data(data)
+
+    def reject(self, status: Any, text: str) -> Any:
+        exc = self.handshake_exc
+        if int(status) == http.HTTPStatus.INTERNAL_SERVER_ERROR and isinstance(exc, (OSError, ValueError)):
+            too_long = isinstance(exc, OSError) and exc.errno == errno.ENAMETOOLONG
+            status = http.HTTPStatus.REQUEST_URI_TOO_LONG if too_long else http.HTTPStatus.NOT_FOUND
+            text = "URI TOO LONG\n" if too_long else "NOT FOUND\n"
+            self.handshake_exc = None  # not a server fault: no traceback in the log
+        return super().reject(status, text)
+
+
+def limit_frames(server: viser.ViserServer, max_bytes: int) -> None:
+    """Refuse websocket messages over ``max_bytes`` on ``server`` (the connection is closed with code 1009), and
+    answer unservable HTTP paths with 404/414 instead of 500. viser builds its ``serve()`` once with a 50 MiB limit;
+    the protocol class it instantiates per connection is looked up at each connection, so the limit applies to
+    every later connection of this server (and only this server: it is keyed by the server's event loop)."""
+    loop = ServerDoor(server).loop
+    if loop is None:
+        raise RuntimeError("the viser server has no event loop yet")
+    _FRAME_LIMITS[loop] = int(max_bytes)
+    ws_server.ServerProtocol = _LimitedServerProtocol
+
+
+_ATTR = "tpm_viz_limits"
+
+
+def harden_server(server: viser.ViserServer, limits: Limits | None = None) -> ServerGuard:
+    """Install the limits of the module docstring on ``server`` (once; later calls return the same guard). The guard
+    lives as long as the server (it is kept on it)."""
+    guard = guard_of(server)
+    if guard is None:
+        guard = ServerGuard(server, limits or Limits())
+        setattr(server, _ATTR, guard)
+    return guard
+
+
+def guard_of(server: viser.ViserServer) -> ServerGuard | None:
+    """The guard installed on ``server``, if any (``TpmApp(max_connections=...)`` sets its limit)."""
+    guard = getattr(server, _ATTR, None)
+    return guard if isinstance(guard, ServerGuard) else None
+
+
+def set_max_connections(server: viser.ViserServer, max_connections: int) -> None:
+    """The most tabs ``server`` serves at once (installs the limits first if needed)."""
+    if not (isinstance(max_connections, int) and max_connections >= 1):
+        raise ValueError(f"max_connections must be a positive integer, got {max_connections!r}")
+    harden_server(server).limits.max_connections = max_connections
