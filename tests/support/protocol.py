@@ -3,8 +3,9 @@
 :class:`ProtocolClient` is a synchronous tab for tests against an in-process app (it sends what a browser sends and
 records the scene nodes it was sent); :class:`Tab` is an asyncio tab for the load and soak benchmarks.
 
-:class:`ServerProcess` starts ``python app.py --port 0`` on 127.0.0.1 (optionally with a presenter token), reads the
-port from its one printed line, measures its CPU time and resident memory from ``/proc/<pid>``, keeps its stderr
+:class:`ServerProcess` starts ``python app.py --port 0`` on 127.0.0.1 (optionally with a presenter token, a session
+file and more options; by default a session file of its own in a temporary folder), reads the port from its first
+printed line, measures its CPU time and resident memory from ``/proc/<pid>``, keeps its stderr
 (the server log) in a temporary file and stops it by its own pid.
 
 :class:`Tab` is one browser tab without a browser (websocket subprotocol ``viser-v<version>``, msgpack messages,
@@ -54,11 +55,19 @@ CAMERA = dict(
 class ServerProcess:
     """``python app.py --port 0`` on loopback, in a child process."""
 
-    def __init__(self, presenter_token: str | None = None) -> None:
+    def __init__(
+        self, presenter_token: str | None = None, session: Path | None = None, args: tuple[str, ...] = ()
+    ) -> None:
+        """``session``: the session file (default: a new one in a temporary folder, never the user's);
+        ``args``: more command-line options (e.g. ``--fresh``)."""
         self.log = tempfile.NamedTemporaryFile(prefix="tpm-viz-server-", suffix=".log", delete=False)
-        cmd = [sys.executable, str(ROOT / "app.py"), "--host", "127.0.0.1", "--port", "0"]
+        if session is None:
+            session = Path(tempfile.mkdtemp(prefix="tpm-viz-session-")) / "session.json"
+        self.session = session
+        cmd = [sys.executable, str(ROOT / "app.py"), "--host", "127.0.0.1", "--port", "0", "--session", str(session)]
         if presenter_token:
             cmd += ["--presenter-token", presenter_token]
+        cmd += list(args)
         self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=self.log, text=True, cwd=ROOT)
         line = self.proc.stdout.readline().strip()
         if not line.startswith("tpm-viz serving at http://127.0.0.1:"):

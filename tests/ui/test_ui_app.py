@@ -86,9 +86,11 @@ def test_loopback_detection_and_warning(monkeypatch):
     monkeypatch.setattr(app_module, "TpmApp", Fake)
     err, out = io.StringIO(), io.StringIO()
     with redirect_stderr(err), redirect_stdout(out):
-        main(host="0.0.0.0", port=8080, block=False)
+        main(host="0.0.0.0", port=8080, block=False, addresses=lambda: ["192.0.2.7", "127.0.0.1"])
     assert "warning" in err.getvalue() and "0.0.0.0" in err.getvalue()
-    assert out.getvalue().count("\n") == 1
+    lines = out.getvalue().splitlines()  # any non-loopback host is classroom mode: the URLs students type
+    assert lines[0] == "tpm-viz serving at http://127.0.0.1:1234"
+    assert [line for line in lines if line.startswith("Students open")] == ["Students open: http://192.0.2.7:1234/"]
 
 
 def test_share_url_tunnel_is_disabled(app, connect):

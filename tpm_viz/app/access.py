@@ -8,7 +8,14 @@ sees the shared mechanism and may do anything on its own copy (*Work on my own c
 the shared one is refused with a message to that tab only.
 
 No viser in :class:`Access` (tested without a server); :class:`LoginPanel` is the small widget group.
-Tokens are compared in constant time; a tab gets :data:`MAX_FAILURES` wrong attempts per :data:`LOCKOUT_SECONDS`.
+Tokens are compared in constant time. Wrong attempts are counted per *source address* (a tab that reconnects
+does not start again) and server-wide: :data:`MAX_FAILURES` per address per :data:`LOCKOUT_SECONDS`, after which
+each new lockout of that address lasts twice as long (up to :data:`MAX_LOCKOUT_SECONDS`), and at most
+:data:`MAX_FAILURES_SERVER` wrong attempts per :data:`LOCKOUT_SECONDS` from everybody together.
+
+Classroom mode (``tpm-viz serve --classroom``): a tab opened on the serving machine itself is a presenter
+(:meth:`Access.grant`), and the presenter can hand the shared mechanism to the class and take it back
+(:attr:`Access.open_to_class`).
 """
 
 from __future__ import annotations
@@ -20,10 +27,12 @@ import weakref
 
 from tpm_viz.errors import InputError
 
-__all__ = ["LOCKOUT_SECONDS", "MAX_FAILURES", "Access", "AccessDenied"]
+__all__ = ["LOCKOUT_SECONDS", "MAX_FAILURES", "MAX_FAILURES_SERVER", "MAX_LOCKOUT_SECONDS", "Access", "AccessDenied"]
 
 MAX_FAILURES = 5
 LOCKOUT_SECONDS = 60.0
+MAX_LOCKOUT_SECONDS = 900.0
+MAX_FAILURES_SERVER = 30
 MAX_TOKEN_CHARS = 256
 
 DENIED = (
@@ -52,9 +61,13 @@ class Access:
         checked = None if token is None else check_token(token)
         self._token = None if checked is None else checked.encode()
         self._presenters: weakref.WeakSet = weakref.WeakSet()
-        self._failures: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+        self._failures: dict[str, list[float]] = {}  # source address -> times of recent wrong attempts
+        self._lockouts: dict[str, tuple[float, int]] = {}  # source address -> (locked until, lockouts so far)
+        self._server_failures: list[float] = []
         self._lock = threading.Lock()
         self._clock = clock
+        self.open_to_class = False
+        """Classroom mode: the presenter handed the shared mechanism to the class (everybody may change it)."""
 
     @property
     def enabled(self) -> bool:
@@ -68,36 +81,59 @@ class Access:
         with self._lock:
             return view in self._presenters
 
+    def is_presenter_tab(self, view) -> bool:
+        """Whether ``view`` logged in (or was granted): presenter mode only; False without a token."""
+        with self._lock:
+            return self._token is not None and view in self._presenters
+
+    def grant(self, view) -> None:
+        """Make ``view`` a presenter tab without a token (a tab opened on the serving machine, classroom mode)."""
+        with self._lock:
+            self._presenters.add(view)
+
     def may_change(self, view, session) -> bool:
         """Whether ``view`` may commit to ``session`` (private copies: always)."""
-        return not getattr(session, "shared", False) or self.is_presenter(view)
+        return not getattr(session, "shared", False) or self.open_to_class or self.is_presenter(view)
 
     def check(self, view, session) -> None:
         """Raise :class:`AccessDenied` unless ``view`` may commit to ``session``."""
         if not self.may_change(view, session):
             raise AccessDenied(DENIED)
 
-    def login(self, view, attempt) -> bool:
-        """Make ``view`` a presenter tab if ``attempt`` is the token; raises after too many wrong attempts."""
+    def login(self, view, attempt, source: str | None = None) -> bool:
+        """Make ``view`` a presenter tab if ``attempt`` is the token; raises after too many wrong attempts from
+        ``source`` (the tab's address; default: the tab itself) or from everybody (see the module docstring)."""
         if self._token is None:
             return True
         now = self._clock()
+        where = source if source is not None else f"tab-{id(view)}"
         with self._lock:
-            recent = [t for t in self._failures.get(view, []) if now - t < LOCKOUT_SECONDS]
-            if len(recent) >= MAX_FAILURES:
-                wait = LOCKOUT_SECONDS - (now - recent[0])
-                raise InputError(f"too many wrong presenter tokens from this tab; try again in {wait:.0f} s")
+            until, count = self._lockouts.get(where, (0.0, 0))
+            if now < until:
+                raise InputError(f"too many wrong presenter tokens from this address; try again in {until - now:.0f} s")
+            self._server_failures = [t for t in self._server_failures if now - t < LOCKOUT_SECONDS]
+            if len(self._server_failures) >= MAX_FAILURES_SERVER:
+                wait = LOCKOUT_SECONDS - (now - self._server_failures[0])
+                raise InputError(f"too many wrong presenter tokens on this server; try again in {wait:.0f} s")
             text = attempt if isinstance(attempt, str) else ""
             ok = len(text) <= MAX_TOKEN_CHARS and hmac.compare_digest(text.encode(), self._token)
             if ok:
                 self._presenters.add(view)
-                self._failures.pop(view, None)
-            else:
-                self._failures[view] = [*recent, now]
-            return ok
+                self._failures.pop(where, None)
+                return True
+            recent = [t for t in self._failures.get(where, []) if now - t < LOCKOUT_SECONDS] + [now]
+            self._server_failures.append(now)
+            if len(recent) >= MAX_FAILURES:  # locked out, each time twice as long
+                wait = min(LOCKOUT_SECONDS * 2**count, MAX_LOCKOUT_SECONDS)
+                self._lockouts[where] = (now + wait, count + 1)
+                recent = []
+            self._failures[where] = recent
+            if len(self._failures) > 10_000:  # bounded: forget the oldest addresses
+                for old in list(self._failures)[:5000]:
+                    del self._failures[old]
+            return False
 
     def logout(self, view) -> None:
         """``view`` is no longer a presenter tab (it closed or logged out)."""
         with self._lock:
             self._presenters.discard(view)
-            self._failures.pop(view, None)

@@ -1,6 +1,6 @@
 """The one door to viser's private internals (viser 1.1.x). No other module of tpm-viz touches a private viser name.
 
-tpm-viz needs five things viser's public API does not offer:
+tpm-viz needs these things viser's public API does not offer:
 
 - the server's callback thread pool (``server._thread_executor``), to guard every callback (:mod:`.guard`);
 - a tab's message handlers (``client._websock_connection``, ``gui._handle_gui_updates``,
@@ -8,7 +8,13 @@ tpm-viz needs five things viser's public API does not offer:
   to drop malformed GUI updates and oversized uploads before viser handles them (:mod:`.transport`);
 - a GUI handle's current value without running its callbacks (``handle._impl.value``);
 - a client-scoped gizmo's cross-client echo (``gizmo._impl_aux.sync_cb``), which costs CPU and reaches nobody;
-- the share-URL tunnel, which any client can request: ``server.request_share_url`` is replaced by a no-op.
+- the share-URL tunnel, which any client can request: ``server.request_share_url`` is replaced by a no-op;
+- the websocket server under viser (:class:`ServerDoor`, for :mod:`.limits`): each connection's message dispatch
+  (``_handle_incoming_message``, wrapped to drop malformed messages), its outgoing backlog
+  (``_client_state_from_id``), the raw connections (``_live_connections``, to refuse or drop a tab) and the
+  websockets module viser serves with (:data:`ws_server`; :mod:`.limits` replaces the ``ServerProtocol`` it builds per
+  connection: viser accepts 50 MiB frames and answers an over-long URL segment with HTTP 500), and viser's decoding of
+  incoming messages (:func:`quiet_decoding`).
 
 :func:`check_viser` runs when the server is built: the installed viser must be the tested minor version
 (:data:`TESTED`, pinned in ``pyproject.toml``) and every internal above must exist, else the app stops at start with
@@ -18,30 +24,46 @@ behaviour of each internal.
 
 from __future__ import annotations
 
+import asyncio
+import contextlib
 import inspect
-from collections.abc import Awaitable, Callable
+import threading
+import uuid
+from collections.abc import Awaitable, Callable, Iterator
 from typing import Any, cast
 
 import viser
 from viser import _messages
+from viser.infra import _infra
 
 from tpm_viz.errors import TpmVizError
+
+ws_server = _infra.websockets.asyncio.server
+"""websockets' asyncio server, as viser imported it (tpm-viz does not depend on websockets directly)."""
 
 __all__ = [
     "TESTED",
     "ClientDoor",
     "IncompatibleViserError",
+    "Malformed",
+    "ServerDoor",
     "check_viser",
+    "connection_request",
     "disable_share_url",
     "drop_gizmo_echo",
+    "hook_handshakes",
+    "quiet_decoding",
     "thread_pool",
+    "widget_uuid",
     "widget_value",
+    "ws_server",
 ]
 
 TESTED = "1.1"
 """The viser minor version tpm-viz is tested with (``pyproject.toml`` pins ``viser>=1.1.1,<1.2``)."""
 
-_SERVER_ATTRS = ("_thread_executor", "request_share_url")
+_SERVER_ATTRS = ("_thread_executor", "request_share_url", "_websock_server")
+_WEBSOCK_ATTRS = ("_client_state_from_id", "_live_connections", "_background_event_loop", "_handle_incoming_message")
 _GUI_METHODS = ("_handle_gui_updates", "_handle_file_transfer_start", "_handle_file_transfer_part")
 _MESSAGES = ("GuiUpdateMessage", "FileTransferStartUpload", "FileTransferPart")
 
@@ -60,6 +82,9 @@ def check_viser(version: str | None = None) -> None:
     missing = [f"ViserServer.{a}" for a in _SERVER_ATTRS if not _has_attr_or_init(viser.ViserServer, a)]
     missing += [f"GuiApi.{m}" for m in _GUI_METHODS if not hasattr(viser.GuiApi, m)]
     missing += [f"_messages.{m}" for m in _MESSAGES if not hasattr(_messages, m)]
+    missing += [f"WebsockServer.{a}" for a in _WEBSOCK_ATTRS if not _has_attr_or_init(viser.infra.WebsockServer, a)]
+    if not hasattr(ws_server, "ServerProtocol"):
+        missing.append("websockets.asyncio.server.ServerProtocol")
     if missing:
         raise IncompatibleViserError(f"viser {version} lacks {', '.join(missing)}; {fix}")
 
@@ -96,6 +121,11 @@ def disable_share_url(server: viser.ViserServer) -> None:
 def widget_value(handle: Any) -> Any:
     """The current value of a GUI handle as viser stores it (no callback runs, no cast)."""
     return handle._impl.value
+
+
+def widget_uuid(handle: Any) -> str:
+    """The uuid of a GUI handle (its ``label for=`` in the page: :mod:`.login` masks the token field by it)."""
+    return str(handle._impl.uuid)
 
 
 def drop_gizmo_echo(gizmo: Any) -> None:
@@ -143,3 +173,191 @@ class ClientDoor:
         for message_type, old, new in pairs:
             self._conn.unregister_handler(message_type, old)
             self._conn.register_handler(message_type, new)
+
+
+Incoming = Callable[[int, Any], Awaitable[None]]
+Wrapper = Callable[[Incoming], Incoming]
+
+
+class ServerDoor:
+    """The websocket server under a viser server, for :mod:`.limits` (see the module docstring)."""
+
+    def __init__(self, server: viser.ViserServer) -> None:
+        self._ws: Any = server._websock_server
+
+    @property
+    def loop(self) -> asyncio.AbstractEventLoop | None:
+        """The server's event loop (None before it starts)."""
+        loop: asyncio.AbstractEventLoop | None = self._ws._background_event_loop
+        return loop
+
+    def on_connect(self, cb: Callable[[int], None], wrap: Wrapper) -> None:
+        """Run ``cb(client_id)`` on the event loop for every new websocket connection, before any of its messages
+        is handled, and route that connection's messages through ``wrap(dispatch)``."""
+
+        async def connected(conn: Any) -> None:
+            conn._handle_incoming_message = wrap(conn._handle_incoming_message)
+            cb(conn.client_id)
+
+        self._ws.on_client_connect(connected)
+
+    def on_disconnect(self, cb: Callable[[int], None]) -> None:
+        """Run ``cb(client_id)`` on the event loop when a websocket connection ends, after emptying its outgoing
+        buffer (what a tab that stopped reading left queued is freed now, not when its handles are collected)."""
+
+        async def disconnected(conn: Any) -> None:
+            buffer = conn._state.message_buffer
+            with buffer.buffer_lock:
+                buffer.message_from_id.clear()
+                buffer.id_from_redundancy_key.clear()
+                buffer.ids_from_entity_state_key.clear()
+            cb(conn.client_id)
+
+        self._ws.on_client_disconnect(disconnected)
+
+    def wrap_server_dispatch(self, wrap: Wrapper) -> None:
+        """Route the messages handled at the server level (server-scoped widgets and scene) through ``wrap``."""
+        self._ws._handle_incoming_message = wrap(self._ws._handle_incoming_message)
+
+    def live(self) -> list[int]:
+        """Ids of the open websocket connections."""
+        return list(self._ws._live_connections)
+
+    def backlog(self, client_id: int, count_bytes_below: int) -> tuple[int, int]:
+        """``(messages, bytes)`` queued for this connection and not yet written to its socket; the bytes (payloads
+        of files, text, arrays) are only added up when there are fewer than ``count_bytes_below`` messages."""
+        state, connection = self._ws._client_state_from_id.get(client_id), self._ws._live_connections.get(client_id)
+        if state is None or connection is None:
+            return 0, 0
+        messages = list(state.message_buffer.message_from_id.values())
+        if len(messages) >= count_bytes_below:
+            return len(messages), -1
+        transport = connection.transport  # the frame being written (up to one window of 128 messages)
+        written = transport.get_write_buffer_size() if transport is not None else 0
+        return len(messages), written + sum(map(_message_bytes, messages))
+
+    def notify(self, client_id: int, title: str, body: str) -> None:
+        """Show a red notification in that tab (a connection not yet registered as a viser client included)."""
+        state = self._ws._client_state_from_id.get(client_id)
+        if state is None:
+            return
+        props = _messages.NotificationProps(
+            title=title, body=body, loading=False, with_close_button=True, auto_close_seconds=None, color="red"
+        )
+        state.message_buffer.push(_messages.NotificationShowMessage(uuid=str(uuid.uuid4()), props=props))
+        state.message_buffer.flush()
+
+    def close(self, client_id: int, code: int, reason: str) -> None:
+        """Close this connection with a closing handshake (from any thread)."""
+        connection, loop = self._ws._live_connections.get(client_id), self.loop
+        if connection is not None and loop is not None and not loop.is_closed():
+            asyncio.run_coroutine_threadsafe(connection.close(code, reason), loop)
+
+    def abort(self, client_id: int) -> None:
+        """Drop this connection at once, without a closing handshake (a tab that does not read; from any thread)."""
+        connection, loop = self._ws._live_connections.get(client_id), self.loop
+        if connection is not None and loop is not None and not loop.is_closed():
+            loop.call_soon_threadsafe(connection.transport.abort)
+
+
+def _message_bytes(message: Any) -> int:
+    """Rough size of a queued message [bytes]: its bytes, text and array payloads plus a fixed overhead."""
+    size = 64
+    for value in vars(message).values():
+        if isinstance(value, (bytes, bytearray, str)):
+            size += len(value)
+        else:
+            size += int(getattr(value, "nbytes", 0) or 0)
+    return size
+
+
+class Malformed:
+    """Stands for a message of a known type whose fields viser could not decode (wrong types, missing fields):
+    dispatched like a message, handled by nobody, dropped with a log line by :mod:`.limits`."""
+
+    def __init__(self, problem: str) -> None:
+        self.problem = problem
+
+
+_DESERIALIZE = _messages.Message.deserialize.__func__  # type: ignore[attr-defined]
+_BIG_MESSAGE = 64 << 10
+"""Incoming messages larger than this [bytes] must be upload parts (nothing else a browser sends is that big): a
+big map or list in any other message would hold the event loop while it is decoded."""
+
+
+class _UploadPart(_infra.msgspec.Struct, forbid_unknown_fields=True):
+    """The one big message a browser sends, decoded strictly (fails at the first unexpected field)."""
+
+    type: str
+    source_component_uuid: str | None
+    transfer_uuid: str
+    part_index: int
+    content: bytes
+
+
+def quiet_decoding(on_garbage: Callable[[str], object]) -> None:
+    """Make viser's decoding of incoming messages forgiving (process-wide, once): a message whose fields cannot be
+    cast (``float("a")`` in a position, a missing field) becomes a :class:`Malformed` instead of an exception that
+    closes the connection with a traceback in the log; bytes that are not a message at all (not msgpack, no known
+    type) still close the connection, quietly (``on_garbage(text)`` is told)."""
+    if getattr(_messages.Message, "_tpm_viz_quiet", False):
+        return
+
+    def deserialize(cls: Any, raw: bytes) -> Any:
+        if len(raw) > _BIG_MESSAGE:
+            try:
+                big = _infra.msgspec.msgpack.decode(raw, type=_UploadPart)
+            except _infra.msgspec.MsgspecError:
+                big = None
+            if big is None or big.type != "FileTransferPart":
+                on_garbage(f"connection closed: a message of {len(raw)} bytes that is not an upload part")
+                raise _infra.websockets.exceptions.ConnectionClosedError(None, None)
+        try:
+            return _DESERIALIZE(cls, raw)
+        except (_infra.msgspec.DecodeError, KeyError, AttributeError) as exc:
+            on_garbage(f"connection closed: not a viser message ({type(exc).__name__})")
+            raise _infra.websockets.exceptions.ConnectionClosedError(None, None) from None
+        except (ValueError, TypeError, IndexError) as exc:
+            return Malformed(f"{type(exc).__name__}: {str(exc)[:120]}")
+
+    _messages.Message.deserialize = classmethod(deserialize)  # type: ignore[method-assign,assignment]
+    _messages.Message._tpm_viz_quiet = True  # type: ignore[attr-defined]
+
+
+# -- handshakes (ui/classroom.py: same-origin check, the browser's identity cookie) ----------------------------------
+Handshake = Callable[[Any, Any, Callable[[], Any]], Any]
+"""``hook(connection, request, viser_response)``: return a websockets ``Response`` (e.g. ``viser_response()``, with
+headers added, or ``connection.respond(403, ...)`` to refuse) or None (go on with the websocket handshake)."""
+_HANDSHAKE_LOCK = threading.Lock()
+
+
+@contextlib.contextmanager
+def hook_handshakes(hook: Handshake) -> Iterator[None]:
+    """While a ``ViserServer`` is built inside this block, every HTTP request and websocket handshake of the server
+    it starts goes through ``hook`` first (viser passes its page server to websockets' ``serve(process_request=)``;
+    ``ViserServer()`` returns once ``serve`` was entered, so the block covers it)."""
+    with _HANDSHAKE_LOCK:
+        original = ws_server.serve
+
+        def serve(*args: Any, **kwargs: Any) -> Any:
+            inner = kwargs.get("process_request")
+
+            def process_request(connection: Any, request: Any) -> Any:
+                return hook(connection, request, lambda: None if inner is None else inner(connection, request))
+
+            kwargs["process_request"] = process_request
+            return original(*args, **kwargs)
+
+        ws_server.serve = serve  # type: ignore[assignment]
+        try:
+            yield
+        finally:
+            ws_server.serve = original
+
+
+def connection_request(server: viser.ViserServer, client_id: int) -> tuple[Any, Any] | None:
+    """``(remote_address, request headers)`` of a connected tab's websocket handshake, or None if it is gone."""
+    connection = server._websock_server._live_connections.get(client_id)
+    if connection is None or connection.request is None:
+        return None
+    return connection.remote_address, connection.request.headers

@@ -19,10 +19,13 @@ import gc
 import io
 import ipaddress
 import logging
+import signal
 import sys
 import threading
 import time
 import warnings
+from collections.abc import Callable
+from pathlib import Path
 
 import viser
 
@@ -32,10 +35,14 @@ from tpm_viz.app.readouts import Reference
 from tpm_viz.app.state import AppState
 from tpm_viz.errors import TpmVizError
 from tpm_viz.params import Params
-from tpm_viz.ui._viser import check_viser, disable_share_url, thread_pool
+from tpm_viz.ui._viser import check_viser, disable_share_url, hook_handshakes, thread_pool
+from tpm_viz.ui.classroom import Classroom, Handshakes, local_addresses, qr_text, student_urls
 from tpm_viz.ui.client import ClientView
-from tpm_viz.ui.guard import guard_executor, guarded, log, report
+from tpm_viz.ui.continuity import Store
+from tpm_viz.ui.guard import guard_executor, guarded, log, log_fault, report
+from tpm_viz.ui.limits import DEFAULT_MAX_CONNECTIONS, harden_server, set_max_connections
 from tpm_viz.ui.login import LoginPanel
+from tpm_viz.ui.room import Room
 from tpm_viz.ui.scene import MechanismScene, camera_pose
 from tpm_viz.ui.session import Hub
 from tpm_viz.ui.teaching.tabs import Services
@@ -62,10 +69,14 @@ def build_server(host: str = "127.0.0.1", port: int = 8080) -> viser.ViserServer
     Raises :class:`~tpm_viz.ui._viser.IncompatibleViserError` (one line) if the installed viser is not the tested one.
     """
     check_viser()
-    with contextlib.redirect_stdout(io.StringIO()):  # viser prints its own banner even with verbose=False
+    with (
+        contextlib.redirect_stdout(io.StringIO()),
+        hook_handshakes(Handshakes()),
+    ):  # same-origin check; viser prints its own banner even with verbose=False
         server = viser.ViserServer(host=host, port=port, label="tpm-viz", verbose=False)
     disable_share_url(server)
     guard_executor(thread_pool(server))  # every callback's exception is logged
+    harden_server(server)  # one tab cannot freeze or fill the server (ui/limits.py)
     server.gui.configure_theme(
         control_width="large", show_share_button=False, show_logo=False, brand_color=BRAND, dark_mode=False
     )
@@ -88,9 +99,13 @@ class TpmApp:
         params: Params | None = None,
         reference: Reference | None = multibody.inverse_dynamics,
         presenter_token: str | None = None,
+        max_connections: int = DEFAULT_MAX_CONNECTIONS,
+        classroom: Classroom | None = None,
+        store: Store | None = None,
     ) -> None:
         self.server = server
-        self.access = Access(presenter_token)
+        set_max_connections(server, max_connections)  # the next tab is told the class is full, then closed
+        self.access = Access(presenter_token if presenter_token or classroom is None else classroom.token)
         state = AppState.initial(params)
         shared_scene = MechanismScene(server.scene, state.params, sink=server)  # drawn once for every tab
         self.hub = Hub(state, reference, self.access, shared_scene)
@@ -103,6 +118,9 @@ class TpmApp:
         server.initial_camera.position = position
         server.initial_camera.look_at = look_at
         self.hub.on_membership = self._class_info
+        self.room = Room(self, classroom, store)
+        """Classroom mode, tabs that come back, the session file (:mod:`.room`)."""
+        self.room.start()
         server.on_client_connect(self._connect)
         server.on_client_disconnect(self._disconnect)
 
@@ -114,11 +132,13 @@ class TpmApp:
     @guarded
     def _connect(self, client: viser.ClientHandle) -> None:
         harden(client)  # malformed GUI updates and oversized uploads are dropped before viser sees them
+        who = self.room.identify(client)  # before the view moves the camera
         view = ClientView(client, self.hub, self.services)
         if self.access.enabled:
             view.login = LoginPanel(client.gui, lambda event, view=view: self._login(event, view))
         with self._views_lock:
             self.views[client.client_id] = view
+        self.room.connected(view, who)  # presenter or not; what it had before a drop
         self._class_info()
 
     @guarded
@@ -126,6 +146,7 @@ class TpmApp:
         with self._views_lock:
             view = self.views.pop(client.client_id, None)
         if view is not None:
+            self.room.leaving(view)  # kept 30 minutes for a tab that comes back
             self.access.logout(view)
             view.close()
 
@@ -139,16 +160,17 @@ class TpmApp:
             return
         attempt = login.take()
         try:
-            ok = self.access.login(view, attempt)
+            ok = self.access.login(view, attempt, source=self.room.source(view))
         except TpmVizError as exc:
             view.refuse(str(exc), resync=False)
             return
         if not ok:
-            log.warning("client %s: wrong presenter token", view.client.client_id)
+            log_fault(view.client.client_id, "login", "wrong presenter token")  # rate-limited
             view.refuse("wrong presenter token", resync=False)
             return
         log.info("client %s is now a presenter tab", view.client.client_id)
         login.show("**You are the presenter**: your changes go to the shared mechanism.")
+        self.room.promoted(view)
         self._class_info()
 
     def _class_info(self) -> None:
@@ -160,12 +182,14 @@ class TpmApp:
             where = "your own copy" if not view.session.shared else "the shared mechanism"
             text = f"{len(views)} tab(s) connected, {shared} on the shared mechanism. You see {where}."
             if self.access.enabled:
-                who = "you are" if self.access.is_presenter(view) else "only the presenter is"
+                who = "you are" if self.access.is_presenter_tab(view) else "only the presenter is"
+                who = "the presenter handed it to the class: everybody is" if self.access.open_to_class else who
                 text += f" Presenter mode: {who} allowed to change the shared mechanism."
             view.set_class_info(text)
 
     def stop(self) -> None:
-        """Stop the server (the port is free again at once) and the app's drag threads."""
+        """Stop the server (the port is free again at once) and the app's drag threads; save the session."""
+        self.room.stop()
         self.server.stop()
         self.hub.drag_pool.shutdown(wait=False, cancel_futures=True)
 
@@ -187,13 +211,31 @@ def _thread_died(args) -> None:
         report(args.exc_value, f"thread {args.thread.name if args.thread else '?'}")
 
 
-def main(host: str = "127.0.0.1", port: int = 8080, block: bool = True, presenter_token: str | None = None) -> TpmApp:
-    """Serve the app; print one line with the real URL; block until Ctrl-C unless ``block`` is False.
+def main(
+    host: str = "127.0.0.1",
+    port: int = 8080,
+    block: bool = True,
+    presenter_token: str | None = None,
+    classroom: bool = False,
+    session: Path | None = None,
+    fresh: bool = False,
+    addresses: Callable[[], list[str]] | None = None,
+) -> TpmApp:
+    """Serve the app; print the real URL; block until Ctrl-C (or SIGTERM) unless ``block`` is False.
 
-    ``presenter_token``: if given, only a tab that logs in with it changes the shared mechanism."""
+    ``presenter_token``: if given, only a tab that logs in with it changes the shared mechanism. ``classroom``
+    (implied by a non-loopback ``host``): print the URLs students type and a QR code, a tab on this machine is the
+    presenter, and a token (``presenter_token`` or a random one, printed here only) lets the lecturer present from
+    another device. ``session``: the session file to read at start and keep saved (None: nothing is saved);
+    ``fresh``: start clean (the file is overwritten). ``addresses``: this machine's network addresses (a lookup;
+    tests inject theirs)."""
     access = Access(presenter_token)  # validates the token before anything starts
+    classroom = classroom or not is_loopback(host)
+    room = Classroom(addresses=addresses or local_addresses) if classroom else None
+    if room is not None and presenter_token:
+        room.token = presenter_token
     if not is_loopback(host):
-        who = "the presenter (token) can" if access.enabled else "anyone who can reach this address can"
+        who = "the presenter (token) can" if access.enabled or classroom else "anyone who can reach this address can"
         print(
             f"warning: serving on {host}, not only this machine: {who} change the shared mechanism "
             "(no encryption: use a trusted network)",
@@ -203,14 +245,21 @@ def main(host: str = "127.0.0.1", port: int = 8080, block: bool = True, presente
     # A tab that closes while its frame is being pushed makes viser warn once per connection; expected in a
     # classroom (the tab is dropped a moment later), and not worth a line in the log each time.
     warnings.filterwarnings("ignore", message=r"Queued a \w+ on a closed connection", category=UserWarning)
-    app = TpmApp(build_server(host, port), presenter_token=presenter_token)
+    server = build_server(host, port)
+    if room is None and session is None:
+        app = TpmApp(server, presenter_token=presenter_token)
+    else:
+        app = TpmApp(server, presenter_token=presenter_token, classroom=room, store=Store(session, fresh))
     gc.collect()
     gc.freeze()  # the start-up heap (numpy, trimesh, Pinocchio, viser) is never scanned again: full collections
     # with 30 tabs take ~7 ms instead of ~90 ms (a pause every tab would feel in the middle of a drag)
     shown = "127.0.0.1" if host in ("0.0.0.0", "::") else host
     print(f"tpm-viz serving at http://{shown}:{app.port}", flush=True)
+    if room is not None:
+        _announce(app, room, bound=host)
     if not block:
         return app
+    signal.signal(signal.SIGTERM, _interrupt)  # a stop by the system saves the session too
     try:
         while True:
             time.sleep(3600)
@@ -219,3 +268,24 @@ def main(host: str = "127.0.0.1", port: int = 8080, block: bool = True, presente
     finally:
         app.stop()
     return app
+
+
+def _interrupt(signum, frame) -> None:
+    raise KeyboardInterrupt
+
+
+def _announce(app: TpmApp, room: Classroom, bound: str) -> None:
+    """Classroom mode: the URLs students type, a QR code of the first, and the presenter token (terminal only)."""
+    urls = student_urls("0.0.0.0", app.port, room.addresses())
+    if not urls:
+        print("No network address found: connect this computer to the room's network and restart.", flush=True)
+    for url in urls:
+        print(f"Students open: {url}", flush=True)
+    if is_loopback(bound):
+        print(f"(bound to {bound} only: students cannot connect; serve with --host 0.0.0.0)", flush=True)
+    if urls:
+        print(qr_text(urls[0]), end="", flush=True)
+    print(
+        "A tab opened on this computer is the presenter. To present from another device, log in there with", flush=True
+    )
+    print(f"the presenter token {room.token} (shown here only: keep it off the projector).", flush=True)

@@ -25,6 +25,7 @@ from tpm_viz.app.poses import DEMO_KINDS
 from tpm_viz.app.state import AppState
 from tpm_viz.errors import TpmVizError
 from tpm_viz.params import Params
+from tpm_viz.ui._viser import widget_value
 from tpm_viz.ui.drags import PendingDrag
 from tpm_viz.ui.guard import guarded
 from tpm_viz.ui.login import LoginPanel
@@ -56,6 +57,12 @@ WATCH_INTERVAL = 0.05
 """While another tab drags (or a trajectory plays), this tab's own part of a frame (gizmo, panel, teaching layer)
 is drawn at most once per this many seconds (20 Hz); the mechanism itself is drawn at every commit, once for all
 tabs, and the last frame of a drag is always drawn."""
+WATCH_TABS = 30
+"""Beyond this many tabs on one session, :data:`WATCH_INTERVAL` grows with the square of their number (60 tabs:
+5 Hz each, 150 watchers: 0.8 Hz each), so that the per-tab parts of a lecture hall (gizmo, panel: one message
+batch per tab, serialised per tab by viser) cost less than those of 30 tabs; the mechanism itself still moves at
+every commit for everybody (one broadcast drawing), and the frame where the motion stops is always drawn
+(``benchmarks/bench_load.py --mode hall``)."""
 
 
 def _internal_error(view: ClientView, exc: Exception) -> None:
@@ -102,6 +109,38 @@ class ClientView:
             self.frame_camera(state.params)
             self.session: Session = hub.join(self, private=False)
             self.teaching.attach()
+            self._catch_up()
+
+    def _catch_up(self) -> None:
+        """Inputs that arrived while the tab was being built, before its callbacks were wired (viser stored the
+        value and ran no callback): apply every widget value that differs from what the tab shows. The motion and
+        parameter inputs are written by the first render, so only the choices the server never writes are read."""
+        private = bool(widget_value(self.panel.own_copy))
+        if private != (not self.session.shared):
+            self.switch(private)
+        for what, handle in self.panel.show_toggles.items():
+            visible = bool(widget_value(handle))
+            if visible != self.scene.show.get(what, True):
+                self.scene.set_visible(what, visible)
+        self.client.flush()
+
+    def switch(self, private: bool, source: Session | None = None) -> None:
+        """Move this tab to a new own copy of ``source`` (default: its session; a copy of ``source`` starts with its
+        player, not the shared one's), or back to the shared mechanism (under the lock)."""
+        old = self.session
+        self.hub.leave(self, old)
+        if private:
+            origin = old if source is None else source
+            scene = self.scene.open_private(origin.state.params)
+            self.session = self.hub.join(self, private=True, session=origin, scene=scene)
+            if source is not None:
+                self.teaching.services.runs.adopt(self.session, source)
+        else:
+            self.scene.close_private()
+            self.session = self.hub.join(self, private=False)
+        self._drawn_at = -1.0
+        self.teaching.switched(old)
+        self.hub.membership_changed()
 
     # -- drawing -------------------------------------------------------------------------------------------
     def render(self, frame: Snapshot, *, dragging: bool = False) -> None:
@@ -110,8 +149,11 @@ class ClientView:
         if self.closed:
             return
         now = time.monotonic()
-        if frame.in_drag and not dragging and now - self._drawn_at < WATCH_INTERVAL:
-            return
+        if frame.in_drag and not dragging:
+            session = getattr(self, "session", None)  # None during the first render (inside Hub.join)
+            tabs = 1 if session is None else len(session.views)
+            if now - self._drawn_at < WATCH_INTERVAL * max(1.0, (tabs / WATCH_TABS) ** 2):
+                return
         self._drawn_at = now
         with self.client.atomic():
             self.scene.update(frame, dragging=dragging)
@@ -232,7 +274,8 @@ class ClientView:
             queue.next_at = time.monotonic() + SHARED_DRAG_INTERVAL  # not before this
             take = None if self.closed else queue.take(self, lambda view: self.hub.access.may_change(view, session))
             if take is None:
-                queue.drop(self)
+                if self.closed:
+                    queue.drop(self)
                 for other in queue.waiting():  # this tab left (or was merged) with the session's drain: hand it on
                     if not other.closed:
                         other.drain_drags()
@@ -325,17 +368,8 @@ class ClientView:
         private = bool(self.panel.own_copy.value)
         if private == (not self.session.shared):
             return
-        old = self.session
-        self.hub.leave(self, old)
-        if private:
-            scene = self.scene.open_private(old.state.params)
-            self.session = self.hub.join(self, private=True, session=old, scene=scene)
-        else:
-            self.scene.close_private()
-            self.session = self.hub.join(self, private=False)
-        self._drawn_at = -1.0
-        self.teaching.switched(old)
-        self.hub.membership_changed()
+        self.panel.restore.visible = False  # a fresh copy (or the shared one): the old copy is no longer offered
+        self.switch(private)
 
     @guarded
     def _on_show(self, event, what: str) -> None:

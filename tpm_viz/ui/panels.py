@@ -69,6 +69,12 @@ class Panel:
         stroke_mm = state.params.stroke * 1e3
         self.dashboard = gui.add_html("")
         self.message = gui.add_markdown("")
+        self.restore = gui.add_button(
+            "Restore my own copy from before the drop",
+            icon=viser.Icon.RESTORE,
+            visible=False,
+            hint="Your own copy, as it was when the connection dropped (kept 30 minutes)",
+        )
         tabs = gui.add_tab_group()
         with tabs.add_tab("Move"):
             self.p = gui.add_vector2("Platform p (mm)", (0.0, 0.0), step=0.1, hint="Or drag the gizmo in 3D")

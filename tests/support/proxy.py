@@ -1,0 +1,94 @@
+"""A small TCP proxy on 127.0.0.1 for network-drop tests: a browser talks to the app through it, and
+:meth:`TcpProxy.drop` cuts every connection and refuses new ones for a while (a wifi blip, a closed laptop lid).
+
+The proxy runs its own asyncio loop in a daemon thread; :meth:`TcpProxy.close` stops it. Bounded: at most
+:data:`MAX_CONNECTIONS` at once.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import threading
+import time
+
+__all__ = ["TcpProxy"]
+
+MAX_CONNECTIONS = 200
+
+
+class TcpProxy:
+    """``127.0.0.1:<port>`` -> ``127.0.0.1:<target>``."""
+
+    def __init__(self, target: int) -> None:
+        self.target = target
+        self.port = 0
+        self.accepted = 0
+        self._down_until = 0.0
+        self._writers: set[asyncio.StreamWriter] = set()
+        self._loop = asyncio.new_event_loop()
+        self._ready = threading.Event()
+        self._server: asyncio.base_events.Server | None = None
+        self._thread = threading.Thread(target=self._run, name="tcp-proxy", daemon=True)
+        self._thread.start()
+        if not self._ready.wait(10.0):
+            raise RuntimeError("the proxy did not start")
+
+    def _run(self) -> None:
+        asyncio.set_event_loop(self._loop)
+        self._server = self._loop.run_until_complete(asyncio.start_server(self._handle, "127.0.0.1", 0))
+        self.port = self._server.sockets[0].getsockname()[1]
+        self._ready.set()
+        self._loop.run_forever()
+
+    async def _handle(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        if time.monotonic() < self._down_until or len(self._writers) >= MAX_CONNECTIONS:
+            writer.close()  # the network is down
+            return
+        self.accepted += 1
+        try:
+            up_reader, up_writer = await asyncio.open_connection("127.0.0.1", self.target)
+        except OSError:
+            writer.close()
+            return
+        self._writers |= {writer, up_writer}
+
+        async def pipe(src: asyncio.StreamReader, dst: asyncio.StreamWriter) -> None:
+            try:
+                while data := await src.read(65536):
+                    dst.write(data)
+                    await dst.drain()
+            except (ConnectionError, OSError):
+                pass
+            finally:
+                dst.close()
+
+        await asyncio.gather(pipe(reader, up_writer), pipe(up_reader, writer), return_exceptions=True)
+        self._writers -= {writer, up_writer}
+
+    def drop(self, seconds: float) -> None:
+        """Cut every connection now (reset, no closing handshake) and refuse new ones for ``seconds``."""
+
+        def cut() -> None:
+            self._down_until = time.monotonic() + seconds
+            for w in list(self._writers):
+                transport = w.transport
+                with contextlib.suppress(Exception):
+                    transport.abort()
+            self._writers.clear()
+
+        self._loop.call_soon_threadsafe(cut)
+
+    def close(self) -> None:
+        """Stop the proxy and its thread."""
+
+        def stop() -> None:
+            if self._server is not None:
+                self._server.close()
+            for w in list(self._writers):
+                with contextlib.suppress(Exception):
+                    w.transport.abort()
+            self._loop.stop()
+
+        self._loop.call_soon_threadsafe(stop)
+        self._thread.join(timeout=5.0)

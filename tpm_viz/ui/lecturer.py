@@ -1,0 +1,90 @@
+"""The *Lecturer* folder of a presenter's tab: how students join, who may change the shared mechanism, and the
+session as a file (*Save session* / *Open session*, :mod:`tpm_viz.app.sessions`).
+
+Shown to a tab that may change the shared mechanism as its presenter: every tab when nobody holds the shared
+mechanism (no presenter token, not classroom mode: e.g. a lecturer preparing a class at home), else the presenter's
+tabs only. No logic here: the app (:class:`~.app.TpmApp`) does the work through the :class:`Lecture` it passes.
+"""
+
+from __future__ import annotations
+
+import html
+from typing import Any, Protocol
+
+import viser
+
+from tpm_viz.app.inputs import MAX_UPLOAD_BYTES
+from tpm_viz.ui.classroom import qr_data_uri
+from tpm_viz.ui.guard import guarded
+
+__all__ = ["Lecture", "LecturerPanel", "join_html"]
+
+
+class Lecture(Protocol):
+    """What the lecturer's folder asks of the app."""
+
+    def session_json(self) -> str:
+        """The current session as a JSON document."""
+
+    def open_session(self, view: Any, data: bytes) -> None:
+        """Replace the shared mechanism by a session file's (refused with one line to ``view``)."""
+
+    def hand_to_class(self, view: Any, open_: bool) -> None:
+        """Let everybody change the shared mechanism (True) or only the presenter (False)."""
+
+
+def join_html(urls: list[str]) -> str:
+    """The URLs students type and a QR code of the first one (HTML for the panel)."""
+    if not urls:
+        return (
+            "<p><b>No network address found</b>: connect this computer to the room's network "
+            "(students use the same wifi), then restart the app.</p>"
+        )
+    links = "".join(f"<div style='font-size:1.1em'><b>{html.escape(u)}</b></div>" for u in urls)
+    image = f"<img alt='QR code of {html.escape(urls[0])}' src='{qr_data_uri(urls[0])}' style='width:180px'>"
+    return f"<div>Students open (same network):{links}{image}</div>"
+
+
+class LecturerPanel:
+    """The *Lecturer* folder of one tab."""
+
+    def __init__(self, gui: viser.GuiApi, lecture: Lecture, view: Any, urls: list[str] | None, presenter: bool):
+        self._lecture, self._view = lecture, view
+        with gui.add_folder("Lecturer", expand_by_default=urls is not None):
+            self.join = gui.add_html(join_html(urls) if urls is not None else "")
+            self.join.visible = urls is not None
+            self.open_to_class = gui.add_checkbox(
+                "Let the class change the shared mechanism",
+                False,
+                hint="Off: only you (the presenter) change it; students still have their own copy",
+                visible=presenter,
+            )
+            self.save = gui.add_button("Save session (JSON)", icon=viser.Icon.DOWNLOAD)
+            self.open = gui.add_upload_button(
+                "Open session (JSON)", icon=viser.Icon.UPLOAD, mime_type=".json,application/json"
+            )
+        self.open_to_class.on_update(self._on_open_to_class)
+        self.save.on_click(self._on_save)
+        self.open.on_upload(self._on_open)
+
+    @guarded
+    def _on_open_to_class(self, event) -> None:
+        if getattr(event, "client", None) is not None:
+            self._lecture.hand_to_class(self._view, bool(self.open_to_class.value))
+
+    @guarded
+    def _on_save(self, event) -> None:
+        if getattr(event, "client", None) is not None:
+            data = self._lecture.session_json().encode()
+            self._view.client.send_file_download("tpm-viz-session.json", data, save_immediately=True)
+
+    @guarded
+    def _on_open(self, event) -> None:
+        if getattr(event, "client", None) is None:
+            return
+        file = self.open.value
+        content = getattr(file, "content", b"")
+        if len(content) > MAX_UPLOAD_BYTES * 5:
+            self._view.refuse("the session file is too large", resync=False)
+            return
+        self._lecture.open_session(self._view, content)

@@ -1,0 +1,233 @@
+"""The classroom around the app: who presents, tabs that come back, the session file and its download.
+
+:class:`Room` is what :class:`~.app.TpmApp` calls when a tab connects (:meth:`Room.identify` before its view is
+built, :meth:`Room.connected` after), leaves (:meth:`Room.leaving`) or logs in (:meth:`Room.promoted`), and what
+the *Lecturer* folder (:mod:`.lecturer`) calls to save, open and hand over the session. Under the hub's lock like
+every other change; no maths here.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+import weakref
+from typing import Any
+
+from tpm_viz.app import sessions
+from tpm_viz.app.sessions import Document, Saved
+from tpm_viz.errors import TpmVizError
+from tpm_viz.ui._viser import connection_request
+from tpm_viz.ui.classroom import Classroom, identity, student_urls
+from tpm_viz.ui.continuity import Away, Store, reload, restore, saved_of
+from tpm_viz.ui.guard import guarded, log
+from tpm_viz.ui.lecturer import LecturerPanel
+
+__all__ = ["BACK", "KEPT", "Room"]
+
+BACK = "Welcome back: your own copy from before the connection dropped is restored."
+KEPT = (
+    "The connection dropped and you are now on the shared mechanism. Your own copy from before is kept for "
+    "30 minutes: press 'Restore my own copy from before the drop'."
+)
+
+
+class Room:
+    """Classroom mode, continuity and persistence of one app (``app``: its ``server``, ``hub``, ``access``,
+    ``services``, ``views``)."""
+
+    def __init__(self, app: Any, classroom: Classroom | None = None, store: Store | None = None) -> None:
+        self.app = app
+        self.classroom = classroom
+        self.store = store if store is not None else Store(None)
+        self.away = Away()
+        self.lesson_step = 0
+        self.urls: list[str] | None = None
+        self._keys: weakref.WeakKeyDictionary[Any, str] = weakref.WeakKeyDictionary()
+        self._lecturers: weakref.WeakKeyDictionary[Any, LecturerPanel] = weakref.WeakKeyDictionary()
+        self.ready: weakref.WeakSet[Any] = weakref.WeakSet()
+        """The tabs :meth:`connected` has finished with (tests wait for it)."""
+
+    # -- start and stop ---------------------------------------------------------------------------------------------
+    def start(self) -> None:
+        """Read the session file (the shared mechanism and the tabs that were away) and save from now on."""
+        if self.classroom is not None:
+            self.urls = student_urls("0.0.0.0", self.app.port, self.classroom.addresses())
+        doc = self.store.load()
+        if doc is not None:
+            try:
+                self._apply_shared(doc, origin=None)
+                self.away.restore(doc.tabs)
+            except TpmVizError as exc:
+                print(f"warning: session file: {exc}; starting with the defaults", file=sys.stderr, flush=True)
+        self.store.start(self.document)
+
+    def stop(self) -> None:
+        self.store.stop(self.document)
+
+    # -- tabs -------------------------------------------------------------------------------------------------------
+    def identify(self, client: Any) -> tuple[str | None, str, Any]:
+        """``(identity, source address, camera)`` of a connecting tab, read before its view moves the camera."""
+        request = connection_request(self.app.server, client.client_id)
+        remote, headers = request if request is not None else (("?", 0), None)
+        host = remote[0] if isinstance(remote, (tuple, list)) and remote else "?"
+        try:
+            camera = tuple(client.camera.position) + tuple(client.camera.wxyz)
+        except Exception:  # no camera yet
+            camera = None
+        return identity(remote, headers), str(host), camera
+
+    def source(self, view: Any) -> str | None:
+        """The address a tab connected from (the key of the presenter-login limits)."""
+        return getattr(view, "address", None)
+
+    def connected(self, view: Any, who: tuple[str | None, str, Any]) -> None:
+        """A tab's view is built (on the shared mechanism): presenter or not, and what it had before a drop (a
+        browser known by its cookie gets it back by itself; one that blocks cookies is offered its own copy)."""
+        key, host, camera = who
+        if key is not None:
+            self._keys[view] = key
+        view.address = host
+        hub = self.app.hub
+        with hub.lock:
+            record = self.away.take(key, camera) if key is not None and key.startswith("c:") else None
+            here = self.classroom is not None and self.classroom.presenter_address(host)
+            if self.app.access.enabled and (here or (record is not None and record.get("presenter"))):
+                self.app.access.grant(view)  # this computer, or the presenter's device back after a drop
+                if view.login is not None:
+                    view.login.show("**You are the presenter**" + (" (this computer)." if here else ": welcome back."))
+            if self.lecturer(view):
+                self._add_lecturer(view)
+            self._set_lesson_step(view)
+            view.panel.restore.on_click(lambda event, view=view: self._on_restore(event, view))
+            if record is not None:
+                restore(view, record["saved"], record["private"] and record["saved"] is not None)
+                if record["private"]:
+                    view.tell(BACK)
+            elif key is not None and self.away.offer(key) is not None:
+                view.panel.restore.visible = True
+                view.tell(KEPT)
+            view.client.flush()
+            self.ready.add(view)
+
+    def leaving(self, view: Any) -> None:
+        """A tab is closing (or its connection dropped): keep what it had for 30 minutes (its data, not the tab:
+        the lecturer panel refers to the view, so it must go with it or the weak keys would never die)."""
+        self._lecturers.pop(view, None)
+        key = self._keys.pop(view, None)
+        if key is None or view.closed:
+            return
+        with self.app.hub.lock:
+            try:
+                camera = tuple(view.client.camera.position) + tuple(view.client.camera.wxyz)
+            except Exception:
+                camera = None
+            private = not view.session.shared
+            presenter = self.app.access.is_presenter_tab(view)
+            self.away.park(key, private, saved_of(view), camera, presenter=presenter)
+
+    @guarded
+    def _on_restore(self, event, view: Any) -> None:
+        if getattr(event, "client", None) is None or view.closed:
+            return
+        key = self._keys.get(view)
+        with self.app.hub.lock:
+            record = None if key is None else self.away.offer(key)
+            view.panel.restore.visible = False
+            if key is None or record is None or not self.away.claim(key, record):
+                view.tell("That copy is no longer kept (30 minutes passed, or another tab took it back).")
+                return
+            restore(view, record["saved"], True)
+            view.tell(BACK)
+
+    # -- presenter ----------------------------------------------------------------------------------------------------
+    def lecturer(self, view: Any) -> bool:
+        """Whether ``view`` gets the *Lecturer* folder: its presenter, or anyone when nobody holds the mechanism."""
+        access = self.app.access
+        return access.is_presenter_tab(view) if access.enabled else True
+
+    def promoted(self, view: Any) -> None:
+        """``view`` logged in as the presenter."""
+        if view not in self._lecturers:
+            self._add_lecturer(view)
+
+    def _add_lecturer(self, view: Any) -> None:
+        self._lecturers[view] = LecturerPanel(view.client.gui, self, view, self.urls, presenter=self.app.access.enabled)
+
+    def hand_to_class(self, view: Any, open_: bool) -> None:
+        """The presenter lets the class change the shared mechanism, or takes it back."""
+        access = self.app.access
+        with self.app.hub.lock:
+            if not access.is_presenter_tab(view):
+                view.refuse("only the presenter can hand the shared mechanism to the class", resync=False)
+                return
+            access.open_to_class = open_
+            for panel in self._lecturers.values():
+                if panel.open_to_class.value != open_:
+                    panel.open_to_class.value = open_
+            log.info("the shared mechanism is %s", "open to the class" if open_ else "the presenter's again")
+        self.app.hub.membership_changed()
+
+    # -- the session as a document ---------------------------------------------------------------------------------
+    def document(self) -> Document:
+        """The shared mechanism, the lesson step and every tab's own copy (away or still here)."""
+        app, hub = self.app, self.app.hub
+        with hub.lock:
+            runs = app.services.runs
+            ps = runs.of(hub.shared)
+            source = ps.run.source if ps.run is not None else ps.loading
+            shared = Saved(hub.shared.state, source, hub.shared.state.trajectory.t)
+            for view in list(hub.shared.views):
+                if app.access.is_presenter(view):
+                    self.lesson_step = int(getattr(view.teaching.demos, "index", self.lesson_step))
+                    break
+            tabs = self.away.snapshot()
+            now = time.time()
+            for view in list(app.views.values()):
+                key = self._keys.get(view)
+                if key is not None and not view.closed:
+                    record = {
+                        "private": not view.session.shared,
+                        "saved": saved_of(view),
+                        "left_at": now,
+                        "presenter": app.access.is_presenter_tab(view),
+                    }
+                    tabs.setdefault(key, []).append(record)
+        return Document(shared, self.lesson_step, tabs)
+
+    def session_json(self) -> str:
+        """The session for *Save session*: the shared mechanism and the lesson step (no students' copies)."""
+        doc = self.document()
+        return sessions.dumps(Document(doc.shared, doc.lesson_step))
+
+    def open_session(self, view: Any, data: bytes) -> None:
+        """*Open session*: the shared mechanism becomes the file's (refused with one line to this tab only)."""
+        hub = self.app.hub
+        with hub.lock:
+            try:
+                hub.authorize(view, hub.shared)
+                doc = sessions.loads(data)
+                self._apply_shared(doc, origin=view)
+            except TpmVizError as exc:
+                view.refuse(str(exc), resync=False)
+                return
+            view.tell("Session opened.")
+
+    def _apply_shared(self, doc: Document, origin: Any) -> None:
+        hub, runs = self.app.hub, self.app.services.runs
+        shared = hub.shared
+        with hub.lock:
+            shared.play_token += 1
+            runs.unload(shared)
+            hub.commit(shared, doc.shared.state, origin=origin)
+            reload(runs, shared, doc.shared)
+            self.lesson_step = doc.lesson_step
+            for view in list(shared.views):
+                self._set_lesson_step(view)
+
+    def _set_lesson_step(self, view: Any) -> None:
+        demos = getattr(getattr(view, "teaching", None), "demos", None)
+        choice = getattr(demos, "choice", None)
+        if demos is None or choice is None or not 0 <= self.lesson_step < len(choice.options):
+            return
+        demos.index = self.lesson_step
+        choice.value = choice.options[self.lesson_step]
