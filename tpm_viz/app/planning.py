@@ -119,10 +119,12 @@ class PlanResult:
         return 60.0 / self.cycle_time
 
 
+@functools.lru_cache(maxsize=32)
 def solve(params: Params, kind: str, force: float, speed: float | None = None, waypoints: str = "") -> PlanResult:
     """Plan the cycle of path ``kind`` (``pick``, ``line``, ``circle``, ``waypoints`` with the typed ``waypoints``
     in mm) within ``|τ_i| <= force`` [N] and ``|ṗ| <= speed`` [m/s] (None: no speed limit); size it and its cubic
-    counterpart."""
+    counterpart. Cached (the last 32 requests): a class arriving at once shares one plan of the default settings,
+    and a slider dragged back and forth is answered at once."""
     t0 = time.perf_counter()
     points = None
     if kind == "waypoints":

@@ -8,6 +8,7 @@ drag ended are told so (their gizmos are written back by that commit). No viser 
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
 from typing import Generic, TypeVar
@@ -17,7 +18,8 @@ import numpy as np
 __all__ = ["DragQueue", "PendingDrag", "Take"]
 
 V = TypeVar("V", bound=Hashable)
-"""A tab (any hashable object: the queue never looks inside it)."""
+"""A tab (any object that can be weakly referenced: the queue never looks inside it, and never keeps a tab that
+left alive, even if one of its drags arrives after it left)."""
 
 
 @dataclass(frozen=True)
@@ -46,9 +48,9 @@ class DragQueue(Generic[V]):
     """A drain is scheduled (a drag that arrives meanwhile is taken by it)."""
     next_at: float = 0.0
     """``time.monotonic()`` before which no further drag is committed (pacing of a session shown by many tabs)."""
-    taken: int = -1
-    """Arrival number of the drag last taken: an older one that is queued late is dropped."""
-    _pending: dict[V, list[PendingDrag]] = field(default_factory=dict)
+    _pending: weakref.WeakKeyDictionary[V, list[PendingDrag]] = field(default_factory=weakref.WeakKeyDictionary)
+    _taken: weakref.WeakKeyDictionary[V, int] = field(default_factory=weakref.WeakKeyDictionary)
+    """Per tab, the arrival number of its drag last taken: an older one of that tab queued late is dropped."""
 
     def push(self, view: V, drag: PendingDrag) -> None:
         """Queue ``view``'s drag event."""
@@ -65,19 +67,21 @@ class DragQueue(Generic[V]):
     def drop(self, view: V) -> None:
         """Forget ``view``'s drags (it left the session or closed)."""
         self._pending.pop(view, None)
+        self._taken.pop(view, None)
 
     def take(self, origin: V, may_merge: Callable[[V], bool]) -> Take[V] | None:
         """Remove ``origin``'s drags and, if ``may_merge(origin)``, those of every other view with
-        ``may_merge(view)``; return the latest of them by arrival, or None if there is none newer than the drag last
-        taken (a drag that arrived while its tab was being built is queued late: it must not undo a newer one)."""
-        own = self._pending.pop(origin, [])
+        ``may_merge(view)``; return the latest of them by arrival, or None if none is newer than what was taken from
+        the same tab before (a drag that arrived while its tab was being built is queued late: it must not undo a
+        newer one of that tab)."""
+        own = self._fresh(origin, self._pending.pop(origin, []))
         if not own:
             return None
         latest, mover = max(own, key=lambda d: d.arrival), origin
         ended: list[V] = []
         if may_merge(origin):
             for view in list(self._pending):
-                drags = self._pending[view]
+                drags = self._fresh(view, self._pending[view])
                 if not drags or not may_merge(view):
                     continue
                 del self._pending[view]
@@ -88,7 +92,12 @@ class DragQueue(Generic[V]):
                     latest, mover = newest, view
         if mover is not origin and any(d.phase == "end" for d in own):
             ended.append(origin)
-        if latest.arrival <= self.taken:
-            return None
-        self.taken = latest.arrival
         return Take(mover, latest, tuple(ended))
+
+    def _fresh(self, view: V, drags: list[PendingDrag]) -> list[PendingDrag]:
+        """``drags`` newer than the last one taken from ``view`` (and remember the newest as taken)."""
+        last = self._taken.get(view, -1)
+        fresh = [d for d in drags if d.arrival > last]
+        if fresh:
+            self._taken[view] = max(d.arrival for d in fresh)
+        return fresh
