@@ -7,7 +7,7 @@ import pytest
 
 from tpm_viz import InputError, InvalidParametersError, Params, SingularityThresholds
 from tpm_viz.app.moves import Pose, check
-from tpm_viz.app.poses import DEMO_KINDS, demo_pose, home_pose, settle
+from tpm_viz.app.poses import DEMO_KINDS, home_pose, preset_pose, settle
 from tpm_viz.paper.jacobians import jacobians
 from tpm_viz.paper.status import MOVE_LIMITS, PoseStatus
 
@@ -55,7 +55,7 @@ def test_settle_moves_an_invalid_pose_to_a_valid_one_and_says_so():
 @pytest.mark.parametrize("kind", DEMO_KINDS)
 def test_demo_poses_are_valid_and_show_their_condition(kind):
     limits, thr = MOVE_LIMITS, SingularityThresholds()
-    move = demo_pose(P, kind)
+    move = preset_pose(P, kind)
     pose = move.pose
     assert not move.clamped, move.reason
     assert check(P, pose) == PoseStatus.REGULAR
@@ -70,7 +70,7 @@ def test_demo_poses_are_valid_and_show_their_condition(kind):
 
 def test_demo_pose_explains_when_the_stroke_keeps_the_mechanism_away():
     params = P.replace(stroke=0.2)
-    move = demo_pose(params, "direct")
+    move = preset_pose(params, "direct")
     if move.clamped:
         assert "closest pose" in move.reason
     assert check(params, move.pose) == PoseStatus.REGULAR
@@ -78,4 +78,4 @@ def test_demo_pose_explains_when_the_stroke_keeps_the_mechanism_away():
 
 def test_demo_kind_is_checked():
     with pytest.raises(InputError):
-        demo_pose(P, "nope")
+        preset_pose(P, "nope")

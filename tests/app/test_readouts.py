@@ -16,7 +16,7 @@ from tpm_viz import (
     leg_angles,
 )
 from tpm_viz.app.moves import Pose, drive_to
-from tpm_viz.app.poses import demo_pose
+from tpm_viz.app.poses import preset_pose
 from tpm_viz.app.readouts import Load, evaluate
 
 P = Params.paper()
@@ -86,7 +86,7 @@ def test_reference_is_skipped_off_the_working_branch():
 
 @pytest.mark.parametrize("kind", ["inverse", "direct", "stroke"])
 def test_alerts_at_the_demo_poses(kind):
-    r = evaluate(P, demo_pose(P, kind).pose, Load("static", f_ext=(10.0, 10.0)))
+    r = evaluate(P, preset_pose(P, kind).pose, Load("static", f_ext=(10.0, 10.0)))
     assert kind in {a.kind for a in r.alerts}
     assert _finite_numbers(r)
 

@@ -10,7 +10,7 @@ import pytest
 
 from tpm_viz import Params
 from tpm_viz.app.moves import Pose
-from tpm_viz.app.poses import demo_pose
+from tpm_viz.app.poses import preset_pose
 from tpm_viz.app.readouts import Forces, Load, evaluate
 from tpm_viz.app.state import AppState
 from tpm_viz.ui.text import banner_level, dashboard_html, force_scale, legend_html, num
@@ -64,7 +64,7 @@ def test_dashboard_with_missing_forces_prints_dashes_not_nan():
 
 @pytest.mark.parametrize("kind", ["inverse", "direct", "stroke"])
 def test_banner_level_follows_the_alerts(kind):
-    pose = demo_pose(P, kind).pose
+    pose = preset_pose(P, kind).pose
     readout = evaluate(P, pose)
     assert banner_level(readout) == kind
     assert f'data-level="{kind}"' in dashboard_html(AppState(params=P, pose=pose), readout)

@@ -14,10 +14,10 @@ from tpm_viz.errors import InputError, InvalidParametersError
 from tpm_viz.paper.status import MOVE_LIMITS, WARN, PoseStatus, SingularityThresholds
 from tpm_viz.params import Params
 
-__all__ = ["DEMO_KINDS", "demo_pose", "home_pose", "settle"]
+__all__ = ["DEMO_KINDS", "home_pose", "preset_pose", "settle"]
 
 DEMO_KINDS = ("inverse", "direct", "stroke")
-"""Kinds of :func:`demo_pose`: near an inverse singularity, near the direct singularity, at a stroke end."""
+"""Kinds of :func:`preset_pose`: near an inverse singularity, near the direct singularity, at a stroke end."""
 
 _WORKING = np.ones(2)
 
@@ -87,7 +87,7 @@ def _measure(params: Params, kind: str, p: np.ndarray, d: np.ndarray) -> np.ndar
     return np.min(np.minimum(d, params.stroke - d), axis=-1)
 
 
-def demo_pose(
+def preset_pose(
     params: Params,
     kind: str,
     near=(0.0, 0.0),

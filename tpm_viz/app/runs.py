@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 
@@ -36,6 +37,10 @@ MAX_DURATION = 100.0  # s, the paper's line and circle and the demo segments
 MIN_DURATION = 0.01  # s
 
 
+SourceKind = Literal["line", "circle", "segment", "csv"]
+"""Where a run's path comes from: the paper's line or circle, a straight segment (lessons), a user's CSV."""
+
+
 @dataclass(frozen=True)
 class Source:
     """Where the platform goes. ``kind`` is ``"line"``, ``"circle"``, ``"segment"`` or ``"csv"``.
@@ -43,7 +48,7 @@ class Source:
     ``duration`` [s]; ``start``/``end`` [m] for a segment; ``knots`` = ``(t, p)`` samples for a CSV path.
     """
 
-    kind: str
+    kind: SourceKind
     duration: float
     label: str
     start: tuple[float, float] | None = None
@@ -56,8 +61,9 @@ class Source:
         if kind not in DEFAULT_DURATIONS:
             raise InputError(f"trajectory must be 'line' or 'circle', got {kind!r}")
         duration = _duration(DEFAULT_DURATIONS[kind] if duration is None else duration)
-        figure = "Fig. 4" if kind == "line" else "Fig. 5"
-        return cls(kind, duration, f"{kind} ({figure}), T = {duration:g} s")
+        paper_kind: SourceKind = "line" if kind == "line" else "circle"
+        figure = "Fig. 4" if paper_kind == "line" else "Fig. 5"
+        return cls(paper_kind, duration, f"{paper_kind} ({figure}), T = {duration:g} s")
 
     @classmethod
     def from_trajectory(cls, traj: Trajectory, label: str | None = None) -> Source:

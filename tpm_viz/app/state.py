@@ -8,20 +8,13 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
-from typing import Literal
 
 from tpm_viz.app.moves import Pose
 from tpm_viz.app.poses import home_pose
 from tpm_viz.app.readouts import Load
 from tpm_viz.params import Params
 
-__all__ = ["TRAJECTORY_KINDS", "AppState", "TrajectorySample"]
-
-
-TrajectoryKind = Literal["none", "line", "circle", "file"]
-
-TRAJECTORY_KINDS = ("none", "line", "circle")
-"""Trajectory sample that drives the platform: none, the paper's line (Fig. 4) or circle (Fig. 5)."""
+__all__ = ["AppState", "TrajectorySample"]
 
 
 @dataclass(frozen=True)
@@ -29,6 +22,8 @@ class TrajectorySample:
     """Which trajectory sample drives the platform: ``kind``, duration ``T`` [s] and time ``t`` [s]."""
 
     kind: str = "none"
+    """``"none"`` (moved by hand), or the tag of the run that placed the platform (its source kind, or a tab's own
+    control or planner run)."""
     duration: float = 0.2
     t: float = 0.0
 

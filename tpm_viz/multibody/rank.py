@@ -30,11 +30,6 @@ class RankedSvd(NamedTuple):
         """Orthonormal basis of the null space of ``A``, shape ``(n, n - rank)``."""
         return self.vt[self.rank :].T
 
-    @property
-    def smallest_kept_ratio(self) -> float:
-        """``σ_rank / σ_max``: how far the kept part is from losing rank (1 is best)."""
-        return float(self.s[self.rank - 1] / self.s[0]) if self.rank else 0.0
-
     def solve(self, b: np.ndarray) -> np.ndarray:
         """Minimum-norm least-squares solution ``x = A⁺ b`` on the revealed rank (``b``: (m,) or (m, k))."""
         r = self.rank
