@@ -13,7 +13,7 @@ import argparse
 import math
 import sys
 
-from tpm_viz.cli.common import params_from_args, positive
+from tpm_viz.cli.common import check_output, params_from_args, positive
 from tpm_viz.csvio import read_text, write_columns
 from tpm_viz.errors import InputError
 from tpm_viz.paper.control import Gains
@@ -43,6 +43,7 @@ def _reference(args):
     duration = positive(args.duration, "--duration")
     if args.trajectory in ("line", "circle"):
         return args.trajectory, duration, None
+    check_output(args.output, args.trajectory)
     try:
         text = read_text(args.trajectory)
     except OSError as exc:

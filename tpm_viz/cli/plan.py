@@ -15,7 +15,7 @@ import numpy as np
 
 from tpm_viz.app import paths
 from tpm_viz.app.sizing import format_sizing, size_trajectory, sizing_columns
-from tpm_viz.cli.common import params_from_args, positive
+from tpm_viz.cli.common import check_output, params_from_args, positive
 from tpm_viz.csvio import parse_columns, read_columns, read_text, write_columns
 from tpm_viz.errors import InputError
 from tpm_viz.paper.trajectories import trajectory_from_samples
@@ -47,6 +47,7 @@ def _cmd_plan(args) -> int:
     if args.path in ("line", "circle", "pick"):
         path = paths.path_for(params, args.path, corner_radius=args.corner_radius, pick=_pick_size(args.pick_size))
     else:
+        check_output(args.output, args.path)
         cols = read_columns(args.path, ["p1", "p2"])
         points = np.stack([cols["p1"], cols["p2"]], -1)
         path = paths.path_for(params, "waypoints", points, corner_radius=args.corner_radius)
@@ -108,6 +109,7 @@ def _read_motion(path: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndar
 def _cmd_size(args) -> int:
     params = params_from_args(args)
     dwell = 0.0 if args.dwell is None else args.dwell
+    check_output(args.output, args.input)
     t, p, dp, ddp, tau = _read_motion(args.input)
     sizing = size_trajectory(params, t, p, dp, ddp, dwell, args.motor_constant, tau=tau)
     print(format_sizing(sizing))
