@@ -77,6 +77,7 @@ def _cmd_serve(args) -> int:
         classroom=args.classroom,
         session=args.session if args.session is not None else default_path(),
         fresh=args.fresh,
+        lessons=args.lessons,
     )
     return 0
 
@@ -102,6 +103,12 @@ def register(sub, common: argparse.ArgumentParser) -> None:
         help="session file: read at start, saved on every change (default: session.json in the user data folder)",
     )
     s.add_argument("--fresh", action="store_true", help="start with the defaults (the session file is overwritten)")
+    s.add_argument(
+        "--lessons",
+        type=Path,
+        metavar="DIR",
+        help="your own lessons for the Demos tab: a folder of *.toml files (format: assets/lessons/README.md)",
+    )
     s.add_argument(
         "--port",
         type=port_number,

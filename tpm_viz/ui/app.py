@@ -24,16 +24,17 @@ import sys
 import threading
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import viser
 
 from tpm_viz import multibody
 from tpm_viz.app.access import Access
+from tpm_viz.app.lessons import Demo, load_lessons
 from tpm_viz.app.readouts import Reference
 from tpm_viz.app.state import AppState
-from tpm_viz.errors import TpmVizError
+from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.params import Params
 from tpm_viz.ui._viser import check_viser, disable_share_url, hook_handshakes, thread_pool
 from tpm_viz.ui.classroom import Classroom, Handshakes, local_addresses, qr_text, student_urls
@@ -102,6 +103,7 @@ class TpmApp:
         max_connections: int = DEFAULT_MAX_CONNECTIONS,
         classroom: Classroom | None = None,
         store: Store | None = None,
+        lessons: tuple[Sequence[Demo], Sequence[str]] | None = None,
     ) -> None:
         self.server = server
         set_max_connections(server, max_connections)  # the next tab is told the class is full, then closed
@@ -110,7 +112,7 @@ class TpmApp:
         shared_scene = MechanismScene(server.scene, state.params, sink=server)  # drawn once for every tab
         self.hub = Hub(state, reference, self.access, shared_scene)
         self.hub.evaluate(self.hub.shared.state)  # warm-up: builds the Pinocchio model once
-        self.services = Services.create(self.hub)
+        self.services = Services.create(self.hub) if lessons is None else Services.create(self.hub, *lessons)
         """The worker, floor maps and trajectory runs every tab of this app shares."""
         self.views: dict[int, ClientView] = {}
         self._views_lock = threading.Lock()
@@ -220,6 +222,7 @@ def main(
     session: Path | None = None,
     fresh: bool = False,
     addresses: Callable[[], list[str]] | None = None,
+    lessons: str | Path | None = None,
 ) -> TpmApp:
     """Serve the app; print the real URL; block until Ctrl-C (or SIGTERM) unless ``block`` is False.
 
@@ -228,8 +231,15 @@ def main(
     presenter, and a token (``presenter_token`` or a random one, printed here only) lets the lecturer present from
     another device. ``session``: the session file to read at start and keep saved (None: nothing is saved);
     ``fresh``: start clean (the file is overwritten). ``addresses``: this machine's network addresses (a lookup;
-    tests inject theirs)."""
+    tests inject theirs). ``lessons``: a folder of lesson files (or one file) for the *Demos* tab instead of the
+    packaged ones; a refused file is one warning line, and no lesson at all is an error."""
     access = Access(presenter_token)  # validates the token before anything starts
+    tour = None if lessons is None else load_lessons(lessons)
+    if tour is not None:
+        if not tour[0]:
+            raise InputError(f"no lesson loaded from {lessons}: {tour[1][0] if tour[1] else 'no lesson files'}")
+        for problem in tour[1]:
+            print(f"warning: lesson refused: {problem}", file=sys.stderr)
     classroom = classroom or not is_loopback(host)
     room = Classroom(addresses=addresses or local_addresses) if classroom else None
     if room is not None and presenter_token:
@@ -246,10 +256,8 @@ def main(
     # classroom (the tab is dropped a moment later), and not worth a line in the log each time.
     warnings.filterwarnings("ignore", message=r"Queued a \w+ on a closed connection", category=UserWarning)
     server = build_server(host, port)
-    if room is None and session is None:
-        app = TpmApp(server, presenter_token=presenter_token)
-    else:
-        app = TpmApp(server, presenter_token=presenter_token, classroom=room, store=Store(session, fresh))
+    store = None if room is None and session is None else Store(session, fresh)
+    app = TpmApp(server, presenter_token=presenter_token, classroom=room, store=store, lessons=tour)
     gc.collect()
     gc.freeze()  # the start-up heap (numpy, trimesh, Pinocchio, viser) is never scanned again: full collections
     # with 30 tabs take ~7 ms instead of ~90 ms (a pause every tab would feel in the middle of a drag)
