@@ -74,7 +74,7 @@ def main() -> None:
         presser.join(2)
         ms = 1e3
         print(
-            f"tab B drags, tab A idle:        median {statistics.median(idle) * ms:6.2f} ms  p95 {p95(idle) * ms:6.2f} ms"
+            f"tab B drags, tab A idle: median {statistics.median(idle) * ms:6.2f} ms  p95 {p95(idle) * ms:6.2f} ms"
         )
         print(
             f"tab B drags, A simulating ({presses[0]} presses): median {statistics.median(busy) * ms:6.2f} ms  "
