@@ -73,9 +73,7 @@ def main() -> None:
         stop.set()
         presser.join(2)
         ms = 1e3
-        print(
-            f"tab B drags, tab A idle: median {statistics.median(idle) * ms:6.2f} ms  p95 {p95(idle) * ms:6.2f} ms"
-        )
+        print(f"tab B drags, tab A idle: median {statistics.median(idle) * ms:6.2f} ms  p95 {p95(idle) * ms:6.2f} ms")
         print(
             f"tab B drags, A simulating ({presses[0]} presses): median {statistics.median(busy) * ms:6.2f} ms  "
             f"p95 {p95(busy) * ms:6.2f} ms   ratio of p95 {p95(busy) / p95(idle):.2f}"
