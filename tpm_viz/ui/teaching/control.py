@@ -20,6 +20,7 @@ import numpy as np
 import viser
 
 from tpm_viz import meshes
+from tpm_viz.app.palette import hex_colour
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.multibody.control import ControlRun, ControlSetup
 from tpm_viz.paper.control import ControllerKind, axis_masses, model_with_errors
@@ -108,15 +109,15 @@ class ControlView:
             gui,
             "Tracking error e = p_ref − p",
             "error (µm)",
-            (("e₁", "#2563eb", None), ("e₂", "#dc2626", None), ("|e|", "#0f172a", (4.0, 3.0))),
+            (("e₁", hex_colour("tau1"), None), ("e₂", hex_colour("tau2"), None), ("|e|", "#0f172a", (4.0, 3.0))),
         )
         self.force_chart = TimeChart(
             gui,
             "Actuator forces: applied (solid) vs feedforward (dashed)",
             "force (N)",
             (
-                ("τ₁", "#2563eb", None),
-                ("τ₂", "#dc2626", None),
+                ("τ₁", hex_colour("tau1"), None),
+                ("τ₂", hex_colour("tau2"), None),
                 ("τ₁ ff", "#93c5fd", (4.0, 3.0)),
                 ("τ₂ ff", "#fca5a5", (4.0, 3.0)),
             ),

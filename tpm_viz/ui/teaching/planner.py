@@ -17,6 +17,7 @@ import numpy as np
 import viser
 
 from tpm_viz import meshes
+from tpm_viz.app.palette import hex_colour
 from tpm_viz.app.planning import PATH_KINDS, PlanResult, solve
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.params import Params
@@ -135,8 +136,8 @@ class PlannerView:
             "Actuator forces τ against ±F_max",
             "force (N)",
             (
-                ("τ₁", "#2563eb", None),
-                ("τ₂", "#dc2626", None),
+                ("τ₁", hex_colour("tau1"), None),
+                ("τ₂", hex_colour("tau2"), None),
                 ("+F_max", "#64748b", (6.0, 4.0)),
                 ("−F_max", "#64748b", (6.0, 4.0)),
             ),
