@@ -82,13 +82,17 @@ class TcpProxy:
     def close(self) -> None:
         """Stop the proxy and its thread."""
 
-        def stop() -> None:
+        async def stop() -> None:
             if self._server is not None:
                 self._server.close()
             for w in list(self._writers):
                 with contextlib.suppress(Exception):
                     w.transport.abort()
+            tasks = [t for t in asyncio.all_tasks() if t is not asyncio.current_task()]
+            for task in tasks:  # no connection handler is left pending (it would be reported when collected)
+                task.cancel()
+            await asyncio.gather(*tasks, return_exceptions=True)
             self._loop.stop()
 
-        self._loop.call_soon_threadsafe(stop)
+        asyncio.run_coroutine_threadsafe(stop(), self._loop)
         self._thread.join(timeout=5.0)

@@ -96,8 +96,11 @@ class Gate:
 
     def submit(self, fn, /, *args, **kwargs) -> concurrent.futures.Future:
         client_id = _client_of(args)
-        if client_id is None:
-            return self._submit(fn, *args, **kwargs)
+        if client_id is None:  # connect and disconnect callbacks: never gated
+            try:
+                return self._submit(fn, *args, **kwargs)
+            except RuntimeError:  # the pool is shut down (a tab left while the server stops): nothing to run
+                return _done()
         with self._lock:
             waiting = self._waiting.get(client_id)
             if client_id in self.blocked:
@@ -131,10 +134,10 @@ class Gate:
 
         try:
             return self._submit(run, *args, **kwargs)
-        except RuntimeError:  # the pool is shut down: forget this tab's calls
+        except RuntimeError:  # the pool is shut down (the server is stopping): nothing runs any more
             with self._lock:
                 self._waiting.pop(client_id, None)
-            raise
+            return _done()
 
     def _next(self, client_id: int) -> None:
         with self._lock:
