@@ -224,7 +224,7 @@ def test_too_many_tabs_are_told_and_closed():
         texts = []
         try:
             while True:
-                for m in decode_batch(ws.recv(timeout=5.0)):
+                for m in decode_batch(ws.recv(timeout=15.0)):
                     if m["type"] == "NotificationShowMessage":
                         texts.append(m["props"]["title"] + ": " + m["props"]["body"])
         except Exception as exc:  # closed by the server
