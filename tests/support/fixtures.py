@@ -18,7 +18,7 @@ from tests.support.browser import CHROMIUM, CHROMIUM_ARGS
 from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz.ui.app import TpmApp, build_server
 
-__all__ = ["app", "browser", "connect"]
+__all__ = ["app", "browser", "connect", "open_tab"]
 
 
 @pytest.fixture
@@ -30,21 +30,22 @@ def app():
     application.stop()
 
 
+def open_tab(app, opened: list[ProtocolClient]):
+    """Open a protocol client on ``app`` (appended to ``opened``); ``(client, view)`` once its first render is done."""
+    before = set(app.views)
+    client = ProtocolClient(app.port)
+    opened.append(client)
+    new = wait_for(lambda: set(app.views) - before, what="the app to build a view for the client")
+    view = app.views[next(iter(new))]
+    wait_for(lambda: view.session.readout is not None, what="the first render")
+    return client, view
+
+
 @pytest.fixture
 def connect(app):
     """``connect()`` opens a protocol client and returns ``(client, view)`` once the app built its view."""
     opened: list[ProtocolClient] = []
-
-    def _connect():
-        before = set(app.views)
-        client = ProtocolClient(app.port)
-        opened.append(client)
-        new = wait_for(lambda: set(app.views) - before, what="the app to build a view for the client")
-        view = app.views[next(iter(new))]
-        wait_for(lambda: view.session.readout is not None, what="the first render")
-        return client, view
-
-    yield _connect
+    yield lambda: open_tab(app, opened)
     for client in opened:  # one at a time: each tab's departure is processed before the next one leaves
         count = len(app.views)
         client.close()

@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 
 import tpm_viz.ui.app as app_module
+from tests.support.fixtures import open_tab
 from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz import InputError
 from tpm_viz.app.access import LOCKOUT_SECONDS, MAX_FAILURES, Access, AccessDenied
@@ -300,17 +301,7 @@ def presenter_app():
 def pconnect(presenter_app):
     """Like conftest's ``connect``, for the presenter-mode app; tolerates tabs the test closed itself."""
     opened: list[ProtocolClient] = []
-
-    def _connect():
-        before = set(presenter_app.views)
-        client = ProtocolClient(presenter_app.port)
-        opened.append(client)
-        new = wait_for(lambda: set(presenter_app.views) - before, what="a view for the client")
-        view = presenter_app.views[next(iter(new))]
-        wait_for(lambda: view.session.readout is not None, what="the first render")
-        return client, view
-
-    yield _connect
+    yield lambda: open_tab(presenter_app, opened)
     for client in opened:
         client.close()
     wait_for(lambda: not presenter_app.views, what="every tab to leave")
