@@ -8,13 +8,12 @@ file's constraints: ``(Nᵀ Sᵀ) τ = Nᵀ rnea(q, v, a)`` (λ eliminated, the 
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pinocchio as pin
 import pytest
 
 import tpm_viz as tv
+from tests.support.strategies import random_states
 from tpm_viz.exchange.mjcf import mjcf_text
 from tpm_viz.exchange.topology import JOINT_NAMES, joint_motion
 from tpm_viz.multibody.rank import ranked_svd
@@ -77,17 +76,6 @@ class FromFile:
         n = svd.null_space
         rhs = pin.rnea(self.model, self.data, q, v, a)
         return np.linalg.solve(n.T @ self.s_t, n.T @ rhs)
-
-
-def random_states(params, count: int, seed: int):
-    """Regular platform states: ``|p_j| <= 0.85 l_a``, cos θ_i and det J_x above 0.25 (SI units)."""
-    rng, la, out = np.random.default_rng(seed), params.l_a, []
-    while len(out) < count:
-        p = rng.uniform(-0.85 * la, 0.85 * la, 2)
-        cos1, cos2 = math.sqrt(1 - (p[1] / la) ** 2), math.sqrt(1 - (p[0] / la) ** 2)
-        if min(cos1, cos2) > 0.25 and abs(cos1 * cos2 - p[0] * p[1] / la**2) > 0.25:
-            out.append((p, rng.uniform(-2, 2, 2), rng.uniform(-30, 30, 2)))
-    return out
 
 
 @pytest.fixture(scope="module")

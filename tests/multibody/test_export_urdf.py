@@ -7,7 +7,6 @@ projecting ``rnea`` on its null space reproduces the paper's closed-form forces.
 
 from __future__ import annotations
 
-import math
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -15,6 +14,7 @@ import pinocchio as pin
 import pytest
 
 import tpm_viz as tv
+from tests.support.strategies import random_states
 from tpm_viz.exchange.topology import joint_motion
 from tpm_viz.exchange.urdf import MIMIC, urdf_text
 from tpm_viz.multibody.rank import ranked_svd
@@ -84,23 +84,13 @@ class UrdfModel:
         return gap, jac
 
 
-def states(params, count, seed):
-    rng, la, out = np.random.default_rng(seed), params.l_a, []
-    while len(out) < count:
-        p = rng.uniform(-0.85 * la, 0.85 * la, 2)
-        cos1, cos2 = math.sqrt(1 - (p[1] / la) ** 2), math.sqrt(1 - (p[0] / la) ** 2)
-        if min(cos1, cos2) > 0.25 and abs(cos1 * cos2 - p[0] * p[1] / la**2) > 0.25:
-            out.append((p, rng.uniform(-2, 2, 2), rng.uniform(-30, 30, 2)))
-    return out
-
-
 @pytest.mark.parametrize("mimic", [True, False])
 def test_pinocchio_reads_the_urdf_and_the_documented_closure_holds(mimic):
     um = UrdfModel(P, mimic)
     assert (um.model.nq, um.model.nv) == ((4, 4) if mimic else (7, 7))
     mass = sum(um.model.inertias[i].mass for i in range(1, um.model.njoints))
     assert mass == pytest.approx(2 * P.m_a + 2 * P.m_b + P.m_p, rel=1e-12)
-    for p, _, _ in states(P, 20, seed=5):
+    for p, _, _ in random_states(P, 20, seed=5):
         q, _, _ = um.state(p)
         gap, _ = um.closure(q)
         assert np.abs(gap).max() < 1e-12
@@ -116,7 +106,7 @@ def test_mimic_tree_plus_documented_closure_gives_the_closed_form_forces(params)
     s_t = np.zeros((um.model.nv, 2))
     s_t[[um.iv[0], um.iv[2]], [0, 1]] = 1.0
     worst = 0.0
-    for p, dp, ddp in states(params, 50, seed=11):
+    for p, dp, ddp in random_states(params, 50, seed=11):
         q, v, a = um.state(p, dp, ddp)
         _, jac = um.closure(q)
         svd = ranked_svd(jac)

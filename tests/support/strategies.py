@@ -37,3 +37,15 @@ def regular_states(draw, params: Params, margin: float = 0.25):
     dp = np.array([draw(st.floats(-2, 2)), draw(st.floats(-2, 2))])
     ddp = np.array([draw(st.floats(-30, 30)), draw(st.floats(-30, 30))])
     return p, dp, ddp
+
+
+def random_states(params, count: int, seed: int):
+    """Seeded (numpy) regular platform states ``(p, ṗ, p̈)``: ``|p_j| <= 0.85 l_a``, cos θ_i and det J_x above
+    0.25 (SI units)."""
+    rng, la, out = np.random.default_rng(seed), params.l_a, []
+    while len(out) < count:
+        p = rng.uniform(-0.85 * la, 0.85 * la, 2)
+        cos1, cos2 = math.sqrt(1 - (p[1] / la) ** 2), math.sqrt(1 - (p[0] / la) ** 2)
+        if min(cos1, cos2) > 0.25 and abs(cos1 * cos2 - p[0] * p[1] / la**2) > 0.25:
+            out.append((p, rng.uniform(-2, 2, 2), rng.uniform(-30, 30, 2)))
+    return out
