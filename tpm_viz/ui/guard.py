@@ -121,9 +121,12 @@ log_fault = FAULTS
 
 
 def report(exc: BaseException, what: str) -> None:
-    """Log an unexpected exception of ``what`` with its traceback and count it."""
-    ACTIVITY.error()
+    """Log an unexpected exception of ``what`` with its traceback, then count it.
+
+    Logged first: whoever waits on the count (a health page, a test) then finds the log line written.
+    """
     log.error("%s failed: %s: %s", what, type(exc).__name__, exc, exc_info=exc)
+    ACTIVITY.error()
 
 
 def _notify(on_error, args, exc: Exception, what: str) -> None:
