@@ -82,7 +82,7 @@ class Phrase:
         return isinstance(other, Phrase) and (self.template, dict(self.values)) == (other.template, dict(other.values))
 
 
-def T(template: str) -> Phrase:  # noqa: N802 (the conventional name of a translatable literal)
+def T(template: str) -> Phrase:
     """A phrase without fields: a label, a button, a heading (``T("Apply parameters")``)."""
     return Phrase(template)
 

@@ -35,6 +35,7 @@ from tpm_viz.ui.session import Hub, Session
 from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.tabscene import TabScene
 from tpm_viz.ui.teaching.tabs import Services, Teaching
+from tpm_viz.words import Lang, Phrase, say
 
 __all__ = ["ClientView"]
 
@@ -84,7 +85,7 @@ def _callback(method):
             try:
                 method(self, event, *args)
             except TpmVizError as exc:
-                self.refuse(str(exc))
+                self.refuse(exc.args[0] if exc.args and isinstance(exc.args[0], Phrase) else str(exc))
 
     return wrapper
 
@@ -96,6 +97,8 @@ class ClientView:
         self.client = client
         self.hub = hub
         self.closed = False
+        self.lang = Lang.EN
+        """The language of this tab's words (:mod:`tpm_viz.words`): render a phrase with ``say(view.lang, ...)``."""
         self.login: LoginPanel | None = None
         """The presenter login of this tab (presenter mode only)."""
         self._notified: tuple[str, float] = ("", 0.0)
@@ -164,14 +167,15 @@ class ClientView:
                 self.frame_camera(frame.state.params)
         self.client.flush()
 
-    def refuse(self, text: str, resync: bool = True) -> None:
-        """Tell this tab (only) that its input was refused; the mechanism keeps its last good state and, with
-        ``resync``, this tab's widgets and gizmo show that state again."""
-        self.panel.tell(f"Refused: {text}")
+    def refuse(self, what: str | Phrase, resync: bool = True) -> None:
+        """Tell this tab (only) that its input was refused (``what`` in the tab's language); the mechanism keeps
+        its last good state and, with ``resync``, this tab's widgets and gizmo show that state again."""
+        text = say(self.lang, what)
+        self.panel.tell(say(self.lang, "Refused: {text}", text=text))
         now = time.monotonic()
         if self._notified[0] != text or now - self._notified[1] > NOTIFY_AGAIN_SECONDS:
             self._notified = (text, now)
-            self.client.add_notification("Input refused", text, color="red", auto_close_seconds=8.0)
+            self.client.add_notification(say(self.lang, "Input refused"), text, color="red", auto_close_seconds=8.0)
         if resync and self.session.frame is not None:
             self.panel.forget()
             self.scene.forget()
