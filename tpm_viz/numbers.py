@@ -16,7 +16,11 @@ write ``1234.5``), NaN and infinities, numbers too large for a float (``1e999``)
 :data:`MAX_TEXT` characters. Messages quote at most :data:`QUOTE` characters of what was typed.
 
 :data:`UNITS` and :func:`unit_factor` convert the units people write (``mm``, ``ms``, ``mm/s^2``, ``kN``, ``deg``)
-to SI; :func:`plausibility_note` flags results far beyond the usual size (a hint at an input in the wrong unit).
+to SI; :func:`plausibility` (:func:`plausibility_note`: as text) flags results far beyond the usual size (a hint at
+an input in the wrong unit).
+
+Numbers as people read them: :func:`fixed` is the one formatter of a shown number (a dash for None, NaN or
+infinity; never ``-0.0``: a value that rounds to zero is written as zero, whatever its sign).
 
 Base layer: standard library only.
 """
@@ -27,8 +31,20 @@ import math
 import re
 
 from tpm_viz.errors import InputError
+from tpm_viz.words import Phrase
 
-__all__ = ["MAX_TEXT", "QUOTE", "UNITS", "parse_number", "plausibility_note", "shorten", "unit_factor"]
+__all__ = [
+    "DASH",
+    "MAX_TEXT",
+    "QUOTE",
+    "UNITS",
+    "fixed",
+    "parse_number",
+    "plausibility",
+    "plausibility_note",
+    "shorten",
+    "unit_factor",
+]
 
 MAX_TEXT = 400
 """Longest text accepted as a number [characters] (the exact decimal value of a float fits in far less)."""
@@ -62,6 +78,29 @@ _GROUPED = re.compile(rf"[+-]?\d{{1,3}}(?:[{_SPACES}]\d{{3}})+(?:[.,]\d*)?(?:[eE
 _NUMBERISH = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 
 
+DASH = "—"
+"""What :func:`fixed` shows for a number that is missing or not finite."""
+
+
+def fixed(x, fmt: str = ".1f", scale: float = 1.0) -> str:
+    """``x * scale`` formatted with ``fmt`` (a :func:`format` spec: ``".1f"``, ``"+.2f"``, ``".3e"``, ``"g"``)
+    as a number is shown to people: :data:`DASH` for None, NaN, infinity or a non-number, and never a negative
+    zero (``fixed(-1e-12, ".1f")`` is ``"0.0"``, ``fixed(-0.04, "+.1f")`` is ``"+0.0"``)."""
+    if x is None or isinstance(x, bool):
+        return DASH
+    try:
+        v = float(x) * float(scale)
+    except (TypeError, ValueError, OverflowError):
+        return DASH
+    if not math.isfinite(v):
+        return DASH
+    text = format(v, fmt)
+    mantissa = re.split("[eE]", text, maxsplit=1)[0]
+    if "-" in mantissa and not any(c in "123456789" for c in mantissa):  # rounds to zero: drop the sign
+        text = format(0.0, fmt)
+    return text
+
+
 def shorten(text, limit: int = QUOTE) -> str:
     """``repr`` of ``text`` cut to about ``limit`` characters (``'123...'``), for messages."""
     text = str(text)
@@ -83,22 +122,32 @@ def parse_number(text, name: str = "value", unit: str = "") -> float:
     """
     label = _label(name, unit)
     if isinstance(text, bool):
-        raise InputError(f"{label} must be a number, got {text!r}")
+        raise InputError(Phrase("{label} must be a number, got {text}", label=label, text=repr(text)))
     if isinstance(text, (int, float)):
         try:
             value = float(text)
         except OverflowError:
-            raise InputError(f"{label} is too large for a number, got {shorten(text)}") from None
+            raise InputError(
+                Phrase("{label} is too large for a number, got {text}", label=label, text=shorten(text))
+            ) from None
         if not math.isfinite(value):
-            raise InputError(f"{label} must be a finite number, got {value!r}")
+            raise InputError(Phrase("{label} must be a finite number, got {text}", label=label, text=repr(value)))
         return value
     if not isinstance(text, str):
-        raise InputError(f"{label} must be a number, got {shorten(text)}")
+        raise InputError(Phrase("{label} must be a number, got {text}", label=label, text=shorten(text)))
     s = text.strip()
     if not s:
-        raise InputError(f"{label} is empty: type a number such as 0.25, 0,25 or 2.5e-1")
+        raise InputError(Phrase("{label} is empty: type a number such as 0.25, 0,25 or 2.5e-1", label=label))
     if len(s) > MAX_TEXT:
-        raise InputError(f"{label}: {shorten(s)} is too long for a number ({len(s)} characters; at most {MAX_TEXT})")
+        raise InputError(
+            Phrase(
+                "{label}: {text} is too long for a number ({n} characters; at most {most})",
+                label=label,
+                text=shorten(s),
+                n=len(s),
+                most=MAX_TEXT,
+            )
+        )
     s = s.translate(_MINUS)
     if unit and s.endswith(unit) and len(s) > len(unit):
         s = s[: -len(unit)].rstrip()
@@ -107,34 +156,63 @@ def parse_number(text, name: str = "value", unit: str = "") -> float:
     if "," in s:
         if "." in s or s.count(",") > 1:
             raise InputError(
-                f"{label}: {shorten(text.strip())} mixes separators; write the number without thousands "
-                "separators, with one decimal point or comma (1234.5 or 1234,5)"
+                Phrase(
+                    "{label}: {text} mixes separators; write the number without thousands separators, with one "
+                    "decimal point or comma (1234.5 or 1234,5)",
+                    label=label,
+                    text=shorten(text.strip()),
+                )
             )
         s = s.replace(",", ".")
     try:
         value = float(s)
     except ValueError:
-        raise InputError(f"{label}: {shorten(text.strip())} is not a number (examples: 0.25, 0,25, -1.5e-3)") from None
+        raise InputError(
+            Phrase(
+                "{label}: {text} is not a number (examples: 0.25, 0,25, -1.5e-3)",
+                label=label,
+                text=shorten(text.strip()),
+            )
+        ) from None
     if not math.isfinite(value):
         if _NUMBERISH.fullmatch(s.replace("_", "")):
-            raise InputError(f"{label}: {shorten(text.strip())} is too large (beyond ±1.8e308)")
-        raise InputError(f"{label}: {shorten(text.strip())} is not finite; type a finite number")
+            raise InputError(
+                Phrase("{label}: {text} is too large (beyond ±1.8e308)", label=label, text=shorten(text.strip()))
+            )
+        raise InputError(
+            Phrase("{label}: {text} is not finite; type a finite number", label=label, text=shorten(text.strip()))
+        )
     return value
 
 
-def plausibility_note(value: float, name: str, unit: str = "", typical: float | None = None) -> str | None:
-    """A one-line note when ``|value|`` exceeds ``typical`` (same unit) by more than a factor of 1000, else None.
+def plausibility(
+    value: float, name: str, unit: str = "", typical: float | None = None, factor: float = 1000.0
+) -> Phrase | None:
+    """A one-line note when ``|value|`` exceeds ``typical`` (same unit) by more than ``factor``, else None.
 
     For results that are computed correctly but hint at an input in the wrong unit (forces of meganewtons from
-    positions typed in millimetres as metres, a 1000 s run from times in milliseconds).
+    positions typed in millimetres as metres, a 1000 s run from times in milliseconds). ``str()`` of the phrase is
+    the English line; the app renders it in a tab's language.
     """
-    if typical is None or not math.isfinite(value) or abs(value) <= 1000.0 * abs(typical):
+    if typical is None or not math.isfinite(value) or abs(value) <= factor * abs(typical):
         return None
-    u = f" {unit}" if unit else ""
-    return (
-        f"note: {_label(name, '')} = {value:.3g}{u} is more than 1000 times the usual {typical:.3g}{u}; "
-        "check the units of the inputs"
+    return Phrase(
+        "note: {name} = {value:.3g}{unit} is more than {factor:g} times the usual {typical:.3g}{unit}; "
+        "check the units of the inputs",
+        name=str(name)[:QUOTE],
+        value=value,
+        unit=f" {unit}" if unit else "",
+        factor=factor,
+        typical=typical,
     )
+
+
+def plausibility_note(
+    value: float, name: str, unit: str = "", typical: float | None = None, factor: float = 1000.0
+) -> str | None:
+    """:func:`plausibility` as English text (the command line), or None."""
+    note = plausibility(value, name, unit, typical, factor)
+    return None if note is None else str(note)
 
 
 def unit_factor(unit: str, quantity: str | None, label: str, name: str) -> tuple[float, float]:

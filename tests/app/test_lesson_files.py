@@ -36,6 +36,7 @@ from tpm_viz.app.lessons import (
 from tpm_viz.app.runs import Source, build_run
 from tpm_viz.errors import InputError
 from tpm_viz.paper.trajectories import parse_trajectory_csv
+from tpm_viz.words import Lang
 
 ASSETS = assets_dir()
 LESSONS = ASSETS / "lessons"
@@ -123,7 +124,7 @@ BAD = {
     "crossing": (
         GOOD.replace("[pose]\np = [0.0, 0.0]\n", "[motion]\nkind = 'csv'\nfile = '../csv/cross.csv'\n"),
         4,
-        "the motion: at t = 0.820 s, p = (-181.6, -181.6) mm: too close to the direct singularity",
+        "the motion: at t = 0.820 s, p = (-181.6, -181.6) mm: the platform would come too close to the direct singularity",
     ),
     "missing_csv": (
         GOOD.replace("[pose]\np = [0.0, 0.0]\n", "[motion]\nkind = 'csv'\nfile = 'nope.csv'\n"),
@@ -229,16 +230,18 @@ def test_the_demos_tab_takes_a_lecturers_lessons_and_lists_the_refused_files(tmp
 
     folder = _folder(tmp_path, {"01-a.toml": GOOD, "02-b.toml": GOOD + "colour = 1\n"})
     lessons, problems = load_lessons(folder)
-    view = DemosView(SimpleNamespace(), None, None, lambda: 1.0, lessons=lessons, problems=problems)
+    view = DemosView(SimpleNamespace(lang=Lang.EN), None, None, lambda: 1.0, lessons=lessons, problems=problems)
     gui = FakeApi()
     view.build(gui)
     assert view.choice.value == "7. Mine" and "A lesson of my own" in view.text.content
     (note,) = [n for n in gui.nodes if n.kind == "add_html" and "demo-problems" in n.content]
     assert "1 lesson file(s) refused" in note.content and re.search(r"02-b\.toml:6: unknown key", note.content)
-    empty = DemosView(SimpleNamespace(), None, None, lambda: 1.0, lessons=(), problems=("x: no lesson files",))
+    empty = DemosView(
+        SimpleNamespace(lang=Lang.EN), None, None, lambda: 1.0, lessons=(), problems=("x: no lesson files",)
+    )
     empty.build(FakeApi())
     assert empty.choice.disabled and empty.play.disabled and "No lessons" in empty.text.content
-    default = DemosView(SimpleNamespace(), None, None, lambda: 1.0)
+    default = DemosView(SimpleNamespace(lang=Lang.EN), None, None, lambda: 1.0)
     assert default.lessons == DEMOS and default.problems == ()
 
 

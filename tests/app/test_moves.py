@@ -17,6 +17,7 @@ from tpm_viz.app.moves import (
     place,
     pose_codes,
     switch_mode,
+    why_not,
 )
 from tpm_viz.paper.jacobians import jacobians
 from tpm_viz.paper.status import MOVE_LIMITS, PoseStatus
@@ -72,7 +73,8 @@ def test_drag_past_the_stroke_stops_at_the_stroke_end():
     """d_1 = p_1 + a - b - l_a at p_2 = 0 (eq. 4): the stroke end d_1 = 300 mm is at p_1 = 170 mm."""
     move = drag_to(P, HOME, (0.5, 0.0))
     assert move.clamped
-    assert "actuator 1" in move.reason and "300.0 mm" in move.reason
+    assert str(move.reason).startswith("stopped: slider 1 is against its end-stop at the end of its rail")
+    assert "(d1 = Δd = 300.0 mm)" in str(move.reason)
     assert move.pose.p[0] == pytest.approx(0.170, abs=1e-5)
     assert move.pose.d[0] == pytest.approx(P.stroke, abs=1e-5)
     _assert_valid(P, move.pose)
@@ -80,7 +82,11 @@ def test_drag_past_the_stroke_stops_at_the_stroke_end():
 
 def test_drag_towards_the_direct_singularity_stops_before_it():
     move = drag_to(P, HOME, (-0.3, -0.3))
-    assert move.clamped and "direct singularity" in move.reason and "modes merge" in move.reason
+    why = str(move.reason)
+    assert move.clamped and "direct singularity" in why and "modes merge" in why
+    # the physics first (a degree of freedom gained, the stiffness lost, the forces unbounded), then the equation
+    for words in ("gains a degree of freedom", "loses its stiffness in one direction", "grow without bound"):
+        assert why.index(words) < why.index("eq. 12")
     det = float(jacobians(P, move.pose.p, move.pose.d).det_jx)
     assert det == pytest.approx(MOVE_LIMITS.direct, abs=1e-4)
     _assert_valid(P, move.pose)
@@ -123,7 +129,7 @@ def test_drive_inside_the_valid_set_is_forward_kinematics_in_the_same_mode():
 def test_drive_to_both_zero_stops_where_the_assembly_modes_merge():
     """d = (0, 0) puts the leg circles 0.55 m apart, more than 2 l_a: the modes merge on the way."""
     move = drive_to(P, HOME, (0.0, 0.0))
-    assert move.clamped and "modes merge" in move.reason
+    assert move.clamped and "modes merge" in str(move.reason)
     sol = forward_kinematics_both(P, move.pose.d)
     assert np.linalg.norm(sol.plus - sol.minus) < 0.1 * P.l_a  # the two solutions are close
     _assert_valid(P, move.pose)
@@ -131,7 +137,9 @@ def test_drive_to_both_zero_stops_where_the_assembly_modes_merge():
 
 def test_drive_past_the_stroke_stops_at_the_end():
     move = drive_to(P, HOME, (0.5, 0.13))
-    assert move.clamped and "actuator 1" in move.reason
+    assert move.clamped and "slider 1 is against its end-stop at the end of its rail (d1 = Δd = 300.0 mm)" in str(
+        move.reason
+    )
     assert move.pose.d[0] == pytest.approx(P.stroke, abs=1e-6)
 
 
@@ -149,14 +157,19 @@ def test_switch_mode_goes_to_the_other_circle_intersection_and_back():
 def test_switch_mode_is_refused_at_home_where_the_other_mode_is_singular():
     """At home the other intersection is (-l_a, -l_a): c_1 = 0, leg 1 at an inverse singularity."""
     move = switch_mode(P, HOME)
-    assert move.clamped and "inverse singularity" in move.reason
+    why = str(move.reason)
+    assert why.startswith("the other assembly mode is not usable here: leg 1 would come too close to an inverse")
+    assert "perpendicular to rail 1" in why and "actuator 1 loses its authority" in why
+    assert "(cos θ1 = 0.000, eq. 11)" in why  # c_1 = 0 exactly there: never "-0.000"
     assert move.pose is HOME
 
 
 def test_place_accepts_valid_and_refuses_invalid_positions():
     assert not place(P, HOME, (0.1, 0.05)).clamped
     refused = place(P, HOME, (0.25, 0.0))
-    assert refused.clamped and refused.pose is HOME and "stroke" in refused.reason
+    # d_1 = 0.25 + 0.39 - 0.26 = 380 mm (eq. 4), beyond the 300 mm stroke
+    assert refused.clamped and refused.pose is HOME
+    assert "actuator 1 would leave its stroke: slider 1 would have to be at d1 = 380.0 mm" in str(refused.reason)
     with pytest.raises(InputError):
         place(P, HOME, (np.inf, 0.0))
 
@@ -178,3 +191,22 @@ def test_requests_must_be_finite():
         drag_to(P, HOME, (np.nan, 0.0))
     with pytest.raises(InputError):
         drive_to(P, HOME, (0.1,))
+
+
+def test_why_not_names_the_leg_and_its_cosine_from_the_geometry():
+    """Lesson 6's pose: cos θ1 = c_1 / l_a with c_1 = p_1 - d_1 + a - b (eq. 23), read off the joints."""
+    p = np.array([-0.2252, -0.2582])
+    d = inverse_kinematics(P, p)
+    a1, b1 = np.array([d[0] - P.a, 0.0]), p - np.array([P.b, 0.0])  # A_1 = (d_1 - a) e_1, B_1 = P - b e_1
+    cos1 = (b1 - a1)[0] / np.linalg.norm(b1 - a1)
+    why = str(why_not(P, PoseStatus.NEAR_INVERSE, p, d, "drag"))
+    assert why.startswith("leg 1 would come too close to an inverse singularity")
+    assert f"(cos θ1 = {cos1:.3f}, eq. 11)" in why
+
+
+def test_why_not_never_writes_a_negative_zero():
+    p = np.array([0.1, 0.05])
+    d = inverse_kinematics(P, p)
+    d_bad = d + np.array([np.sqrt(P.l_a**2 - p[1] ** 2) + 1e-13, 0.0])  # c_1 = -1e-13 m: cos θ1 = -4e-13
+    why = str(why_not(P, PoseStatus.NEAR_INVERSE, p, d_bad, "drag"))
+    assert "cos θ1 = 0.000" in why and "-0.0" not in why and "−0.0" not in why

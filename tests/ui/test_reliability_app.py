@@ -128,7 +128,7 @@ def assert_valid(state: AppState) -> None:
     assert np.all(np.isfinite(pose.p)) and np.all(np.isfinite(pose.d))
     np.testing.assert_allclose(pose.d, ik_branch(params, pose.p, pose.branch(params)), atol=1e-9)
     assert check(params, pose) == PoseStatus.REGULAR, (params, pose)
-    assert not BAD_TEXT.search(state.note)
+    assert not BAD_TEXT.search(str(state.note))
     for value in (*state.load.f_ext, *state.load.dp, *state.load.ddp, state.trajectory.duration, state.trajectory.t):
         assert math.isfinite(value)
 

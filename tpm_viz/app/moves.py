@@ -27,9 +27,11 @@ from typing import Literal, NamedTuple
 import numpy as np
 
 from tpm_viz.errors import InputError
+from tpm_viz.numbers import fixed
 from tpm_viz.paper.kinematics import forward_kinematics_both, inverse_kinematics
 from tpm_viz.paper.status import MOVE_LIMITS, PoseStatus, SingularityThresholds
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase
 
 __all__ = [
     "Move",
@@ -62,7 +64,11 @@ class Pose:
         for name in ("p", "d"):
             arr = np.array(getattr(self, name), dtype=float).reshape(-1)
             if arr.shape != (2,) or not np.all(np.isfinite(arr)):
-                raise InputError(f"pose {name} must be two finite numbers, got {getattr(self, name)!r}")
+                raise InputError(
+                    Phrase(
+                        "pose {name} must be two finite numbers, got {got}", name=name, got=repr(getattr(self, name))
+                    )
+                )
             arr.setflags(write=False)
             object.__setattr__(self, name, arr)
 
@@ -82,11 +88,12 @@ class Pose:
 
 
 class Move(NamedTuple):
-    """Result of a move: the new pose, whether it stopped short of the request, and why (one line)."""
+    """Result of a move: the new pose, whether it stopped short of the request, and why (one line: a
+    :class:`~tpm_viz.words.Phrase`, rendered in the tab's language; ``""`` when there is nothing to say)."""
 
     pose: Pose
     clamped: bool = False
-    reason: str = ""
+    reason: str | Phrase = ""
 
 
 def ik_branch(params: Params, p, branch) -> np.ndarray:
@@ -145,32 +152,66 @@ Cause = Literal["drag", "drive", "path"]
 """What led to a pose: a drag of the platform, a drive of the actuators, or a sample of a given path."""
 
 
-def why_not(params: Params, status: int, p, d, cause: Cause = "path") -> str:
+def why_not(params: Params, status: int, p, d, cause: Cause = "path") -> Phrase:
     """One line saying why the pose ``(p, d)`` [m] is not valid, for a status of :class:`PoseStatus` other than
-    ``REGULAR``: the one describer of refusals (moves, trajectories, presets). For a drag or a drive ``(p, d)`` is
-    the first blocked pose of the move; for a path, the offending sample."""
+    ``REGULAR``: the one describer of refusals (moves, trajectories, presets, lessons). What happens physically
+    first (which actuator and which end, which leg, what the platform does), then the number and the equation.
+    For a drag or a drive ``(p, d)`` is the first blocked pose of the move; for a path, the offending sample."""
     p, d, mm = np.asarray(p, dtype=float), np.asarray(d, dtype=float), 1e3
     cos = (p - d + params.offset) / params.l_a
     if status == PoseStatus.OUT_OF_STROKE:
         i = int(np.argmax(np.maximum(-d, d - params.stroke)))
         if cause != "path":
-            end = 0.0 if d[i] < 0.5 * params.stroke else params.stroke
-            return f"actuator {i + 1} reached the end of its stroke (d{i + 1} = {end * mm:.1f} mm)"
-        stroke = f"0 to {params.stroke * mm:.0f} mm"
-        return f"actuator {i + 1} would leave its stroke (d{i + 1} = {d[i] * mm:.1f} mm, {stroke})"
+            if d[i] < 0.5 * params.stroke:
+                return Phrase(
+                    "slider {i} is against its end-stop at the start of its rail (d{i} = 0 mm): actuator {i} cannot "
+                    "pull it further back",
+                    i=i + 1,
+                )
+            return Phrase(
+                "slider {i} is against its end-stop at the end of its rail (d{i} = Δd = {end} mm): actuator {i} "
+                "cannot push it further",
+                i=i + 1,
+                end=fixed(params.stroke * mm, ".1f"),
+            )
+        return Phrase(
+            "actuator {i} would leave its stroke: slider {i} would have to be at d{i} = {d} mm, beyond its "
+            "end-stops at 0 and {stroke} mm",
+            i=i + 1,
+            d=fixed(d[i] * mm, ".1f"),
+            stroke=fixed(params.stroke * mm, ".0f"),
+        )
     if status == PoseStatus.NEAR_INVERSE:
         i = int(np.nanargmin(np.abs(cos))) if np.any(np.isfinite(cos)) else 0
-        value = f"cos θ{i + 1} = {cos[i]:.3f}, " if np.isfinite(cos[i]) else ""
-        return f"leg {i + 1} comes too close to the inverse singularity ({value}eq. 11)"
+        value = f"cos θ{i + 1} = {fixed(cos[i], '.3f')}, " if np.isfinite(cos[i]) else ""
+        return Phrase(
+            "leg {i} would come too close to an inverse singularity: its links would stand almost perpendicular to "
+            "rail {i}, where actuator {i} loses its authority along them ({value}eq. 11)",
+            i=i + 1,
+            value=value,
+        )
     if status == PoseStatus.NEAR_DIRECT:
         det = cos[0] * cos[1] - p[1] * p[0] / params.l_a**2
         dot = cos[0] * p[1] + p[0] * cos[1]  # l_a s_1 · s_2 / l_a
-        kind = "the leg circles coincide" if dot > 0 else "the two assembly modes merge"
-        value = f"cos(θ1+θ2) = {det:.3f}, " if np.isfinite(det) else ""
-        return f"too close to the direct singularity ({value}eq. 12): {kind}"
+        kind = Phrase("the leg circles coincide") if dot > 0 else Phrase("the two assembly modes merge")
+        value = f"cos(θ1+θ2) = {fixed(det, '.3f')}, " if np.isfinite(det) else ""
+        return Phrase(
+            "the platform would come too close to the direct singularity, where it gains a degree of freedom: it "
+            "loses its stiffness in one direction and the actuator forces grow without bound for a load along it; "
+            "{kind} ({value}eq. 12)",
+            kind=kind,
+            value=value,
+        )
     if cause == "drive":
-        return "the leg circles no longer meet: the mechanism cannot be assembled there"
-    return f"out of reach (|p1|, |p2| must stay below l_a = {params.l_a * mm:.1f} mm)"
+        return Phrase(
+            "the two legs cannot both reach the platform there: their circles no longer meet, so the mechanism "
+            "cannot be assembled"
+        )
+    return Phrase(
+        "out of reach: a leg of length l_a = {l_a} mm cannot reach the platform there (|p1| and |p2| must stay "
+        "below l_a)",
+        l_a=fixed(params.l_a * mm, ".1f"),
+    )
 
 
 def _clamp(codes_of, x0: np.ndarray, x1: np.ndarray) -> tuple[np.ndarray, int]:
@@ -223,7 +264,8 @@ def drag_to(params: Params, pose: Pose, p_req, limits: SingularityThresholds = M
         if np.linalg.norm(slid - p_req) < np.linalg.norm(best - p_req) - 1e-12:
             best = slid
     new = Pose(best, ik_branch(params, best, branch))
-    return Move(new, True, "stopped: " + why_not(params, stop, blocked, ik_branch(params, blocked, branch), "drag"))
+    why = why_not(params, stop, blocked, ik_branch(params, blocked, branch), "drag")
+    return Move(new, True, Phrase("stopped: {why}", why=why))
 
 
 def _project_on_edge(margins_of, start: np.ndarray, blocked: np.ndarray) -> np.ndarray | None:
@@ -292,23 +334,19 @@ def drive_to(params: Params, pose: Pose, d_req, limits: SingularityThresholds = 
         return Move(new)
     d_bad = _first_bad(codes_of, d0, d_req)
     p_bad = _fk(params, d_bad, mode)
-    return Move(new, True, "stopped: " + why_not(params, stop, p_bad, d_bad, "drive"))
+    return Move(new, True, Phrase("stopped: {why}", why=why_not(params, stop, p_bad, d_bad, "drive")))
 
 
 def switch_mode(params: Params, pose: Pose, limits: SingularityThresholds = MOVE_LIMITS) -> Move:
     """Jump to the other assembly mode at the same actuator positions (the other circle intersection)."""
     other = _fk(params, pose.d, -pose.mode(params))
     if not np.all(np.isfinite(other)):
-        return Move(
-            pose,
-            True,
-            "no other assembly mode here: " + why_not(params, PoseStatus.UNREACHABLE, pose.p, pose.d, "drive"),
-        )
+        why = why_not(params, PoseStatus.UNREACHABLE, pose.p, pose.d, "drive")
+        return Move(pose, True, Phrase("no other assembly mode here: {why}", why=why))
     code = int(pose_codes(params, other, pose.d, -pose.mode(params), None, limits))
     if code != PoseStatus.REGULAR:
-        return Move(
-            pose, True, "the other assembly mode is not usable here: " + why_not(params, code, other, pose.d, "drive")
-        )
+        why = why_not(params, code, other, pose.d, "drive")
+        return Move(pose, True, Phrase("the other assembly mode is not usable here: {why}", why=why))
     return Move(Pose(other, pose.d))
 
 
@@ -319,9 +357,9 @@ def place(params: Params, pose: Pose, p, limits: SingularityThresholds = MOVE_LI
         raise InputError(f"platform position must be two finite numbers, got {p!r}")
     d = ik_branch(params, p, (1.0, 1.0))
     if not np.all(np.isfinite(d)):
-        return Move(pose, True, "refused: " + why_not(params, PoseStatus.UNREACHABLE, p, d, "drag"))
+        return Move(pose, True, Phrase("refused: {why}", why=why_not(params, PoseStatus.UNREACHABLE, p, d)))
     new = Pose(p, d)
     code = check(params, new, limits)
     if code != PoseStatus.REGULAR:
-        return Move(pose, True, "refused: " + why_not(params, code, p, d, "drag"))
+        return Move(pose, True, Phrase("refused: {why}", why=why_not(params, code, p, d)))
     return Move(new)

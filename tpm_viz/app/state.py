@@ -13,6 +13,7 @@ from tpm_viz.app.moves import Pose
 from tpm_viz.app.poses import home_pose
 from tpm_viz.app.readouts import Load
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase
 
 __all__ = ["AppState", "TrajectorySample"]
 
@@ -36,8 +37,9 @@ class AppState:
     pose: Pose
     load: Load = field(default_factory=Load)
     trajectory: TrajectorySample = field(default_factory=TrajectorySample)
-    note: str = ""
-    """Why the last move stopped short (shown to every viewer of the session), or empty."""
+    note: str | Phrase = ""
+    """Why the last move stopped short, or what it changed (shown to every viewer of the session, each in their
+    language), or empty."""
     version: int = 0
 
     @classmethod

@@ -16,7 +16,7 @@ import numpy as np
 
 from tpm_viz.app.inputs import read_choice, read_number, read_params, read_vec2
 from tpm_viz.app.moves import Move, drag_to, drive_to, switch_mode
-from tpm_viz.app.poses import DEMO_KINDS, home_pose, preset_pose, settle
+from tpm_viz.app.poses import DEMO_KINDS, go_home, preset_pose, settle
 from tpm_viz.app.readouts import LOAD_MODES, Load
 from tpm_viz.app.state import AppState, TrajectorySample
 from tpm_viz.params import Params
@@ -86,13 +86,13 @@ def switch(state: AppState) -> AppState:
 
 def home(state: AppState) -> AppState:
     """The home pose ``p = 0`` (or the nearest valid pose)."""
-    return _moved(state, Move(home_pose(state.params)))
+    return _moved(state, go_home(state.params, state.pose))
 
 
 def demo(state: AppState, kind) -> AppState:
     """A pose near an inverse singularity, the direct singularity or a stroke end (``DEMO_KINDS``)."""
     kind = read_choice(kind, "demo", DEMO_KINDS)
-    return _moved(state, preset_pose(state.params, kind, near=state.pose.p))
+    return _moved(state, preset_pose(state.params, kind, near=state.pose))
 
 
 def set_load(state: AppState, mode, f_ext, dp, ddp) -> AppState:

@@ -16,6 +16,7 @@ from tpm_viz.app.state import AppState
 from tpm_viz.params import PARAM_INFO, Params
 from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.text import legend_html
+from tpm_viz.words import Lang
 
 __all__ = ["PARAM_LABELS", "Panel"]
 
@@ -115,13 +116,14 @@ class Panel:
             gui.add_html(legend_html())
             self.frame_camera = gui.add_button("Snapshot the mechanism", icon=viser.Icon.FOCUS_CENTERED)
 
-    def show(self, frame: Snapshot) -> None:
-        """Write every value of the frame's state and readout into the widgets (viser skips unchanged ones)."""
+    def show(self, frame: Snapshot, lang: Lang = Lang.EN) -> None:
+        """Write every value of the frame's state and readout into the widgets (viser skips unchanged ones), the
+        dashboard's messages in ``lang``."""
         state, readout = frame.state, frame.readout
         now = time.monotonic()
         due = not frame.in_drag or now - self._dashboard_at >= LIVE_DASHBOARD_INTERVAL
         if due:  # mid-drag the numbers are refreshed at most 10 times a second (load: bench_load.py)
-            self.dashboard.content = frame.dashboard
+            self.dashboard.content = frame.dashboard_in(lang)
             self._dashboard_at = now
         if not frame.in_drag or not self.equations.content:
             self.equations.content = frame.equations

@@ -21,6 +21,7 @@ from tpm_viz.paper.dynamics import inverse_dynamics_detail
 from tpm_viz.paper.jacobians import jacobians
 from tpm_viz.paper.kinematics import MechanismPose, mechanism_pose
 from tpm_viz.ui.text import dashboard_html
+from tpm_viz.words import Lang
 
 __all__ = ["Snapshot"]
 
@@ -35,6 +36,7 @@ class Snapshot:
         """True for the intermediate frames of a gizmo drag (views may skip costly, non-essential parts)."""
         self.complete_readout: Callable[[], Readout] | None = None
         """For a live frame whose ``readout`` lacks the reference forces: computes the readout with them."""
+        self._dashboards: dict[Lang, str] = {}
 
     @cached_property
     def displayed_readout(self) -> Readout:
@@ -67,5 +69,11 @@ class Snapshot:
 
     @cached_property
     def dashboard(self) -> str:
-        """The HTML of the always-visible top of the panel."""
-        return dashboard_html(self.state, self.displayed_readout)
+        """The HTML of the always-visible top of the panel (its messages in English)."""
+        return self.dashboard_in(Lang.EN)
+
+    def dashboard_in(self, lang: Lang) -> str:
+        """The HTML of the always-visible top of the panel, its messages in ``lang`` (built once per language)."""
+        if lang not in self._dashboards:
+            self._dashboards[lang] = dashboard_html(self.state, self.displayed_readout, lang)
+        return self._dashboards[lang]

@@ -15,6 +15,7 @@ import numpy as np
 from tpm_viz.app.palette import hex_colour
 from tpm_viz.app.readouts import Readout
 from tpm_viz.app.state import AppState
+from tpm_viz.words import Lang, say
 
 __all__ = ["COLORS_CSS", "banner_level", "dashboard_html", "force_scale", "legend_html", "num"]
 
@@ -69,11 +70,17 @@ def _q(name: str, text: str) -> str:
     return f'<span data-q="{name}">{html.escape(text)}</span>'
 
 
-def _banner(state: AppState, readout: Readout) -> str:
+def _banner(state: AppState, readout: Readout, lang: Lang) -> str:
     level = banner_level(readout)
     bg, fg, border = COLORS_CSS[level]
-    lines = [html.escape(a.text) for a in readout.alerts] or ["Regular pose: clear of singularities and stroke ends"]
-    note = f'<div style="margin-top:3px;font-style:italic">{html.escape(state.note)}</div>' if state.note else ""
+    lines = [html.escape(say(lang, a.text)) for a in readout.alerts] or [
+        "Regular pose: clear of singularities and stroke ends"
+    ]
+    note = (
+        f'<div style="margin-top:3px;font-style:italic">{html.escape(say(lang, state.note))}</div>'
+        if state.note
+        else ""
+    )
     return (
         f'<div data-q="banner" data-level="{level}" style="background:{bg};color:{fg};border-left:4px solid {border};'
         f'padding:6px 8px;border-radius:4px;font-size:0.85em;line-height:1.35">'
@@ -118,7 +125,7 @@ def _bar(value, scale: float) -> str:
     )
 
 
-def _forces(state: AppState, readout: Readout) -> str:
+def _forces(state: AppState, readout: Readout, lang: Lang) -> str:
     f = readout.forces
     load = state.load
     if load.mode == "static":
@@ -145,7 +152,7 @@ def _forces(state: AppState, readout: Readout) -> str:
             f"{_q(f'tau{i + 1}_ref', num(ref[i], '.2f'))} N, difference "
             f"{_q(f'tau{i + 1}_diff', num(diff[i], '.1e'))} N</div>"
         )
-    note = f'<div style="color:#92400e">{html.escape(f.note)}</div>' if f.note else ""
+    note = f'<div style="color:#92400e">{html.escape(say(lang, f.note))}</div>' if f.note else ""
     return (
         f'<div style="font-size:0.85em;margin-top:6px"><div style="color:#334155;margin-bottom:3px">'
         f"<b>Actuator forces</b> (paper's closed form; bars full scale ±{num(scale, '.0f')} N)<br>{head}</div>"
@@ -174,6 +181,8 @@ def legend_html() -> str:
     return f'<div style="font-size:0.8em;color:#334155;line-height:1.4;padding:2px 0">{rows}</div>'
 
 
-def dashboard_html(state: AppState, readout: Readout) -> str:
-    """The always-visible top of the panel: banner, kinematic readouts, force bars."""
-    return f"<div>{_banner(state, readout)}{_kinematics(readout)}{_forces(state, readout)}</div>"
+def dashboard_html(state: AppState, readout: Readout, lang: Lang = Lang.EN) -> str:
+    """The always-visible top of the panel: banner, kinematic readouts, force bars. Its messages (the alerts, the
+    note of the last move, the force note) in ``lang``; its fixed words are shown in the tab's language by the
+    tab's connection (:mod:`tpm_viz.ui.language`)."""
+    return f"<div>{_banner(state, readout, lang)}{_kinematics(readout)}{_forces(state, readout, lang)}</div>"
