@@ -124,7 +124,8 @@ BAD = {
     "crossing": (
         GOOD.replace("[pose]\np = [0.0, 0.0]\n", "[motion]\nkind = 'csv'\nfile = '../csv/cross.csv'\n"),
         4,
-        "the motion: at t = 0.820 s, p = (-181.6, -181.6) mm: the platform would come too close to the direct singularity",
+        "the motion: at t = 0.820 s, p = (-181.6, -181.6) mm: the platform would come too close to the direct "
+        "singularity",
     ),
     "missing_csv": (
         GOOD.replace("[pose]\np = [0.0, 0.0]\n", "[motion]\nkind = 'csv'\nfile = 'nope.csv'\n"),
