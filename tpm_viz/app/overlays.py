@@ -9,6 +9,11 @@
 - :func:`colour_scale`: the legend of each kind (colour stops with their values and units).
 - :func:`ellipse_polylines`: the velocity and force manipulability ellipses (:mod:`tpm_viz.paper.ellipses`) at a
   platform position, scaled for drawing, or None at a singular pose.
+- :func:`arrow_length`, :func:`arrow_vector`: how long the force arrows of the 3D view are drawn. Near a
+  singularity the actuator forces grow without bound (eq. 12), so the length is proportional to the force for
+  small forces and grows only logarithmically beyond :data:`ARROW_FORCE`, never past :func:`arrow_reach` (a fixed
+  fraction of the mechanism's size): every arrow stays in view, a larger force always has a longer arrow, and the
+  number itself is in the panel.
 """
 
 from __future__ import annotations
@@ -24,9 +29,14 @@ from tpm_viz.paper.workspace import WorkspaceMap, workspace_map
 from tpm_viz.params import Params
 
 __all__ = [
+    "ARROW_FORCE",
+    "ARROW_REACH",
     "MAP_KINDS",
     "ColourScale",
     "EllipseDrawing",
+    "arrow_length",
+    "arrow_reach",
+    "arrow_vector",
     "cached_map",
     "colour_scale",
     "ellipse_polylines",
@@ -159,3 +169,37 @@ def ellipse_polylines(params: Params, p, scale: float, cap: float = 3.0, n: int 
     if not all(np.all(np.isfinite(o)) for o in outlines):
         return None
     return EllipseDrawing(outlines[0], outlines[1], ell.velocity.radii, ell.force.radii, clipped)
+
+
+ARROW_REACH = 0.15
+"""The longest force arrow, as a fraction of the mechanism's size ``a + l_a`` (0.111 m for the paper's)."""
+ARROW_FORCE = 50.0
+"""[N] The force scale of the arrows: linear well below it (``reach / ARROW_FORCE`` per newton, 2.2 mm/N for
+the paper's mechanism), logarithmic above; half the reach at ``(e - 1) ARROW_FORCE`` = 86 N."""
+
+
+def arrow_reach(params: Params) -> float:
+    """Length [m] that no force arrow reaches: :data:`ARROW_REACH` ``(a + l_a)``."""
+    return ARROW_REACH * (params.a + params.l_a)
+
+
+def arrow_length(force, params: Params):
+    """Length [m] of the arrow of a force of magnitude ``|force|`` [N] (scalar or array): ``L u / (1 + u)`` with
+    ``u = ln(1 + |force| / ARROW_FORCE)`` and ``L`` = :func:`arrow_reach`. Strictly increasing in ``|force|``, below
+    ``L`` for every finite force; 0 for NaN, ``L`` for an infinite force."""
+    f = np.abs(np.asarray(force, dtype=float))
+    with np.errstate(invalid="ignore"):
+        u = np.log1p(np.where(np.isfinite(f), f, 0.0) / ARROW_FORCE)
+        out = np.where(np.isinf(f), 1.0, u / (1.0 + u)) * arrow_reach(params)
+    out = np.where(np.isnan(f), 0.0, out)
+    return float(out) if out.ndim == 0 else out
+
+
+def arrow_vector(force, params: Params) -> np.ndarray:
+    """The arrow [m] of a planar force ``force`` (2,) [N]: along the force, :func:`arrow_length` of its norm
+    (zero for a zero or non-finite force)."""
+    f = np.asarray(force, dtype=float).reshape(2)
+    norm = float(np.hypot(f[0], f[1]))
+    if not np.isfinite(norm) or norm == 0.0:
+        return np.zeros(2)
+    return f / norm * arrow_length(norm, params)
