@@ -11,6 +11,11 @@ literal from the source, as ``xgettext`` does).
 Errors carry phrases too: ``raise InputError(Phrase("... {x} ...", x=1))`` keeps ``str(exc)`` English, and
 :func:`say` renders the phrase of an exception in the tab's language.
 
+Texts that are fixed when a widget is built (labels, hints, options, tab names, static markdown) stay English in
+the code; the tab's connection shows them in its language (:mod:`tpm_viz.ui.language`) with :func:`shown` (a whole
+text) and :func:`shown_html` (each text between two tags). :func:`preferred` reads a browser's
+``Accept-Language`` header.
+
 Base layer: standard library only.
 """
 
@@ -18,6 +23,8 @@ from __future__ import annotations
 
 import enum
 import functools
+import html
+import re
 import string
 import tomllib
 from collections.abc import Mapping
@@ -25,7 +32,7 @@ from dataclasses import dataclass, field
 from importlib import resources
 from types import MappingProxyType
 
-__all__ = ["Lang", "Phrase", "T", "catalogue", "fields_of", "say"]
+__all__ = ["Lang", "Phrase", "T", "catalogue", "fields_of", "preferred", "say", "shown", "shown_html"]
 
 
 class Lang(enum.Enum):
@@ -67,10 +74,12 @@ class Phrase:
         """The text in ``lang`` (English when the catalogue has no entry: never an error, never empty)."""
         template = self.template if lang is Lang.EN else catalogue(lang).get(self.template, self.template)
         values = {k: (v.render(lang) if isinstance(v, Phrase) else v) for k, v in self.values.items()}
-        try:
-            return template.format(**values)
-        except (KeyError, IndexError, ValueError):  # a broken translation falls back to the English template
-            return self.template.format(**values)
+        for text in (template, self.template):  # a broken translation falls back to the English template
+            try:
+                return text.format(**values)
+            except (KeyError, IndexError, ValueError, AttributeError, TypeError):
+                continue
+        return self.template  # braces that are not fields (a style rule): the text as written
 
     def __str__(self) -> str:
         return self.render(Lang.EN)
@@ -113,3 +122,51 @@ def catalogue(lang: Lang) -> Mapping[str, str]:
 def fields_of(template: str) -> frozenset[str]:
     """The names of the ``str.format`` fields of a template (``"{x:.1f} mm"`` -> ``{"x"}``)."""
     return frozenset(name for _, name, _, _ in string.Formatter().parse(template) if name)
+
+
+def shown(lang: Lang, text: str) -> str:
+    """``text`` in ``lang`` if it is a whole template without fields of the catalogue (a label, an option), else
+    ``text`` itself: what a tab's connection shows for a text fixed in the code."""
+    return text if lang is Lang.EN else catalogue(lang).get(text, text)
+
+
+_TEXT_NODE = re.compile(r">([^<>]+)<")
+
+
+def shown_html(lang: Lang, markup: str) -> str:
+    """``markup`` with every text between two tags that is a whole template of the catalogue (trimmed, HTML
+    entities decoded) in ``lang``; the rest as it is."""
+    if lang is Lang.EN or "<" not in markup:
+        return markup
+    words = catalogue(lang)
+
+    def one(match: re.Match[str]) -> str:
+        raw = match.group(1)
+        key = html.unescape(raw).strip()
+        if key not in words:
+            return match.group(0)
+        lead, trail = raw[: len(raw) - len(raw.lstrip())], raw[len(raw.rstrip()) :]
+        return f">{lead}{html.escape(words[key], quote=False)}{trail}<"
+
+    return _TEXT_NODE.sub(one, markup)
+
+
+def preferred(accept_language: object, default: Lang = Lang.EN) -> Lang:
+    """The UI language a browser asks for first in its ``Accept-Language`` header (``"ko-KR,ko;q=0.9,en;q=0.8"``
+    -> Korean), among those of :class:`Lang`; ``default`` when it names none of them (or there is no header)."""
+    ranked: list[tuple[float, int, Lang]] = []
+    for index, item in enumerate(str(accept_language or "").split(",")[:32]):
+        tag, _, params = item.strip().partition(";")
+        q = 1.0
+        for param in params.split(";"):
+            name, _, value = param.strip().partition("=")
+            if name.strip().lower() == "q":
+                try:
+                    q = float(value)
+                except ValueError:
+                    q = 0.0
+        primary = tag.strip().lower().split("-")[0]
+        lang = next((lang for lang in Lang if lang.value == primary), None)
+        if lang is not None and q > 0:
+            ranked.append((-q, index, lang))
+    return min(ranked)[2] if ranked else default

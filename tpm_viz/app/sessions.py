@@ -29,6 +29,7 @@ from tpm_viz.app.state import AppState, TrajectorySample
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.paper.trajectories import Trajectory
 from tpm_viz.params import PARAM_INFO, Params
+from tpm_viz.words import Lang
 
 __all__ = [
     "FORMAT",
@@ -54,12 +55,14 @@ _SOURCE_KINDS = ("line", "circle", "segment", "csv")
 
 @dataclass
 class Saved:
-    """One mechanism as saved: its state, loaded trajectory (or None) and view options of the tab (if any)."""
+    """One mechanism as saved: its state, loaded trajectory (or None) and view options of the tab (if any), with
+    the tab's language (``lang``: a :class:`tpm_viz.words.Lang` tag)."""
 
     state: AppState
     source: Source | None = None
     playing_t: float = 0.0
     show: dict[str, bool] = field(default_factory=dict)
+    lang: str = "en"
 
 
 @dataclass
@@ -102,6 +105,7 @@ def _saved(saved: Saved) -> dict[str, Any]:
         "trajectory": _source(saved.source),
         "player_t": float(saved.playing_t),
         "show": {k: bool(v) for k, v in saved.show.items()},
+        "lang": Lang.parse(saved.lang).value,
     }
 
 
@@ -205,7 +209,8 @@ def _read_saved(raw: Any, where: str) -> Saved:
     show_raw = raw.get("show", {}) if isinstance(raw, dict) else {}
     show = {str(k): v for k, v in show_raw.items() if isinstance(v, bool)} if isinstance(show_raw, dict) else {}
     player_t = _number(raw, "player_t", where) if "player_t" in raw else 0.0
-    return Saved(state, _read_source(raw.get("trajectory")), max(0.0, player_t), show)
+    lang = Lang.parse(raw.get("lang")).value  # absent (older files) or unknown: English
+    return Saved(state, _read_source(raw.get("trajectory")), max(0.0, player_t), show, lang)
 
 
 def loads(text: str | bytes, now: float | None = None) -> Document:

@@ -14,7 +14,7 @@ tpm-viz needs these things viser's public API does not offer:
   (``_client_state_from_id``), the raw connections (``_live_connections``, to refuse or drop a tab) and the
   websockets module viser serves with (:data:`ws_server`; :mod:`.limits` replaces the ``ServerProtocol`` it builds per
   connection: viser accepts 50 MiB frames and answers an over-long URL segment with HTTP 500), and viser's decoding of
-  incoming messages (:func:`quiet_decoding`).
+  incoming messages (:func:`quiet_decoding`); a tab's GUI texts and the values it sends (:func:`reword`).
 
 :func:`check_viser` runs when the server is built: the installed viser must be the tested minor version
 (:data:`TESTED`, pinned in ``pyproject.toml``) and every internal above must exist, else the app stops at start with
@@ -26,6 +26,8 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import copy
+import dataclasses
 import inspect
 import threading
 import uuid
@@ -53,6 +55,7 @@ __all__ = [
     "drop_gizmo_echo",
     "hook_handshakes",
     "quiet_decoding",
+    "reword",
     "thread_pool",
     "widget_uuid",
     "widget_value",
@@ -361,3 +364,37 @@ def connection_request(server: viser.ViserServer, client_id: int) -> tuple[Any, 
     if connection is None or connection.request is None:
         return None
     return connection.remote_address, connection.request.headers
+
+
+# -- words on the wire (ui/language.py) ------------------------------------------------------------------------------
+_TEXTS = ("label", "hint", "content", "_markdown", "options", "_tab_labels", "title", "series", "axes")
+
+
+def reword(client: viser.ClientHandle, out: Callable[[str, Any, str], Any], back: Callable[[str, Any], Any]) -> Any:
+    """GUI texts go out as ``out(uuid, texts, kind)`` returns them (kind new, update, gone; texts: props in
+    :data:`_TEXTS`, an option's ``value``), values in by ``back(uuid, value)``. -> ``(send(uuid, texts), headers)``"""
+    conn, request = client._websock_connection, connection_request(client._viser_server, client.client_id)
+    queue, dispatch = conn.queue_message, conn._handle_incoming_message
+
+    def queue_message(message: Any) -> None:
+        uuid_, props = getattr(message, "uuid", ""), getattr(message, "props", None)
+        if isinstance(message, _messages.GuiUpdateMessage) and isinstance(message.updates, dict):
+            message = copy.copy(message)
+            message.updates = out(uuid_, message.updates, "update")
+        elif isinstance(message, _messages.GuiRemoveMessage):
+            out(uuid_, None, "gone")
+        elif isinstance(message, _messages._CreateGuiComponentMessage) and dataclasses.is_dataclass(props):
+            choice = {"value": getattr(message, "value", "")} if hasattr(props, "options") else {}
+            texts = out(uuid_, {k: getattr(props, k) for k in _TEXTS if hasattr(props, k)} | choice, "new")
+            message = copy.copy(message)
+            message.__dict__.update({"value": texts.pop("value")} if choice else {})
+            message.props = dataclasses.replace(cast(Any, props), **texts)
+        queue(message)
+
+    async def handle(client_id: Any, message: Any) -> None:
+        if isinstance(message, _messages.GuiUpdateMessage) and isinstance(u := message.updates, dict) and "value" in u:
+            message.updates = {**u, "value": back(message.uuid, u["value"])}
+        await dispatch(client_id, message)
+
+    conn.queue_message, conn._handle_incoming_message = queue_message, handle  # type: ignore[method-assign]
+    return lambda uuid_, texts: queue_message(_messages.GuiUpdateMessage(uuid_, texts)), request and request[1]

@@ -28,6 +28,7 @@ from tpm_viz.params import Params
 from tpm_viz.ui._viser import widget_value
 from tpm_viz.ui.drags import PendingDrag
 from tpm_viz.ui.guard import guarded
+from tpm_viz.ui.language import TabWords
 from tpm_viz.ui.login import LoginPanel
 from tpm_viz.ui.panels import Panel
 from tpm_viz.ui.scene import MechanismScene, camera_pose
@@ -105,6 +106,7 @@ class ClientView:
         self._drawn_at = -1.0  # time.monotonic() of this tab's last render
         with hub.lock:
             state = hub.shared.state
+            self.words = TabWords(self)  # the Language selector, first in the panel; sets self.lang (ui/language.py)
             self.scene = TabScene(client, cast(MechanismScene, hub.shared.scene))
             self.teaching = Teaching(self, services)  # player, explorer, lessons (ui/teaching/)
             self.panel = Panel(client.gui, state, extra_tabs=self.teaching.build_tabs)
@@ -160,7 +162,7 @@ class ClientView:
         self._drawn_at = now
         with self.client.atomic():
             self.scene.update(frame, dragging=dragging)
-            self.panel.show(frame)
+            self.panel.show(frame, self.lang)
             self.teaching.render(frame)
             size = _size(frame.state.params)
             if not 0.8 < size / self._framed_size < 1.25:  # the mechanism grew or shrank a lot: reframe
@@ -199,9 +201,9 @@ class ClientView:
             self.hub.leave(self, self.session)
             self.teaching.close()
 
-    def set_class_info(self, text: str) -> None:
+    def set_class_info(self, text: str | Phrase) -> None:
         """The classroom line of the *Class & view* tab."""
-        self.panel.class_info.content = text
+        self.panel.class_info.content = say(self.lang, text)
 
     # -- commits -------------------------------------------------------------------------------------------
     def _commit(self, state: AppState, dragging: bool = False) -> None:
@@ -311,9 +313,9 @@ class ClientView:
         """This tab's drag ended inside another tab's commit: its gizmo is written back by that commit."""
         self.scene.forget()
 
-    def tell(self, text: str) -> None:
+    def tell(self, text: str | Phrase) -> None:
         """Show ``text`` in this tab's message line (empty: clear it)."""
-        self.panel.tell(text)
+        self.panel.tell(say(self.lang, text) if text else "")
 
     def run_changed(self) -> None:
         """The session's run changed: redraw this tab's player."""

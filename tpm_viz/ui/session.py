@@ -33,6 +33,7 @@ from tpm_viz.errors import InputError
 from tpm_viz.ui.drags import DragQueue
 from tpm_viz.ui.guard import report
 from tpm_viz.ui.snapshot import Snapshot
+from tpm_viz.words import Lang, Phrase
 
 __all__ = ["AppState", "Hub", "Session", "View", "read_number", "read_vec2"]
 
@@ -50,6 +51,8 @@ class View(Protocol):
 
     closed: bool
     hub: Hub
+    lang: Lang
+    """The tab's language: render its words with ``say(view.lang, phrase)`` (:mod:`tpm_viz.words`)."""
 
     def __hash__(self) -> int: ...  # views are dictionary keys (drag queues, presenter sets)
 
@@ -60,7 +63,7 @@ class View(Protocol):
     def render(self, frame: Snapshot, *, dragging: bool) -> None:
         """Draw ``frame``; ``dragging`` is True while this tab's own gizmo is being dragged."""
 
-    def refuse(self, text: str, resync: bool = True) -> None:
+    def refuse(self, text: str | Phrase, resync: bool = True) -> None:
         """Tell this tab (only) that its input was refused, and why."""
 
     def run_changed(self) -> None:

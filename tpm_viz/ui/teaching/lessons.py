@@ -7,6 +7,10 @@ session's mechanism (parameters, pose and its trajectory, loaded into the player
 tab's explorer settings (map, ellipses). The numbers that back its claim (:func:`tpm_viz.app.lessons.effect`)
 are computed when it is applied, outside the hub's lock, and shown under the paragraph. Lesson files that were
 refused are listed under the tab's introduction, one line each.
+
+Words: the paragraph is the lesson's own in the tab's language (``[text] ko``, else English); titles, buttons and
+the introduction are shown in it by the tab's connection (:mod:`tpm_viz.ui.language`); :meth:`DemosView.retell`
+writes the paragraph again when the tab's language changes.
 """
 
 from __future__ import annotations
@@ -27,6 +31,7 @@ from tpm_viz.ui.session import View
 from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.teaching.explorer import ExplorerView
 from tpm_viz.ui.teaching.playing import RunHub
+from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["DemosView"]
 
@@ -43,25 +48,31 @@ def beside_panel(position, look_at) -> tuple[np.ndarray, np.ndarray]:
     return position + shift, look_at + shift
 
 
+PRESS_SHOW = T("Press 'Show this one' to set up the scene.")
+
+
 def _internal_error(owner, exc: Exception) -> None:
-    owner.view.refuse(f"internal error ({type(exc).__name__}), logged on the server", resync=False)
+    what = Phrase("internal error ({kind}), logged on the server", kind=type(exc).__name__)
+    owner.view.refuse(what, resync=False)
 
 
-def problems_html(problems: Sequence[str]) -> str:
+def problems_html(problems: Sequence[str], lang: Lang = Lang.EN) -> str:
     """The lesson files that were refused, one line each (``file:line: what is wrong``)."""
     lines = "".join(f"<li>{html.escape(p)}</li>" for p in problems)
+    head = say(lang, "{count} lesson file(s) refused:", count=len(problems))
     return (
-        f'<div data-q="demo-problems" style="font-size:0.8em;color:#b91c1c"><b>{len(problems)} lesson file(s) '
-        f'refused:</b><ul style="margin:2px 0 0 16px;padding:0">{lines}</ul></div>'
+        f'<div data-q="demo-problems" style="font-size:0.8em;color:#b91c1c"><b>{html.escape(head)}'
+        f'</b><ul style="margin:2px 0 0 16px;padding:0">{lines}</ul></div>'
     )
 
 
-def demo_html(demo: Demo, facts: str) -> str:
-    """The paragraph of a demonstration and the line of numbers that backs it."""
+def demo_html(demo: Demo, facts: str, lang: Lang = Lang.EN) -> str:
+    """The paragraph of a demonstration in ``lang`` (English if the lesson has none in it) and the line of numbers
+    that backs it."""
     esc = html.escape
     return (
-        f'<div data-q="demo" style="font-size:0.85em;color:#1e293b;line-height:1.45">'
-        f"<p style='margin:0 0 6px 0'>{esc(demo.text)}</p>"
+        f'<div data-q="demo" lang="{lang.value}" style="font-size:0.85em;color:#1e293b;line-height:1.45">'
+        f"<p style='margin:0 0 6px 0'>{esc(demo.text_in(lang.value))}</p>"
         + (
             f'<div data-q="demo-effect" style="background:#f1f5f9;border-left:3px solid #0d9488;padding:4px 6px;'
             f'border-radius:3px;font-variant-numeric:tabular-nums">{esc(facts)}</div>'
@@ -96,6 +107,8 @@ class DemosView:
         self.explorer = explorer
         self.index = 0
         self._written: str | None = None
+        self._facts: object = PRESS_SHOW
+        """What the line under the paragraph says: the numbers of the lesson applied last (a text or a phrase)."""
 
     def build(self, gui: viser.GuiApi) -> None:
         """The *Demos* tab's widgets (inside the tab's context)."""
@@ -104,22 +117,35 @@ class DemosView:
             "your own copy), your camera and your floor map; *Play the motion* runs its trajectory in the Player."
         )
         if self.problems:
-            self.problems_note = gui.add_html(problems_html(self.problems))
+            self.problems_note = gui.add_html(problems_html(self.problems, self.view.lang))
         titles = self.titles or (NONE,)
         self.choice = gui.add_dropdown("Demonstration", titles, initial_value=titles[0])
         self.steps = gui.add_button_group("Step", ("Previous", "Show this one", "Next"))
         self.play = gui.add_button("Play the motion", icon=viser.Icon.PLAYER_PLAY)
-        first = demo_html(self.lessons[0], "Press 'Show this one' to set up the scene.") if self.lessons else ""
-        self.text = gui.add_html(first or "<p>No lessons to show.</p>")
+        self.text = gui.add_html(self._paragraph())
         if not self.lessons:
             self.choice.disabled = self.steps.disabled = self.play.disabled = True
         self.choice.on_update(self._on_choice)
         self.steps.on_click(self._on_step)
         self.play.on_click(self._on_play)
 
+    def _paragraph(self) -> str:
+        """The current lesson's paragraph and numbers in the tab's language."""
+        lang = self.view.lang
+        if not self.lessons:
+            return f"<p>{html.escape(say(lang, 'No lessons to show.'))}</p>"
+        return demo_html(self.lessons[self.index], say(lang, self._facts), lang)
+
+    def retell(self) -> None:
+        """The tab's language changed: the paragraph and the refused files again, in it (under the hub's lock)."""
+        if hasattr(self, "text"):
+            self.text.content = self._paragraph()
+        if self.problems and hasattr(self, "problems_note"):
+            self.problems_note.content = problems_html(self.problems, self.view.lang)
+
     def _refuse(self, exc: Exception) -> None:
         with self.view.hub.lock:
-            self.view.refuse(str(exc))
+            self.view.refuse(exc.args[0] if exc.args and isinstance(exc.args[0], Phrase) else str(exc))
 
     def _user(self, event) -> bool:
         return getattr(event, "client", None) is not None and not getattr(self.view, "closed", False)
@@ -164,7 +190,8 @@ class DemosView:
             self.index = index
             self._written = demo.title
             self.choice.value = demo.title
-            self.text.content = demo_html(demo, facts)
+            self._facts = facts
+            self.text.content = self._paragraph()
             self.play.disabled = source is None
             session = view.session
             state = session.state
@@ -180,7 +207,7 @@ class DemosView:
                 session.play_token += 1
                 view.hub.commit(session, new, origin=view)
             except TpmVizError as exc:
-                view.refuse(str(exc))
+                view.refuse(exc.args[0] if exc.args and isinstance(exc.args[0], Phrase) else str(exc))
                 return
             position, look_at = beside_panel(*camera)
             view.client.camera.position = position

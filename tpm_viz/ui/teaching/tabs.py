@@ -100,6 +100,11 @@ class Teaching:
         self.control.render(frame)
         self.planner.render(frame)
 
+    def words_changed(self) -> None:
+        """The tab's language changed: the texts the tabs wrote themselves, again in it (under the hub's lock)."""
+        self.player.refresh()
+        self.demos.retell()
+
     def close(self) -> None:
         """The tab went away."""
         self.player.close()
