@@ -85,7 +85,7 @@ def test_every_check_name_is_computed_and_documented():
 
 
 def test_the_effect_lines_are_those_of_the_tour():
-    assert "×7.0" in effect(demo_by_key("direct")) and "944 → 771 cm²" in effect(demo_by_key("workspace"))
+    assert "×7.0" in str(effect(demo_by_key("direct"))) and "944 → 771 cm²" in str(effect(demo_by_key("workspace")))
 
 
 def _folder(tmp_path, files: dict[str, str]) -> pathlib.Path:

@@ -27,9 +27,9 @@ LANGUAGES = ("en", "ko")
 CHECK_NAMES = {
     "det_jx_start": "det J_x = cos(θ1+θ2) at the motion's start (eq. 12)",
     "det_jx_end": "det J_x at the motion's end",
-    "force_start": "|τ| at the motion's start [N]",
-    "force_end": "|τ| at the motion's end [N]",
-    "force_ratio": "|τ| at the end / |τ| at the start",
+    "force_start": "the larger |τ_i| at the motion's start [N]",
+    "force_end": "the larger |τ_i| at the motion's end [N]",
+    "force_ratio": "the larger |τ_i| at the end / at the start",
     "peak_force": "peak |τ_i| over the motion [N]",
     "peak_ratio": "peak |τ_i| at motion.compare[0] / at motion.compare[1]",
     "reference_gap": "largest |τ_Pinocchio - τ_paper| over the motion [N] (checked by the tests)",

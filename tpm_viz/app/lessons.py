@@ -22,11 +22,13 @@ from tpm_viz.app.overlays import cached_map
 from tpm_viz.app.readouts import Reference
 from tpm_viz.app.runs import Run, build_run
 from tpm_viz.errors import InputError
+from tpm_viz.numbers import fixed
 from tpm_viz.paper.ellipses import manipulability_ellipses
 from tpm_viz.paper.jacobians import condition_number, jacobians
 from tpm_viz.paper.kinematics import forward_kinematics_both
 from tpm_viz.paper.workspace import workspace_area
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase
 
 __all__ = [
     "CHECKS",
@@ -107,7 +109,9 @@ class _Scene:
 
 
 def _tau(run: Run, k: int) -> float:
-    return float(np.linalg.norm(run.tau[k]))
+    """The larger actuator force ``max_i |τ_i|`` [N] at sample ``k``: what the panel and the Player show, per
+    actuator (never the norm of the vector)."""
+    return float(np.max(np.abs(run.tau[k])))
 
 
 CHECKS: dict[str, Callable[[_Scene], float]] = {
@@ -185,43 +189,74 @@ def _stated(demo: Demo) -> str:
     return "; ".join(f"{CHECK_NAMES[c.name].split(' [')[0]}: {values[c.name]:.4g}" for c in checks)
 
 
-def effect(demo: Demo) -> str:
-    """One line of numbers that shows the lesson's effect (closed form; see the module docstring)."""
+def effect(demo: Demo) -> Phrase | str:
+    """One line of numbers that shows the lesson's effect (closed form; see the module docstring), written as the
+    panel and the Player write them: actuator forces per actuator (``τ_i`` [N], ``|τ_i|``), never as a norm."""
     s = _Scene(demo, None)
     key, mm = demo.key, 1e3
     if key == "direct" and demo.motion is not None:
-        start, end = _tau(s.run, 0), _tau(s.run, -1)
-        return (
-            f"|τ| at the start {start:.0f} N, at the end {end:.0f} N (×{end / start:.1f}) for the same |p̈|; "
-            f"det J_x falls from {CHECKS['det_jx_start'](s):.2f} to {CHECKS['det_jx_end'](s):.2f}"
+        start, end = s.run.tau[0], s.run.tau[-1]
+        return Phrase(
+            "τ = ({a1}, {a2}) N at the start, ({b1}, {b2}) N at the end: the larger |τ_i| grows ×{ratio} for the same "
+            "|p̈|; det J_x falls from {det0} to {det1}",
+            a1=fixed(start[0]),
+            a2=fixed(start[1]),
+            b1=fixed(end[0]),
+            b2=fixed(end[1]),
+            ratio=fixed(CHECKS["force_ratio"](s)),
+            det0=fixed(CHECKS["det_jx_start"](s), ".2f"),
+            det1=fixed(CHECKS["det_jx_end"](s), ".2f"),
         )
     if key == "workspace":
         paper = Params.paper()
-        return (
-            f"in-stroke workspace {s.area(paper, 'in_stroke'):.0f} → {s.area(s.params, 'in_stroke'):.0f} cm²; "
-            f"reachable square {s.area(paper, 'reachable'):.0f} → {s.area(s.params, 'reachable'):.0f} cm² "
-            f"(l_a {paper.l_a * mm:.0f} → {s.params.l_a * mm:.0f} mm)"
+        return Phrase(
+            "in-stroke workspace {w0} → {w1} cm²; reachable square {r0} → {r1} cm² (l_a {l0} → {l1} mm)",
+            w0=fixed(s.area(paper, "in_stroke"), ".0f"),
+            w1=fixed(s.area(s.params, "in_stroke"), ".0f"),
+            r0=fixed(s.area(paper, "reachable"), ".0f"),
+            r1=fixed(s.area(s.params, "reachable"), ".0f"),
+            l0=fixed(paper.l_a * mm, ".0f"),
+            l1=fixed(s.params.l_a * mm, ".0f"),
         )
     if key == "speed" and len(demo.compare) == 2:
         (t1, t2), p1, p2 = demo.compare, s.peak_at(0), s.peak_at(1)
-        return (
-            f"peak |τ| {p1:.1f} N at T = {t1:g} s, {p2:.1f} N at T = {t2:g} s: ratio {p1 / p2:.3f} "
-            f"= (T2/T1)² = {(t2 / t1) ** 2:.3f}"
+        return Phrase(
+            "peak |τ_i| {p1} N at T = {t1} s, {p2} N at T = {t2} s: ratio {ratio} = (T2/T1)² = {law}",
+            p1=fixed(p1),
+            t1=fixed(t1, "g"),
+            p2=fixed(p2),
+            t2=fixed(t2, "g"),
+            ratio=fixed(p1 / p2, ".3f"),
+            law=fixed((t2 / t1) ** 2, ".3f"),
         )
     if key == "agreement" and demo.motion is not None:
-        return f"closed-form peak |τ| {s.run.peak:.1f} N; the Pinocchio curves are drawn dotted on top"
+        return Phrase(
+            "closed-form peak |τ_i| {peak} N; the Pinocchio curves are drawn dotted on top", peak=fixed(s.run.peak)
+        )
     if key == "modes" and demo.d is not None:
         p, q = s.pose.p * mm, s.other * mm
-        return (
-            f"d = ({demo.d[0] * mm:.0f}, {demo.d[1] * mm:.0f}) mm: P = ({p[0]:.1f}, {p[1]:.1f}) mm with "
-            f"det J_x = {CHECKS['det_jx'](s):+.2f}, P′ = ({q[0]:.1f}, {q[1]:.1f}) mm with "
-            f"det J_x = {CHECKS['other_det_jx'](s):+.2f}"
+        return Phrase(
+            "d = ({d1}, {d2}) mm: P = ({p1}, {p2}) mm with det J_x = {det}, P′ = ({q1}, {q2}) mm with "
+            "det J_x = {other}",
+            d1=fixed(demo.d[0] * mm, ".0f"),
+            d2=fixed(demo.d[1] * mm, ".0f"),
+            p1=fixed(p[0]),
+            p2=fixed(p[1]),
+            det=fixed(CHECKS["det_jx"](s), "+.2f"),
+            q1=fixed(q[0]),
+            q2=fixed(q[1]),
+            other=fixed(CHECKS["other_det_jx"](s), "+.2f"),
         )
     if key == "inverse" and demo.motion is None:
         v, f = s.ellipses.velocity.radii, s.ellipses.force.radii
-        return (
-            f"cos θ1 = {CHECKS['cos_theta1'](s):.3f}, cond J = {CHECKS['cond'](s):.1f}; velocity ellipse "
-            f"{v.min():.2f} × {v.max():.2f}, force ellipse {f.min():.2f} × {f.max():.2f} (per unit actuator "
-            "speed / force)"
+        return Phrase(
+            "cos θ1 = {cos}, cond J = {cond}; velocity ellipse {v0} × {v1}, force ellipse {f0} × {f1} (per unit "
+            "actuator speed / force)",
+            cos=fixed(CHECKS["cos_theta1"](s), ".3f"),
+            cond=fixed(CHECKS["cond"](s)),
+            v0=fixed(v.min(), ".2f"),
+            v1=fixed(v.max(), ".2f"),
+            f0=fixed(f.min(), ".2f"),
+            f1=fixed(f.max(), ".2f"),
         )
     return _stated(demo)
