@@ -24,15 +24,21 @@ ADDRESSES = ["192.0.2.7", "127.0.0.1", "198.51.100.20"]
 class Page:
     """A protocol-level tab that knows its widgets by label (uuid and current value)."""
 
-    def __init__(self, port: int, origin: str | None = None, cookie: str | None = None) -> None:
-        headers = {"Cookie": cookie} if cookie else None
+    def __init__(
+        self, port: int, origin: str | None = None, cookie: str | None = None, accept_language: str | None = None
+    ) -> None:
+        headers = {}
+        if cookie:
+            headers["Cookie"] = cookie
+        if accept_language:
+            headers["Accept-Language"] = accept_language
         self.ws = connect_sync(
             f"ws://127.0.0.1:{port}",
             subprotocols=[f"viser-v{viser.__version__}"],
             max_size=None,
             compression=None,
             origin=origin,
-            additional_headers=headers,
+            additional_headers=headers or None,
         )
         self.uuids: dict[str, str] = {}
         self.values: dict[str, object] = {}
@@ -52,14 +58,18 @@ class Page:
             except Exception:
                 return
             for m in decode_batch(raw):
-                props = m.get("props")
-                if m["type"].startswith("Gui") and isinstance(props, dict) and props.get("label"):
-                    self.uuids.setdefault(props["label"], m["uuid"])  # the first of a label (Player before Control)
-                    self.values[m["uuid"]] = m.get("value")
-                    if self.on_widget is not None:
-                        self.on_widget(props["label"], m["uuid"])
-                elif m["type"] == "GuiUpdateMessage" and "value" in m.get("updates", {}):
-                    self.values[m["uuid"]] = m["updates"]["value"]
+                self.take(m)
+
+    def take(self, m: dict) -> None:
+        """One decoded message from the server (on the reader thread)."""
+        props = m.get("props")
+        if m["type"].startswith("Gui") and isinstance(props, dict) and props.get("label"):
+            self.uuids.setdefault(props["label"], m["uuid"])  # the first of a label (Player before Control)
+            self.values[m["uuid"]] = m.get("value")
+            if self.on_widget is not None:
+                self.on_widget(props["label"], m["uuid"])
+        elif m["type"] == "GuiUpdateMessage" and "value" in m.get("updates", {}):
+            self.values[m["uuid"]] = m["updates"]["value"]
 
     def send(self, **message) -> None:
         self.ws.send(msgspec.msgpack.encode(message))

@@ -10,13 +10,10 @@ import json
 import threading
 import time
 
-import msgspec
 import pytest
-import viser
-from websockets.sync.client import connect as connect_sync
 
-from tests.support.pages import classroom_app, views_of
-from tests.support.protocol import CAMERA, ServerProcess, decode_batch, wait_for
+from tests.support.pages import Page, classroom_app, views_of
+from tests.support.protocol import ServerProcess, wait_for
 from tpm_viz.app import sessions
 from tpm_viz.app.sessions import Document, Saved
 from tpm_viz.app.state import AppState
@@ -27,47 +24,21 @@ __all__ = ["classroom_app"]  # the fixture, imported
 KO = catalogue(Lang.KO)
 
 
-class Shown:
+class Shown(Page):
     """A protocol-level tab that keeps, per element, what its page currently shows: label, options, value, tab
     names (creation messages, then every update)."""
 
     def __init__(self, port: int, cookie: str | None = None, accept_language: str | None = None) -> None:
-        headers = {}
-        if cookie:
-            headers["Cookie"] = cookie
-        if accept_language:
-            headers["Accept-Language"] = accept_language
-        self.ws = connect_sync(
-            f"ws://127.0.0.1:{port}",
-            subprotocols=[f"viser-v{viser.__version__}"],
-            max_size=None,
-            compression=None,
-            additional_headers=headers or None,
-        )
         self.props: dict[str, dict] = {}
         self._lock = threading.Lock()
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._read, daemon=True)
-        self._thread.start()
-        self.send(**CAMERA)
+        super().__init__(port, cookie=cookie, accept_language=accept_language)
 
-    def _read(self) -> None:
-        while not self._stop.is_set():
-            try:
-                raw = self.ws.recv(timeout=0.2)
-            except TimeoutError:
-                continue
-            except Exception:
-                return
-            for m in decode_batch(raw):
-                with self._lock:
-                    if m["type"].startswith("Gui") and isinstance(m.get("props"), dict) and "uuid" in m:
-                        self.props[m["uuid"]] = dict(m["props"], value=m.get("value"))
-                    elif m["type"] == "GuiUpdateMessage" and m["uuid"] in self.props:
-                        self.props[m["uuid"]].update(m["updates"])
-
-    def send(self, **message) -> None:
-        self.ws.send(msgspec.msgpack.encode(message))
+    def take(self, m: dict) -> None:
+        with self._lock:
+            if m["type"].startswith("Gui") and isinstance(m.get("props"), dict) and "uuid" in m:
+                self.props[m["uuid"]] = dict(m["props"], value=m.get("value"))
+            elif m["type"] == "GuiUpdateMessage" and m["uuid"] in self.props:
+                self.props[m["uuid"]].update(m["updates"])
 
     def uuid(self, label: str) -> str | None:
         """The first element the page shows with this label now."""
@@ -86,11 +57,6 @@ class Shown:
     def set(self, label: str, value) -> None:
         uuid = wait_for(lambda: self.uuid(label), what=f"an element labelled {label!r}")
         self.send(type="GuiUpdateMessage", uuid=uuid, updates={"value": value})
-
-    def close(self) -> None:
-        self._stop.set()
-        self.ws.close()
-        self._thread.join(timeout=2.0)
 
 
 def test_a_tab_opens_in_the_language_its_browser_asks_for(classroom_app):
