@@ -6,11 +6,12 @@ for a tick computed as ``-0.0``, ``100,000,000`` wider than its axis). So the ap
 text instead (uPlot's static ``splits`` and ``values``) with a fixed range:
 
 - :func:`time_ticks`: the time axis spans exactly the run, ``[t0, t1]``, with 3 to ``most`` ticks on multiples
-  of a 1-2-5 step (``t0 = 0``: always ``0`` and at least two more), for any duration;
+  of a 1-2-5 step (``t0 = 0``: always ``0`` and at least two more), for any duration, spaced so that their labels
+  do not touch on the narrowest chart (``room``: the browser picks the chart's width, the server cannot know it);
 - :func:`value_ticks`: a value axis widened to the nearest ticks around the data, with a flat or negligible
   series (``|v| <= resolution``, e.g. ``-1e-12``) shown as ``[-1, 1]`` or ``c ± 10 %``;
-- :func:`tick_labels`: one format for every label of an axis (the same decimals; ``×10ⁿ`` beyond 10⁶ or below
-  10⁻⁴), a true minus sign, and never a negative zero;
+- :func:`tick_labels`: one format for every label of an axis (the same decimals; ``×10ⁿ`` from 10⁶ up, or for
+  steps below 10⁻⁴ on an axis below 1), a true minus sign, and never a negative zero;
 - :func:`text_width`: a conservative width [CSS px] of a text in the charts' font (DejaVu Sans, the widest of
   the usual sans fonts), from which the y axis gets its width and a chart its height.
 
@@ -78,15 +79,21 @@ def _zero_free(text: str) -> str:
     return text
 
 
+def _exponent(x: float) -> int:
+    """``floor(log10(x))`` for ``x > 0``, robust to a product such as ``3 * 0.1`` landing just off a power of ten."""
+    return math.floor(math.log10(x) + 1e-9)
+
+
 def tick_labels(values, k: int) -> tuple[str, ...]:
     """Labels of ticks on multiples of ``m × 10^k``: written out with ``max(0, -k)`` decimals (thousands
-    separated by commas), or as ``a.b×10ⁿ`` (one exponent for the axis) when a tick reaches 10⁶ or ``k < -4``."""
+    separated by commas), or as ``a.b×10ⁿ`` (one exponent for the axis) when a tick reaches 10⁶, or when
+    ``k < -4`` on an axis whose ticks all lie below 1 (``5×10⁻⁶`` rather than ``0.000005``)."""
     vals = [float(v) for v in values]
     top = max((abs(v) for v in vals), default=0.0)
-    if top < _FIXED_MAX and k >= _FIXED_MIN_EXP:
+    if top < _FIXED_MAX and (k >= _FIXED_MIN_EXP or top >= 1.0):
         decimals = max(0, -k)
         return tuple(_zero_free(f"{v:,.{decimals}f}") for v in vals)
-    exponent = math.floor(math.log10(top)) if top > 0 else k
+    exponent = _exponent(top) if top > 0 else k
     decimals = max(0, exponent - k)
     power = f"×10{str(exponent).translate(_SUPERSCRIPT)}"
     out = []
@@ -112,43 +119,69 @@ def _build(m: int, k: int, first: int, last: int, lo: float, hi: float) -> Ticks
     return Ticks(float(lo), float(hi), values, tick_labels(values, k))
 
 
-def time_ticks(t0: float, t1: float, most: int = 6) -> Ticks:
-    """Ticks of a time axis spanning exactly ``[t0, t1]`` [s]: the smallest 1-2-5 step that gives at most ``most``
-    ticks (``most >= 3``), hence at least 3 for ``t0 = 0`` and at least 2 for any start."""
+_SPAN_MAX = 1e300  # a range wider than this is narrowed to it (its width would overflow to infinity)
+
+
+def _finite_range(lo: float, hi: float) -> tuple[float, float]:
+    return max(lo, -_SPAN_MAX), min(hi, _SPAN_MAX)
+
+
+def time_ticks(t0: float, t1: float, most: int = 6, room: float | None = None, gap: float = 12.0) -> Ticks:
+    """Ticks of a time axis spanning exactly ``[t0, t1]`` [s], on multiples of a 1-2-5 step: between 3
+    (``t0 = 0``; 2 for another start) and ``most`` of them (``most >= 6``, raised to 6 if smaller).
+
+    The smallest such step is taken, unless ``room`` is given: the width [CSS px] of the narrowest plot the axis
+    may be drawn on. Then the step is also large enough that neighbouring labels (12 px, :func:`text_width`)
+    leave ``gap`` px between them, if any step with enough ticks allows it (else the one with the fewest)."""
     t0, t1 = float(t0), float(t1)
     if not (math.isfinite(t0) and math.isfinite(t1)):
         t0, t1 = 0.0, 1.0
+    t0, t1 = _finite_range(t0, t1)
     if t1 <= t0:
         t1 = t0 + (abs(t0) if t0 else 1.0)
-    m, k = _nice((t1 - t0) / (max(3, most) - 1))
+    most = max(6, int(most))
+    fewest = 3 if t0 == 0.0 else 2
+    span = t1 - t0
+    m, k = _nice(span / (10 * most))  # well below the first step with at most `most` ticks
+    best: Ticks | None = None
     while True:
         first, last = _ticks_on(m, k, t0, t1, inside=True)
-        if last - first + 1 <= max(3, most):
-            return _build(m, k, first, last, t0, t1)
-        m, k = _next(m, k)  # pragma: no cover (the first step already fits)
+        count = last - first + 1
+        if count < fewest and best is not None:
+            return best  # no larger step has room for more: the fewest labels that still make an axis
+        if fewest <= count <= most:
+            best = _build(m, k, first, last, t0, t1)
+            widest = max(text_width(label) for label in best.labels)
+            if room is None or room * _step_of(m, k) / span >= widest + gap:
+                return best
+        if count < fewest:  # pragma: no cover (the step after one with > most ticks has >= fewest, see tests)
+            return _build(m, k, first, max(first, last), t0, t1)
+        m, k = _next(m, k)
 
 
 def value_ticks(data, most: int = 5, resolution: float = 1e-9) -> Ticks:
-    """Ticks around the finite values of ``data`` (display units): the range is widened to the ticks, at most
-    ``most`` of them (``most >= 3``). Values within ``resolution`` of each other are one flat line, shown over
-    ``c ± 10 %`` of their level ``c`` (``[-1, 1]`` when ``|c| <= resolution``)."""
+    """Ticks around the finite values of ``data`` (display units): the range is the smallest span of whole
+    steps holding every value, at most ``most`` ticks (``most >= 3``), all of them inside it. Values within
+    ``resolution`` of each other are one flat line, shown over ``c ± 10 %`` of their level ``c`` (``[-1, 1]``
+    when ``|c| <= resolution``). Values beyond ±1e300 count as ±1e300."""
     arr = np.asarray(data, dtype=float).ravel()
-    arr = arr[np.isfinite(arr)]
+    arr = np.clip(arr[np.isfinite(arr)], -_SPAN_MAX, _SPAN_MAX)
     lo, hi = (float(arr.min()), float(arr.max())) if arr.size else (0.0, 0.0)
     level = max(abs(lo), abs(hi))
     if hi - lo <= max(resolution, 1e-9 * level):
-        centre = 0.5 * (lo + hi)
+        centre = 0.5 * lo + 0.5 * hi
         if abs(centre) <= resolution:
-            lo, hi = -1.0, 1.0
+            lo, hi = min(lo, -1.0), max(hi, 1.0)
         else:
-            lo, hi = centre - 0.1 * abs(centre), centre + 0.1 * abs(centre)
+            lo, hi = min(lo, centre - 0.1 * abs(centre)), max(hi, centre + 0.1 * abs(centre))
     most = max(3, most)
     m, k = _nice((hi - lo) / (most - 1))
     while True:
         first, last = _ticks_on(m, k, lo, hi, inside=False)
         if last - first + 1 <= most:
             step = _step_of(m, k)
-            return _build(m, k, first, last, first * step, last * step)
+            # The ticks a rounding error inside the data still count as its ends: the range takes the data.
+            return _build(m, k, first, last, min(first * step, lo), max(last * step, hi))
         m, k = _next(m, k)
 
 

@@ -196,10 +196,15 @@ def arrow_length(force, params: Params):
 
 
 def arrow_vector(force, params: Params) -> np.ndarray:
-    """The arrow [m] of a planar force ``force`` (2,) [N]: along the force, :func:`arrow_length` of its norm
-    (zero for a zero or non-finite force)."""
+    """The arrow [m] of a planar force ``force`` (2,) [N]: along the force, :func:`arrow_length` of its norm.
+    Zero for a zero force or one with a NaN component; an infinite component gives the longest arrow along it."""
     f = np.asarray(force, dtype=float).reshape(2)
+    if np.any(np.isnan(f)):
+        return np.zeros(2)
+    if np.any(np.isinf(f)):
+        f = np.where(np.isinf(f), np.sign(f), 0.0)
+        return f / float(np.hypot(f[0], f[1])) * arrow_reach(params)
     norm = float(np.hypot(f[0], f[1]))
-    if not np.isfinite(norm) or norm == 0.0:
+    if norm == 0.0:
         return np.zeros(2)
     return f / norm * arrow_length(norm, params)

@@ -8,9 +8,11 @@ the wire, so:
   everywhere except ``+1`` at the current sample, a spike that draws as a vertical line across the chart;
 - both axes are decided here, once per run (:func:`axes_for`, maths in :mod:`tpm_viz.app.chart_axes`): fixed
   ranges, the tick positions and their labels (uPlot's static ``splits`` and ``values``), so the time axis always
-  has its ticks whatever the duration, no label reads ``-0``, and the y axis is as wide as its widest label; the
-  chart is tall enough for its rotated y label in every language (:func:`chart_height`). Drag-to-zoom is off
-  (the ticks are fixed to the run's range).
+  has its ticks whatever the duration, no label reads ``-0``, and the y axis is as wide as its widest label. The
+  server does not know how wide the browser draws a chart, so the four charts share one time axis whose labels
+  stay apart on the narrowest chart (:data:`NARROWEST_PX`, a small phone): fewer time ticks on a wide screen, never
+  touching labels on a narrow one. A chart is tall enough for its rotated y label in every language
+  (:func:`chart_height`). Drag-to-zoom is off (the ticks are fixed to the run's range).
 
 No NaN is ever sent. Charts are built once per tab; a new run replaces their axes and data; the marker moves by
 re-sending the (decimated, <= :data:`CHART_POINTS` points) data, which the caller throttles during playback.
@@ -31,7 +33,7 @@ from tpm_viz.app.palette import hex_colour
 from tpm_viz.app.runs import Run
 from tpm_viz.words import Lang, Phrase, T, say
 
-__all__ = ["CHART_POINTS", "Charts", "axes_for", "chart_height", "marker"]
+__all__ = ["CHART_POINTS", "Charts", "axes_for", "chart_height", "marker", "plot_room", "y_axis"]
 
 CHART_POINTS = 151
 FONT_PX = 12  # uPlot's axis font: 12 px (bold for the axis labels)
@@ -39,6 +41,9 @@ TICK_PX, GAP_PX = 10, 5  # uPlot's tick length and the gap between tick and labe
 X_AXIS_PX = 34  # height of the time axis: tick, gap, one line of labels, descenders
 LABEL_PX = 24  # room of an axis label (one line of bold 12 px text and its gap)
 PADDING = (12, 24, 0, 0)  # top: half a y label above the top tick; right: half a time label past the end
+NARROWEST_PX = 303
+"""[CSS px] The narrowest chart the time labels must fit: the full-width phone sheet (:mod:`tpm_viz.ui.look`) of a
+320 px wide phone, measured in Chromium (390 px: 373; the docked panel: 365). A wider chart has room to spare."""
 X_LABEL = T("time t (s)")
 FORCE_COLOURS = (hex_colour("tau1"), hex_colour("tau2"))  # τ1, τ2 as in the PNG figures (blue, red)
 LEG_COLOURS = (hex_colour("leg1"), hex_colour("leg2"))  # leg 1 teal, leg 2 purple as in the 3D view
@@ -80,14 +85,29 @@ def _axis(ticks: Ticks, label: str, size: float) -> dict[str, Any]:
     }
 
 
-def axes_for(t, values, y_label: str, x_label: str) -> tuple[dict[str, Any], tuple[dict[str, Any], ...]]:
+def y_axis(values) -> tuple[Ticks, int]:
+    """The ticks of a value axis around ``values`` (display units, any shape) and its width [px]: tick, gap and
+    the widest label (:func:`~tpm_viz.app.chart_axes.text_width`, an upper bound) with 4 px to spare."""
+    y = value_ticks(values, most=5, resolution=RESOLUTION)
+    return y, math.ceil(TICK_PX + GAP_PX + max(text_width(s, FONT_PX) for s in y.labels) + 4)
+
+
+def plot_room(y_size: float) -> float:
+    """Width [px] of the plot area of a chart whose y axis is ``y_size`` px wide, on the narrowest chart."""
+    return NARROWEST_PX - PADDING[1] - LABEL_PX - y_size
+
+
+def axes_for(
+    t, values, y_label: str, x_label: str, room: float | None = None
+) -> tuple[dict[str, Any], tuple[dict[str, Any], ...]]:
     """uPlot ``scales`` and ``axes`` for series ``values`` (display units, any shape) against ``t`` [s]: the time
     axis spans ``[t[0], t[-1]]``, the y axis the ticks around the values; every tick labelled, no label wider
-    than its axis."""
+    than its axis, time labels apart on a plot ``room`` px wide (default: this chart's on the narrowest chart,
+    :func:`plot_room`)."""
     t = np.asarray(t, dtype=float)
-    x = time_ticks(t[0], t[-1]) if len(t) else time_ticks(0.0, 1.0)
-    y = value_ticks(values, most=5, resolution=RESOLUTION)
-    y_size = TICK_PX + GAP_PX + max(text_width(s, FONT_PX) for s in y.labels) + 4
+    y, y_size = y_axis(values)
+    room = plot_room(y_size) if room is None else room
+    x = time_ticks(t[0], t[-1], room=room) if len(t) else time_ticks(0.0, 1.0, room=room)
     scales = {"x": {"time": False, "range": (x.lo, x.hi)}, "y": {"range": (y.lo, y.hi)}, "c": {"range": (0.0, 1.0)}}
     return scales, (_axis(x, x_label, X_AXIS_PX), _axis(y, y_label, y_size))
 
@@ -184,9 +204,13 @@ class Charts:
             arr = getattr(run, attr)
             self._base.append((run.t[i], arr[i, 0] * scale, arr[i, 1] * scale))
         x_label = say(self.lang, X_LABEL)
-        for handle, base, y_label in zip(self.handles, self._base, self._y_labels, strict=True):
-            shown = base[1:3] if handle is not self.forces or run.tau_ref is None else base[1:]
-            handle.scales, handle.axes = axes_for(base[0], np.concatenate(shown), y_label, x_label)
+        shown = [
+            base[1:3] if handle is not self.forces or run.tau_ref is None else base[1:]
+            for handle, base in zip(self.handles, self._base, strict=True)
+        ]
+        room = min(plot_room(y_axis(np.concatenate(s))[1]) for s in shown)  # one time axis for the four charts
+        for handle, base, values, y_label in zip(self.handles, self._base, shown, self._y_labels, strict=True):
+            handle.scales, handle.axes = axes_for(base[0], np.concatenate(values), y_label, x_label, room)
         series = list(self.forces.series)
         for k in (3, 4):
             series[k] = {**series[k], "show": run.tau_ref is not None}
