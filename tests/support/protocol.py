@@ -284,6 +284,13 @@ class ProtocolClient:
     def click(self, button) -> None:
         self.set_value(button, True)
 
+    def enter(self, box, texts: dict | None = None) -> None:
+        """Type ``texts`` (field key -> text) into a typed box (``tpm_viz.ui.fields.TypedBox``), as a browser sends
+        them (the whole text at each keystroke: here the last one), then press Enter in it (the form's submit)."""
+        for key, text in (texts or {}).items():
+            self.set_value(box.inputs[key], text)
+        self.send(type="GuiFormSubmitMessage", uuid=box.form._impl.uuid)
+
     def drag(self, gizmo, owner: str, positions, end: bool = True) -> None:
         """A gizmo drag through ``positions`` (x, y, z) [m], as start, updates and (optionally) end."""
         name = gizmo.name

@@ -15,7 +15,7 @@ import time
 import numpy as np
 import pytest
 
-from tests.support.browser import WORKER_LOG_JS
+from tests.support.browser import WORKER_LOG_JS, text_input
 from tests.support.protocol import wait_for
 
 pytestmark = pytest.mark.browser
@@ -42,18 +42,11 @@ def _wait_text(page, name: str, expected: str, timeout: float = 10.0) -> None:
     wait_for(lambda: _text(page, name) == expected, timeout=timeout, what=f"{name} = {expected!r}")
 
 
-def _fill(page, uuid: str, value: str, index: int = 0) -> None:
-    """Type into a number input (``index`` 1 is the second field of a vector input) and leave it."""
-    field = (
-        page.locator(f'[id="{uuid}"]')
-        if index == 0
-        else page.locator(f'label[for="{uuid}"]')
-        .locator("xpath=ancestor::div[contains(@class,'mantine-Flex-root')][1]")
-        .locator("input")
-        .nth(index)
-    )
+def _fill(page, handle, value: str, enter: bool = True) -> None:
+    """Type into a typed number field (a text input) and press Enter (or leave it with Tab)."""
+    field = text_input(page, handle)
     field.fill(value)
-    field.press("Tab")
+    field.press("Enter" if enter else "Tab")
     time.sleep(PAUSE)
 
 
@@ -100,8 +93,8 @@ def test_app_end_to_end(app, browser):
     assert float(_text(page, "d1")) > 130.0
 
     # Type a platform position (Move tab, first tab).
-    _fill(page, view.panel.p._impl.uuid, "40")
-    _fill(page, view.panel.p._impl.uuid, "-30", index=1)
+    _fill(page, view.panel.p.inputs["p1"], "40", enter=False)  # the next field, then Enter: both at once
+    _fill(page, view.panel.p.inputs["p2"], "-3e1")
     _wait_text(page, "p1", "40.0")
     _wait_text(page, "p2", "-30.0")
     tau_before = _text(page, "theta1")
@@ -115,19 +108,21 @@ def test_app_end_to_end(app, browser):
 
     # A parameter change (Parameters tab): l_a = 280 mm, then Apply. Numbers change everywhere.
     page.get_by_role("tab", name="Parameters").click()
-    _fill(page, view.panel.params["l_a"]._impl.uuid, "280")
+    _fill(page, view.panel.params.inputs["l_a"], "280", enter=False)
     page.get_by_role("button", name="Apply parameters").click()
     wait_for(lambda: view.session.state.params.l_a == pytest.approx(0.28), what="l_a applied")
     d1_expected = f"{view.session.state.pose.d[0] * 1e3:.1f}"
     _wait_text(page, "d1", d1_expected)
 
-    # A bad value is refused with a message; the last good mechanism stays; the app keeps working.
+    # A bad value is refused with a message under the Apply button; the last good mechanism stays (and is shown
+    # under the field, which keeps the text); the app keeps working.
     time.sleep(PAUSE)
-    _fill(page, view.panel.params["b"]._impl.uuid, "-5")
+    _fill(page, view.panel.params.inputs["b"], "-5", enter=False)
     page.get_by_role("button", name="Apply parameters").click()
     page.get_by_text("Refused: parameter b must be positive").first.wait_for(timeout=10_000)
+    page.get_by_text("b: in use 92 mm").first.wait_for(timeout=10_000)
     assert view.session.state.params.b == pytest.approx(0.092)
-    wait_for(lambda: page.locator(f'[id="{view.panel.params["b"]._impl.uuid}"]').input_value() == "92", what="revert")
+    assert text_input(page, view.panel.params.inputs["b"]).input_value() == "-5"
     page.get_by_role("tab", name="Move").click()
     time.sleep(PAUSE)
     page.get_by_role("button", name="Home (p = 0)").click()

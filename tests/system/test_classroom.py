@@ -71,7 +71,7 @@ def test_only_the_presenter_changes_the_shared_mechanism_until_it_is_handed_to_t
     assert app.access.is_presenter(lv) and not app.access.is_presenter(sv)
     assert sv not in app.room._lecturers and lv in app.room._lecturers
     student.set("Actuator d1 (mm)", 200.0)
-    wait_for(lambda: "only the presenter" in sv.panel.message.content, what="the refusal")
+    wait_for(lambda: "only the presenter" in sv.panel.move_note.handle.content, what="the refusal under Move")
     assert app.hub.shared.state.pose.d[0] == pytest.approx(0.13)
     lecturer.set("Let the class change the shared mechanism", True)
     wait_for(lambda: app.access.open_to_class, what="the hand-over")
@@ -80,7 +80,7 @@ def test_only_the_presenter_changes_the_shared_mechanism_until_it_is_handed_to_t
     lecturer.set("Let the class change the shared mechanism", False)
     wait_for(lambda: not app.access.open_to_class, what="taken back")
     student.set("Actuator d1 (mm)", 150.0)
-    wait_for(lambda: "only the presenter" in sv.panel.message.content, what="refused again")
+    wait_for(lambda: "only the presenter" in sv.panel.move_note.handle.content, what="refused again")
     student.set("Work on my own copy", True)  # always one click away
     wait_for(lambda: not sv.session.shared, what="the student's own copy")
     for page in (student, lecturer):
@@ -217,7 +217,7 @@ def test_the_token_field_shows_dots_not_the_token(browser):
         field.fill("typed-secret")
         security = field.evaluate("e => getComputedStyle(e).webkitTextSecurity")
         assert security == "disc"
-        other = page.locator(f'[id="{view.panel.p._impl.uuid}"]')
+        other = page.locator(f'div:has(> div > p > label[for="{view.panel.p.inputs["p1"]._impl.uuid}"]) input')
         assert other.evaluate("e => getComputedStyle(e).webkitTextSecurity") == "none"
         page.close()
     finally:

@@ -241,10 +241,7 @@ def test_a_parameter_change_during_playback(app, connect, capfd, changes, unreac
     c1.set_value(player.controls, "Play")
     wait_for(lambda: _player(v1).playing and _state(v1).trajectory.t > 0.01, what="playback under way")
 
-    for name, value in changes.items():
-        c2.set_value(v2.panel.params[name], value)
-    wait_for(lambda: all(v2.panel.params[n].value == v for n, v in changes.items()), what="the inputs")
-    c2.click(v2.panel.apply)
+    c2.enter(v2.panel.params, {name: f"{value:g}" for name, value in changes.items()})
     wait_for(lambda: _state(v1).params.l_a == pytest.approx(changes.get("l_a", 260.0) / 1e3), what="the change")
     wait_for(lambda: _state(v1).params.stroke == pytest.approx(changes.get("stroke", 300.0) / 1e3), what="stroke")
     wait_for(lambda: not _player(v1).playing, what="the playback to stop")
@@ -261,7 +258,8 @@ def test_a_parameter_change_during_playback(app, connect, capfd, changes, unreac
 
     c1.set_value(player.controls, "Play")  # playing again: on the new run, or refused with a message
     if unreachable:
-        wait_for(lambda: "load a trajectory first" in v1.panel.message.content, what="the refusal")
+        note = player.note.handle  # under the player's controls
+        wait_for(lambda: "load a trajectory first" in note.content, what="the refusal")
     else:
         wait_for(lambda: _player(v1).playing, what="playback on the new mechanism")
         c1.set_value(player.controls, "Pause")

@@ -85,7 +85,7 @@ def test_switching_relabels_the_tab_and_its_choices_still_reach_the_callbacks(cl
     wait_for(lambda: page.uuid("파라미터 적용"), what="the labels in Korean")
     wait_for(lambda: "수업·보기" in page.tabs(), what="the tab names in Korean")
     assert view.lang is Lang.KO and not page.uuid("Apply parameters")
-    assert page.shown("플랫폼 p (mm)")["hint"] == KO["Or drag the gizmo in 3D"]
+    assert page.shown("구동기 d1 (mm)")["hint"] == KO["Forward kinematics"]
     page.set("하중", "동적")  # a choice sent in Korean is the English option for the server
     wait_for(lambda: view.session.state.load.mode == "dynamic", what="the dynamic load")
     assert view.panel.load_mode.value == "dynamic"
@@ -107,9 +107,10 @@ def test_a_refusal_is_told_in_the_tabs_language(classroom_app):
     app = classroom_app
     page = Shown(app.port, accept_language="ko")
     (view,) = views_of(app, 1)
-    page.set("l_a, 링크 길이 (mm)", -5.0)
+    page.set("l_a, 링크 길이 (mm)", "-5")
     page.set("파라미터 적용", True)
-    wait_for(lambda: view.panel.message.content.startswith("**거부됨: "), what="the refusal in Korean")
+    note = view.panel.params.note.handle  # under the Apply button
+    wait_for(lambda: "거부됨: " in note.content, what="the refusal in Korean")
     page.close()
 
 

@@ -9,9 +9,11 @@ session holds a valid state, every number in the actor's widgets and in both sce
 or inf, and the observer never got a message meant for the actor. (NaN and inf in a GUI update are dropped by
 ``ui/transport.py`` before any callback; the callbacks' own refusal of them is covered by the pure tests.)
 
-A deterministic sweep sends each of 21 nasty values to each of 24 fields (540 messages); the property test
-300 examples x 1-5 messages (+ an Apply and a sync click each): ~870 generated messages (GUI updates, clicks, drags
-and uploads to the panel, the player, the explorer and the demonstrations).
+A deterministic sweep sends each of 21 nasty values to each of 24 fields (540 messages, each followed by Enter in a
+typed field); the property test 300 examples x 1-5 messages (+ an Apply and a sync click each): ~870 generated
+messages (GUI updates, Enter, clicks, drags and uploads to the panel, the player, the explorer and the
+demonstrations). Typed number fields (text inputs) keep whatever text they were sent (it is the user's, quoted in
+their note if refused): for them the check is that the value in use, and every text the app wrote, is finite.
 """
 
 from __future__ import annotations
@@ -108,8 +110,16 @@ UPLOAD_BYTES = st.one_of(CSV_TEXT.map(str.encode), GOOD_ROWS.map(_timed).map(str
 POSITION = st.tuples(
     st.floats(-0.5, 0.5) | NASTY_FLOAT, st.floats(-0.5, 0.5) | NASTY_FLOAT, st.floats(-1.0, 1.0) | NASTY_FLOAT
 )
+TEXT = st.floats(-1e6, 1e6).map(lambda x: format(x, "g")) | st.sampled_from(
+    ["1e9", "5e-1", "0,25", "-100000", "1,000", "1e999", "\u2212 3", "2.5 mm", "1e-320", "９"]
+)
+"""Texts typed into a number field (scientific notation, decimal commas, too large, a full-width digit...)."""
+TYPED = {"p": ("p", "p1"), "f_ext": ("f_ext", "f_x"), "dp": ("dp", "ṗ2"), "ddp": ("ddp", "p̈1")}
+"""Vector fields of the sweep -> (typed box, the field of it that gets the values)."""
 MESSAGE = st.one_of(
     st.tuples(st.just("set"), st.sampled_from(FIELDS), RAW | st.tuples(RAW, RAW) | st.tuples(RAW, RAW) | OPTIONS),
+    st.tuples(st.just("set"), st.sampled_from([*TYPED, "param:l_a", "param:m_p", "player:duration"]), TEXT),
+    st.tuples(st.just("enter"), st.sampled_from([*TYPED, "params", "player:duration"])),
     st.tuples(st.just("upload"), UPLOAD_BYTES),
     st.tuples(st.just("click"), st.sampled_from(BUTTONS)),
     st.tuples(st.just("drag"), st.lists(POSITION, min_size=1, max_size=4), st.booleans()),
@@ -118,11 +128,16 @@ MESSAGE = st.one_of(
 
 def _handle(view, name: str):
     panel = view.panel
+    if name == "player:duration":
+        return view.teaching.player.duration.inputs["T"]
     for part in ("player", "explorer", "demos"):
         if name.startswith(part + ":"):
             return getattr(getattr(view.teaching, part), name[len(part) + 1 :])
     if name.startswith("param:"):
-        return panel.params[name[6:]]
+        return panel.params.inputs[name[6:]]
+    if name in TYPED:
+        box, key = TYPED[name]
+        return getattr(panel, box).inputs[key]
     if name.startswith("show:"):
         return panel.show_toggles[name[5:]]
     if name.startswith("demo:"):
@@ -132,10 +147,23 @@ def _handle(view, name: str):
     return getattr(panel, name)
 
 
+def _box(view, name: str):
+    """The typed box of a field name (``p``, ``params``, ``player:duration``, ...), or None."""
+    if name == "player:duration":
+        return view.teaching.player.duration
+    if name == "params" or name.startswith("param:"):
+        return view.panel.params
+    return getattr(view.panel, TYPED[name][0]) if name in TYPED else None
+
+
 def _numeric_widgets(view):
     p = view.panel
-    yield from (p.p, *p.d, p.f_ext, p.dp, p.ddp, *p.params.values())
-    yield from (view.teaching.player.duration, view.teaching.player.time)
+    yield from (*p.d, view.teaching.player.time)
+
+
+def _typed_boxes(view):
+    p = view.panel
+    yield from (p.p, p.f_ext, p.dp, p.ddp, p.params, view.teaching.player.duration)
 
 
 def _scene_values(view):
@@ -204,6 +232,11 @@ def _check(view, other, errors_before: int) -> None:
                 assert_clean("scene", np.asarray(value, dtype=float))
         for handle in _numeric_widgets(view):
             assert_clean(handle.label, handle.value)
+        for box in _typed_boxes(view):  # the values in use, and the texts the app wrote, are finite
+            for key, field in box.group.fields.items():
+                assert_clean(key, field.value)
+                if not field.own:
+                    assert_clean(key, box.inputs[key].value)
         teaching = view.teaching
         for chart in teaching.player.charts.handles:  # the plots: no NaN or inf on the wire
             assert_clean("chart", [np.asarray(series, dtype=float) for series in chart.data])
@@ -224,6 +257,9 @@ def test_every_field_refuses_every_nasty_value(two_tabs):
         values = NASTY_VALUES + ([(v, 1.0) for v in NASTY_VALUES[:9]] if name in pairs else [])
         for value in values:
             actor.set_value(_handle(view, name), value)
+            box = _box(view, name)
+            if box is not None and box is not view.panel.params:
+                actor.enter(box)  # Enter in that field
             actor.click(view.panel.apply)
             _sync(actor, view, pinged)
             _check(view, other, errors_before)
@@ -246,6 +282,8 @@ def test_generated_protocol_messages_never_break_the_app(two_tabs):
             kind = message[0]
             if kind == "set":
                 actor.set_value(_handle(view, message[1]), message[2])
+            elif kind == "enter":
+                actor.enter(_box(view, message[1]))
             elif kind == "click":
                 actor.click(_handle(view, message[1]))
             elif kind == "upload":

@@ -216,16 +216,16 @@ def test_malformed_gui_updates_are_dropped_with_one_log_line(app, connect, caplo
         client.send(type="GuiUpdateMessage", uuid=view.panel.d[0]._impl.uuid, updates={"label": "hacked"})
         client.send(type="GuiUpdateMessage", uuid=view.panel.d[0]._impl.uuid, updates={"max": 1e9, "value": 5.0})
         client.set_value(view.panel.d[1], "abc")
-        client.set_value(view.panel.f_ext, 3.0)
-        client.set_value(view.panel.p, None)
+        client.set_value(view.panel.f_ext.inputs["f_x"], 3.0)  # a typed field takes text
+        client.set_value(view.panel.p.inputs["p1"], None)
         client.set_value(view.panel.d[1], float("nan"))  # no browser sends these; viser would cast "1e999" to inf
-        client.set_value(view.panel.f_ext, ("1e999", 0.0))
+        client.set_value(view.panel.f_ext.inputs["f_x"], ("1e999", 0.0))
         client.send(type="GuiUpdateMessage", uuid=str(uuid.uuid4()), updates={"value": 1.0})
         client.set_value(view.panel.d[0], 160.0)
         wait_for(lambda: abs(_state(view).pose.d[0] - 0.16) < 1e-9, what="a good update after the bad ones")
     assert view.panel.d[0].label == label and view.panel.d[0].max == pytest.approx(300.0)
     assert "GUI update dropped" in caplog.text
-    assert np.all(np.isfinite(view.panel.f_ext.value)) and np.isfinite(view.panel.d[1].value)
+    assert view.panel.f_ext.inputs["f_x"].value == "0" and np.isfinite(view.panel.d[1].value)
     assert ACTIVITY.snapshot()[1] == errors
     assert _state(other) is _state(view)
 
@@ -319,13 +319,16 @@ def test_presenter_mode_students_are_refused_on_the_shared_mechanism_only(pconne
     start = _state(pv)
 
     student.set_value(sv.panel.d[0], 200.0)
-    wait_for(lambda: "Refused" in sv.panel.message.content, what="the refusal")
-    assert "only the presenter" in sv.panel.message.content
+    note = sv.panel.move_note.handle  # next to the control, in the Move tab
+    wait_for(lambda: "Refused" in note.content, what="the refusal")
+    assert "only the presenter" in note.content
     wait_for(lambda: sv.panel.d[0].value == pytest.approx(130.0), what="the student's slider put back")
     student.drag(sv.scene.gizmo, str(sv.client.client_id), [(0.05, 0.02, 0.09)])
     wait_for(lambda: np.allclose(sv.scene.gizmo.position[:2], (0.0, 0.0)), what="the gizmo put back")
     for button in (sv.panel.home, sv.panel.switch_mode, sv.panel.apply, sv.panel.demo["direct"]):
         student.click(button)
+    student.enter(sv.panel.params, {"l_a": "280"})
+    wait_for(lambda: "only the presenter" in sv.panel.params.note.handle.content, what="refused under Apply")
     time.sleep(0.2)
     assert ACTIVITY.wait_idle()
     assert _state(pv) is start and _state(wv) is start  # nobody else's view changed
@@ -464,5 +467,6 @@ def test_a_tab_gone_mid_login_does_not_break_the_others(presenter_app, pconnect)
     assert not presenter_app.access.is_presenter(view)
     other, ov = pconnect()
     other.set_value(ov.panel.d[0], 180.0)
-    wait_for(lambda: "only the presenter" in ov.panel.message.content, what="presenter rights gone with the tab")
+    note = ov.panel.move_note.handle
+    wait_for(lambda: "only the presenter" in note.content, what="presenter rights gone with the tab")
     assert threading.active_count() < 200

@@ -62,9 +62,7 @@ def test_a_parameter_change_regenerates_the_map_once_for_all_tabs(connect, monke
     for tab, c in ((view, client), (other, _other_client)):
         c.set_value(tab.teaching.explorer.map_kind, MAP_KINDS["workspace"])
     wait_for(lambda: _image(view) is not None and _image(other) is not None, what="both maps")
-    client.set_value(view.panel.params["l_a"], 220.0)
-    wait_for(lambda: view.panel.params["l_a"].value == 220.0, what="the input")
-    client.click(view.panel.apply)
+    client.enter(view.panel.params, {"l_a": "220"})
     wait_for(
         lambda: all(
             _image(v) is not None and v.teaching.explorer._image_key[0].l_a == pytest.approx(0.22)
@@ -89,7 +87,7 @@ def test_a_slow_map_does_not_stall_another_tabs_drag(connect, monkeypatch):
     client.set_value(view.teaching.explorer.map_kind, MAP_KINDS["cond"])
     wait_for(lambda: "Computing" in view.teaching.explorer.status.content, what="the map being computed")
     t0 = time.monotonic()
-    other_client.set_value(other.panel.p, (30.0, 20.0))  # a move from another tab meanwhile
+    other_client.enter(other.panel.p, {"p1": "30", "p2": "20"})  # a move from another tab meanwhile
     wait_for(lambda: np.allclose(other.session.state.pose.p, (0.03, 0.02)), what="the other tab's move")
     assert time.monotonic() - t0 < 0.7  # not behind the 1.5 s map
     wait_for(lambda: _image(view) is not None, timeout=10, what="the slow map, eventually")
@@ -104,7 +102,7 @@ def test_the_ellipses_follow_the_platform_and_say_their_axes(connect):
     assert vel.visible and vel.name.startswith("/explorer/")  # this tab's own scope, world coordinates
     r = np.linalg.norm(vel.points[:, 0, :2], axis=1)
     assert r == pytest.approx(np.full(len(r), explorer_module.ELLIPSE_SCALE), rel=1e-6)  # J = I at home
-    client.set_value(view.panel.p, (-170.0, -170.0))  # towards the direct singularity
+    client.enter(view.panel.p, {"p1": "-170", "p2": "-170"})  # towards the direct singularity
     wait_for(lambda: np.allclose(view.session.state.pose.p, (-0.17, -0.17)), what="the move")
     p = np.array([-0.17, -0.17])
     wait_for(lambda: np.allclose(vel.points[:, 0, :2].mean(axis=0), p, atol=1e-6), what="the ellipse at the platform")
@@ -130,6 +128,6 @@ def test_a_map_that_cannot_be_computed_is_reported_not_retried(connect, monkeypa
     monkeypatch.setattr(service, "_compute", broken)
     client.set_value(view.teaching.explorer.map_kind, MAP_KINDS["cond"])
     wait_for(lambda: "Map unavailable: grid too coarse" in view.teaching.explorer.status.content, what="the report")
-    client.set_value(view.panel.p, (10.0, 0.0))  # more frames: no second attempt for the same parameters
+    client.enter(view.panel.p, {"p1": "10", "p2": "0"})  # more frames: no second attempt for the same parameters
     wait_for(lambda: np.allclose(view.session.state.pose.p, (0.01, 0.0)), what="a move")
     assert len(calls) == 1 and _image(view) is None

@@ -72,7 +72,7 @@ def test_choosing_the_circle_loads_it_with_its_default_duration_and_both_models(
     assert state.load.mode == "dynamic"
     assert run.tau_ref is not None and run.max_diff < 1e-9  # Pinocchio, once per run
     pl = view.teaching.player
-    assert pl.duration.value == 0.5 and pl.time.max == 0.5
+    assert pl.duration.inputs["T"].value == "0.5" and pl.time.max == 0.5
     charts = pl.charts
     for handle in charts.handles:
         assert handle.visible and 100 < len(handle.data[0]) <= CHART_POINTS and handle.data[0][-1] == 0.5
@@ -169,19 +169,24 @@ def test_a_good_upload_is_played_and_a_bad_one_is_refused_to_its_tab_only(connec
     wait_for(lambda: (r := _run(view)) is not None and r.source.kind == "csv", what="the uploaded run")
     assert _run(other).source.label == "wave.csv, T = 1 s"  # the shared mechanism: every tab sees it
     assert view.teaching.player.choice.value == "your CSV: wave.csv"
-    assert view.teaching.player.duration.disabled
+    assert view.teaching.player.duration.inputs["T"].disabled
     good_run = _run(view)
 
     bad = "t,p1,p2\n0,0,0\n0.1,0.1,0\n0.2,0.4,0\n0.3,0.1,0\n"  # 400 mm: out of reach
     _csv_upload(client, view, "far.csv", bad.encode())
-    wait_for(lambda: "Refused" in view.panel.message.content, what="the refusal")
-    assert "far.csv" in view.panel.message.content and "out of reach" in view.panel.message.content
-    assert other.panel.message.content == ""  # to that user only
+    note = view.teaching.player.note.handle  # under the upload button
+    wait_for(lambda: "Refused" in note.content, what="the refusal")
+    assert "far.csv" in note.content and "out of reach" in note.content
+    assert view.panel.message.content == "" and other.teaching.player.note.handle.content == ""  # that tab only
     assert _run(view) is good_run  # the last good trajectory stays
 
     _csv_upload(client, view, "bad.csv", b"time,x\n1,2\n")
-    wait_for(lambda: "missing column" in view.panel.message.content, what="the format refusal")
-    assert _run(view) is good_run
+    wait_for(lambda: "missing column" in note.content, what="the format refusal")
+    assert _run(view) is good_run and "far.csv" not in note.content  # one refusal at a time
+
+    _csv_upload(client, view, "wave2.csv", good.encode())  # a later good upload clears the refusal
+    wait_for(lambda: (r := _run(view)) is not None and r.source.label.startswith("wave2.csv"), what="the new run")
+    assert note.content == ""
 
 
 def test_the_csv_and_png_exports_go_to_the_tab_that_asked(connect):
@@ -206,8 +211,7 @@ def test_a_parameter_change_recomputes_the_run_for_the_new_mechanism(connect):
     client, view = connect()
     _choose(client, view, "circle (Fig. 5)", "circle", 0.5)
     old = _run(view)
-    client.set_value(view.panel.params["m_p"], 4.0)
-    wait_for(lambda: view.panel.params["m_p"].value == 4.0, what="the input")
+    client.set_value(view.panel.params.inputs["m_p"], "4")
     client.click(view.panel.apply)
     wait_for(lambda: (r := _run(view)) is not None and r.params.m_p == 4.0, what="the recomputed run")
     assert _run(view).peak > old.peak  # a heavier platform needs larger forces
@@ -257,5 +261,6 @@ def test_presenter_mode_refuses_player_inputs_from_students(app, connect):
     client, view = connect()
     app.hub.access = Access("secret")
     client.set_value(view.teaching.player.choice, "circle (Fig. 5)")
-    wait_for(lambda: "Refused" in view.panel.message.content, what="the refusal")
-    assert "presenter" in view.panel.message.content and _run(view) is None
+    note = view.teaching.player.note.handle
+    wait_for(lambda: "Refused" in note.content, what="the refusal under the player's controls")
+    assert "presenter" in note.content and _run(view) is None

@@ -118,7 +118,8 @@ def test_actuator_slider_drives_forward_kinematics(connect):
     np.testing.assert_allclose(view.scene.sliders[0].position, (0.25 - P.a, 0.0, 0.0))
     np.testing.assert_allclose(view.scene.platform.position[:2], p)
     assert _q(view, "d1") == "250.0" and _q(view, "p1") == f"{p[0] * 1e3:.1f}"
-    assert view.panel.p.value == pytest.approx(tuple(np.round(p * 1e3, 2)))
+    texts = [float(h.value) for h in view.panel.p.inputs.values()]  # the typed fields show the value in use
+    assert texts == pytest.approx(list(p * 1e3), rel=1e-5)
 
 
 def test_actuator_slider_out_of_range_is_clamped_with_a_reason(connect):
@@ -146,7 +147,7 @@ def test_gizmo_drag_moves_every_part_and_clamps_at_the_stroke(connect):
 
 def test_typed_platform_position(connect):
     client, view = connect()
-    client.set_value(view.panel.p, (40.0, -30.0))
+    client.enter(view.panel.p, {"p1": "4e1", "p2": "-30,0"})
     wait_for(lambda: np.allclose(_state(view).pose.p, (0.04, -0.03)), what="p = (40, -30) mm")
     assert _q(view, "p2") == "-30.0"
 
@@ -155,39 +156,43 @@ def test_parameters_apply_rebuilds_and_a_bad_value_is_refused_for_its_tab_only(c
     client, view = connect()
     _other_client, other = connect()
     old_links = view.scene.links
-    client.set_value(view.panel.params["l_a"], 280.0)
-    client.set_value(view.panel.params["stroke"], 320.0)
-    wait_for(lambda: view.panel.params["stroke"].value == 320.0, what="the input value")
+    client.set_value(view.panel.params.inputs["l_a"], "280")
+    client.set_value(view.panel.params.inputs["stroke"], "3.2e2")
     client.click(view.panel.apply)
     wait_for(lambda: _state(view).params.l_a == pytest.approx(0.28), what="l_a = 280 mm")
     assert _state(view).params.stroke == pytest.approx(0.32)
     assert view.scene.links is not old_links  # geometry re-added once
     assert view.panel.d[0].max == pytest.approx(320.0)
     assert _state(other).params.l_a == pytest.approx(0.28)  # shared by default
-    assert other.panel.params["l_a"].value == pytest.approx(280.0)
+    wait_for(lambda: other.panel.params.inputs["l_a"].value == "280", what="the other tab's field")
 
     good = _state(view)
-    client.set_value(view.panel.params["b"], -5.0)
-    wait_for(lambda: view.panel.params["b"].value == -5.0, what="the bad input")
+    note = view.panel.params.note.handle
+    client.set_value(view.panel.params.inputs["b"], "-5")
     client.click(view.panel.apply)
-    wait_for(lambda: "Refused" in view.panel.message.content, what="the refusal")
-    assert "b must be positive" in view.panel.message.content
-    assert other.panel.message.content == ""
+    wait_for(lambda: "Refused" in note.content, what="the refusal under the Apply button")
+    assert "b must be positive" in note.content and "b: in use 92 mm" in note.content
+    assert view.panel.message.content == ""  # not at the top of the panel
+    assert other.panel.params.note.handle.content == "" and other.panel.message.content == ""
     assert _state(view) is good
-    assert view.panel.params["b"].value == pytest.approx(92.0)  # reverted to the last good value
+    assert view.panel.params.inputs["b"].value == "-5"  # the field keeps the text, the app the last good value
     client.set_value(view.panel.d[0], 200.0)  # the app keeps working
     wait_for(lambda: abs(_state(view).pose.d[0] - 0.2) < 1e-12, what="d1 after a refusal")
-    assert view.panel.message.content == ""
+    assert "Refused" in note.content  # another control's success does not clear it
+    client.enter(view.panel.params, {"b": "9,2e1"})  # fixed, and Enter
+    wait_for(lambda: "Refused" not in note.content, what="the refusal cleared by the next success")
+    assert note.content == "" and view.panel.params.inputs["b"].value == "9,2e1"
 
 
 def test_paper_values_button(connect):
     client, view = connect()
-    client.set_value(view.panel.params["m_p"], 5.0)
-    wait_for(lambda: view.panel.params["m_p"].value == 5.0, what="m_p input")
-    client.click(view.panel.apply)
+    client.enter(view.panel.params, {"m_p": "5"})
     wait_for(lambda: _state(view).params.m_p == 5.0, what="m_p = 5 kg")
+    client.set_value(view.panel.params.inputs["a"], "abc")  # typed, never applied
     client.click(view.panel.paper)
     wait_for(lambda: _state(view).params == P, what="paper values")
+    fields = view.panel.params.inputs
+    wait_for(lambda: fields["a"].value == "482" and fields["m_p"].value == "2.21", what="the paper's values shown")
 
 
 @pytest.mark.parametrize(
@@ -222,14 +227,14 @@ def test_switch_assembly_mode_and_the_ghost(connect):
 
 def test_static_and_dynamic_loads_show_forces_and_the_reference(connect):
     client, view = connect()
-    client.set_value(view.panel.f_ext, (0.0, -20.0))
+    client.enter(view.panel.f_ext, {"f_y": "-2e1"})
     wait_for(lambda: _state(view).load.f_ext == (0.0, -20.0), what="f_ext")
     assert _q(view, "tau2") == "20.00"  # at home J = I: τ = -f_ext
     assert _q(view, "tau2_ref") == "20.00"
     assert view.scene.forces[1].visible
     client.set_value(view.panel.load_mode, "dynamic")
     wait_for(lambda: _state(view).load.mode == "dynamic", what="dynamic mode")
-    client.set_value(view.panel.ddp, (10.0, 0.0))
+    client.enter(view.panel.ddp, {"p̈1": "10"})
     wait_for(lambda: _state(view).load.ddp == (10.0, 0.0), what="ddp")
     tau1 = float(_q(view, "tau1"))
     assert tau1 > 0 and float(_q(view, "tau1_ref")) == pytest.approx(tau1, abs=0.01)
@@ -325,7 +330,7 @@ def test_simultaneous_drags_are_serialised_and_never_corrupt_state(app, connect)
 
 def test_equations_tab_follows_the_state_but_not_every_drag_frame(connect):
     client, view = connect()
-    client.set_value(view.panel.f_ext, (0.0, -20.0))
+    client.enter(view.panel.f_ext, {"f_y": "-2e1"})
     wait_for(lambda: _state(view).load.f_ext == (0.0, -20.0), what="f_ext")
     assert "(a) Inverse kinematics" in view.panel.equations.content and "Errata" in view.panel.equations.content
     before = view.panel.equations.content
@@ -340,10 +345,7 @@ def test_equations_tab_follows_the_state_but_not_every_drag_frame(connect):
 def test_camera_reframes_after_a_large_geometry_change(connect):
     client, view = connect()
     before = np.array(view.client.camera.position)
-    client.set_value(view.panel.params["l_a"], 500.0)
-    client.set_value(view.panel.params["a"], 900.0)
-    wait_for(lambda: view.panel.params["a"].value == 900.0, what="the input")
-    client.click(view.panel.apply)
+    client.enter(view.panel.params, {"l_a": "500", "a": "900"})
     wait_for(lambda: _state(view).params.a == pytest.approx(0.9), what="a = 900 mm")
     wait_for(lambda: not np.allclose(view.client.camera.position, before), what="the camera to move")
 

@@ -5,7 +5,7 @@ tpm-viz needs these things viser's public API does not offer:
 - the server's callback thread pool (``server._thread_executor``), to guard every callback (:mod:`.guard`);
 - a tab's message handlers (``client._websock_connection``, ``gui._handle_gui_updates``,
   ``gui._handle_file_transfer_start/part``, ``gui._current_file_upload_states``, ``gui._gui_input_handle_from_uuid``),
-  to drop malformed GUI updates and oversized uploads before viser handles them (:mod:`.transport`);
+  to drop malformed GUI updates and oversized uploads before viser handles them and hide its toasts (:mod:`.transport`);
 - a GUI handle's current value without running its callbacks (``handle._impl.value``);
 - a client-scoped gizmo's cross-client echo (``gizmo._impl_aux.sync_cb``), which costs CPU and reaches nobody;
 - the share-URL tunnel, which any client can request: ``server.request_share_url`` is replaced by a no-op;
@@ -93,8 +93,7 @@ def check_viser(version: str | None = None) -> None:
 
 
 def _next_minor(minor: str) -> str:
-    major, m = minor.split(".")
-    return f"{major}.{int(m) + 1}"
+    return f"{minor.split('.')[0]}.{int(minor.split('.')[1]) + 1}"
 
 
 def _has_attr_or_init(cls: type, name: str) -> bool:
@@ -114,11 +113,7 @@ def thread_pool(server: viser.ViserServer) -> Any:
 
 def disable_share_url(server: viser.ViserServer) -> None:
     """Make ``server.request_share_url`` a no-op: no outside tunnel, whatever a client asks."""
-
-    def _no_share_url(*_args: object, **_kwargs: object) -> None:
-        return None
-
-    server.request_share_url = _no_share_url  # type: ignore[method-assign]
+    server.request_share_url = lambda *_args, **_kwargs: None  # type: ignore[method-assign]
 
 
 def widget_value(handle: Any) -> Any:
@@ -166,6 +161,12 @@ class ClientDoor:
         """Forget an upload in progress (its buffered parts are freed)."""
         self._gui._current_file_upload_states.pop(transfer_uuid, None)
 
+    def end_upload(self, button: str, transfer: str, size: int | None = None) -> None:
+        """Hide the page's upload toast (a success, whatever the app says); ``size``: free its button too."""
+        self._conn.queue_message(_messages.RemoveNotificationMessage(f"upload-{transfer}"))
+        if size is not None:
+            self._conn.queue_message(_messages.FileTransferPartAck(button, transfer, size, size))
+
     def replace(self, gui_update: GuiUpdate, upload_start: Upload, upload_part: Upload) -> None:
         """Route this tab's GUI updates and upload messages to the given handlers instead of viser's."""
         pairs: tuple[tuple[Any, Any, Any], ...] = (
@@ -191,8 +192,7 @@ class ServerDoor:
     @property
     def loop(self) -> asyncio.AbstractEventLoop | None:
         """The server's event loop (None before it starts)."""
-        loop: asyncio.AbstractEventLoop | None = self._ws._background_event_loop
-        return loop
+        return cast("asyncio.AbstractEventLoop | None", self._ws._background_event_loop)
 
     def on_connect(self, cb: Callable[[int], None], wrap: Wrapper) -> None:
         """Run ``cb(client_id)`` on the event loop for every new websocket connection, before any of its messages

@@ -43,6 +43,7 @@ from tpm_viz.ui.continuity import Store
 from tpm_viz.ui.guard import guard_executor, guarded, log, log_fault, report
 from tpm_viz.ui.limits import DEFAULT_MAX_CONNECTIONS, harden_server, set_max_connections
 from tpm_viz.ui.login import LoginPanel
+from tpm_viz.ui.look import dock_panel
 from tpm_viz.ui.room import Room
 from tpm_viz.ui.scene import MechanismScene, camera_pose
 from tpm_viz.ui.session import Hub
@@ -81,6 +82,7 @@ def build_server(host: str = "127.0.0.1", port: int = 8080) -> viser.ViserServer
     server.gui.configure_theme(
         control_width="large", show_share_button=False, show_logo=False, brand_color=BRAND, dark_mode=False
     )
+    dock_panel(server.gui)  # the panel beside the canvas, never over the mechanism (ui/look.py)
     server.scene.configure_environment_map(None)
     server.scene.configure_default_lights(enabled=True, cast_shadow=False)
     server.scene.add_light_hemisphere(

@@ -27,11 +27,13 @@ from tpm_viz.errors import TpmVizError
 from tpm_viz.params import Params
 from tpm_viz.ui._viser import widget_value
 from tpm_viz.ui.drags import PendingDrag
+from tpm_viz.ui.fields import Place, Typing, control
 from tpm_viz.ui.guard import guarded
 from tpm_viz.ui.language import TabWords
 from tpm_viz.ui.login import LoginPanel
+from tpm_viz.ui.look import Look
 from tpm_viz.ui.panels import Panel
-from tpm_viz.ui.scene import MechanismScene, camera_pose
+from tpm_viz.ui.scene import MechanismScene
 from tpm_viz.ui.session import Hub, Session
 from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.tabscene import TabScene
@@ -72,23 +74,8 @@ def _internal_error(view: ClientView, exc: Exception) -> None:
     view.refuse(f"internal error ({type(exc).__name__}), logged on the server")
 
 
-def _callback(method):
-    """Run a handler under the hub's lock; ignore server-side echoes; report refused input to this tab."""
-
-    @guarded(on_error=_internal_error)
-    @functools.wraps(method)
-    def wrapper(self: ClientView, event, *args) -> None:
-        if getattr(event, "client", None) is None:
-            return
-        with self.hub.lock:
-            if self.closed:
-                return
-            try:
-                method(self, event, *args)
-            except TpmVizError as exc:
-                self.refuse(exc.args[0] if exc.args and isinstance(exc.args[0], Phrase) else str(exc))
-
-    return wrapper
+_callback = control
+"""Run a handler under the hub's lock, ignore echoes, refuse next to the control (:func:`.fields.control`)."""
 
 
 class ClientView:
@@ -104,12 +91,15 @@ class ClientView:
         """The presenter login of this tab (presenter mode only)."""
         self._notified: tuple[str, float] = ("", 0.0)
         self._drawn_at = -1.0  # time.monotonic() of this tab's last render
+        self.typing = Typing(self)
+        """The typed number fields of this tab (Enter, Apply, the quiet time: :mod:`.fields`)."""
         with hub.lock:
             state = hub.shared.state
             self.words = TabWords(self)  # the Language selector, first in the panel; sets self.lang (ui/language.py)
             self.scene = TabScene(client, cast(MechanismScene, hub.shared.scene))
             self.teaching = Teaching(self, services)  # player, explorer, lessons (ui/teaching/)
             self.panel = Panel(client.gui, state, extra_tabs=self.teaching.build_tabs)
+            self.look = Look(self)  # phone layout, presentation mode, camera framed for the canvas (ui/look.py)
             self._wire()
             self.frame_camera(state.params)
             self.session: Session = hub.join(self, private=False)
@@ -163,17 +153,22 @@ class ClientView:
         with self.client.atomic():
             self.scene.update(frame, dragging=dragging)
             self.panel.show(frame, self.lang)
+            self.look.show()
             self.teaching.render(frame)
             size = _size(frame.state.params)
             if not 0.8 < size / self._framed_size < 1.25:  # the mechanism grew or shrank a lot: reframe
                 self.frame_camera(frame.state.params)
         self.client.flush()
 
-    def refuse(self, what: str | Phrase, resync: bool = True) -> None:
-        """Tell this tab (only) that its input was refused (``what`` in the tab's language); the mechanism keeps
+    def refuse(self, what: str | Phrase | BaseException, resync: bool = True, where: Place | None = None) -> None:
+        """Tell this tab (only) that its input was refused (``what`` in the tab's language): next to the control
+        that caused it (``where``: a note or typed box of the panel) or at the top of the panel; the mechanism keeps
         its last good state and, with ``resync``, this tab's widgets and gizmo show that state again."""
         text = say(self.lang, what)
-        self.panel.tell(say(self.lang, "Refused: {text}", text=text))
+        if where is not None:
+            where.tell(what, self.lang)
+        else:
+            self.panel.tell(say(self.lang, "Refused: {text}", text=text))
         now = time.monotonic()
         if self._notified[0] != text or now - self._notified[1] > NOTIFY_AGAIN_SECONDS:
             self._notified = (text, now)
@@ -188,16 +183,15 @@ class ClientView:
         self.client.flush()
 
     def frame_camera(self, params: Params) -> None:
-        """Point this tab's camera at the whole mechanism."""
+        """Point this tab's camera at the whole mechanism, framed for its canvas (:mod:`.look`)."""
         self._framed_size = _size(params)
-        position, look_at = camera_pose(params)
-        self.client.camera.position = position
-        self.client.camera.look_at = look_at
+        self.look.frame(params)
 
     def close(self) -> None:
         """The tab went away: stop drawing and leave the session."""
         with self.hub.lock:
             self.closed = True
+            self.typing.close()
             self.hub.leave(self, self.session)
             self.teaching.close()
 
@@ -216,15 +210,17 @@ class ClientView:
     def _wire(self) -> None:
         panel, scene = self.panel, self.scene
         scene.gizmo.on_update(self._on_drag)
-        panel.p.on_update(self._on_p)
+        self.typing.add(panel.p, self._apply_p)
+        for name in ("f_ext", "dp", "ddp"):
+            self.typing.add(panel.boxes()[name], functools.partial(self._apply_load, name))
+        self.typing.add(panel.params, self._apply_params)
         for i, slider in enumerate(panel.d):
             slider.on_update(lambda event, i=i: self._on_d(event, i))
         panel.switch_mode.on_click(self._on_switch_mode)
         panel.home.on_click(self._on_home)
         for kind in DEMO_KINDS:
             panel.demo[kind].on_click(lambda event, kind=kind: self._on_demo(event, kind))
-        for load_input in (panel.load_mode, panel.f_ext, panel.dp, panel.ddp):
-            load_input.on_update(self._on_load)
+        panel.load_mode.on_update(self._on_load)
         panel.apply.on_click(self._on_apply)
         panel.paper.on_click(self._on_paper)
         panel.own_copy.on_update(self._on_own_copy)
@@ -293,7 +289,7 @@ class ClientView:
             try:
                 mover.commit_drag(latest.phase, latest.position)
             except TpmVizError as exc:  # the gizmo goes back to the last good pose when the drag ends
-                mover.refuse(str(exc), resync=latest.phase == "end")
+                mover.refuse(exc, resync=latest.phase == "end")
 
     @guarded(on_error=_internal_error)
     def _drag_after_build(self, drag: PendingDrag) -> None:
@@ -321,53 +317,59 @@ class ClientView:
         """The session's run changed: redraw this tab's player."""
         self.teaching.player.refresh()
 
-    @_callback
-    def _on_p(self, event) -> None:
-        if self.panel.is_echo(self.panel.p):
-            return
-        self._commit(transitions.move(self.session.state, self.panel.p.value))
+    def _apply_p(self, values) -> None:
+        """The typed platform position (mm), settled (under the lock)."""
+        self._commit(transitions.move(self.session.state, (values["p1"], values["p2"])))
 
-    @_callback
+    def _apply_load(self, name: str, values) -> None:
+        """A typed load vector (``f_ext`` N, ``dp`` m/s, ``ddp`` m/s²), settled (under the lock)."""
+        state = self.session.state
+        load = {"f_ext": state.load.f_ext, "dp": state.load.dp, "ddp": state.load.ddp, name: tuple(values.values())}
+        new = transitions.set_load(state, state.load.mode, load["f_ext"], load["dp"], load["ddp"])
+        if new is not state:
+            self._commit(new)
+
+    def _apply_params(self, values) -> None:
+        """The typed parameters (mm, kg), settled by Enter or *Apply parameters* (under the lock)."""
+        self._commit(transitions.apply_params(self.session.state, values))
+
+    @_callback(place="move_note")
     def _on_d(self, event, i: int) -> None:
         if self.panel.is_echo(self.panel.d[i]):
             return
         self._commit(transitions.drive(self.session.state, i, self.panel.d[i].value))
 
-    @_callback
+    @_callback(place="move_note")
     def _on_switch_mode(self, event) -> None:
         self._commit(transitions.switch(self.session.state))
 
-    @_callback
+    @_callback(place="move_note")
     def _on_home(self, event) -> None:
         self._commit(transitions.home(self.session.state))
 
-    @_callback
+    @_callback(place="move_note")
     def _on_demo(self, event, kind: str) -> None:
         self._commit(transitions.demo(self.session.state, kind))
 
-    @_callback
+    @_callback(place="forces_note")
     def _on_load(self, event) -> None:
         panel = self.panel
-        if panel.is_echo(panel.load_mode, panel.f_ext, panel.dp, panel.ddp):
+        if panel.is_echo(panel.load_mode):
             return
         state = self.session.state
-        new = transitions.set_load(state, panel.load_mode.value, panel.f_ext.value, panel.dp.value, panel.ddp.value)
+        load = state.load
+        new = transitions.set_load(state, panel.load_mode.value, load.f_ext, load.dp, load.ddp)
         if new is not state:
             self._commit(new)
 
     @_callback
-    def _on_apply(self, event) -> None:
-        state = self.session.state
-        try:
-            new = transitions.apply_params(state, self.panel.read_params())
-        except TpmVizError:
-            self.panel.show_params(state.params)  # revert the inputs to the last good mechanism
-            raise
-        self._commit(new)
+    def _on_apply(self, event) -> None:  # the parameter fields settle as on Enter (refusals under the button)
+        self.typing.settle(self.panel.params)
 
-    @_callback
+    @_callback(place="params")
     def _on_paper(self, event) -> None:
         self._commit(transitions.paper_params(self.session.state))
+        self.panel.show_params(self.session.state.params, force=True)  # over anything typed there
 
     @_callback
     def _on_own_copy(self, event) -> None:

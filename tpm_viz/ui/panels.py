@@ -2,6 +2,13 @@
 
 No maths here: the numbers come from a :class:`~tpm_viz.app.readouts.Readout`, formatted by :mod:`.text`.
 Units in labels: mm, N, kg, s, degrees (SI inside; the scale factors come from ``PARAM_INFO``).
+
+Typed numbers (the platform position, the load vectors, the parameters) are text fields read through
+:mod:`tpm_viz.app.typed` (:class:`~.fields.TypedBox`: scientific notation and decimal commas, applied on Enter, by
+*Apply* or after a quiet time, never per keystroke; the value in use always shown). Their groups hold values in
+the units of their labels (mm, N, m/s, m/s², kg), as the transitions take them. Refusals and notes are shown next
+to the control that caused them (:class:`~.fields.Note`); the line at the top of the panel is for the others
+(drags, the classroom).
 """
 
 from __future__ import annotations
@@ -13,7 +20,10 @@ import viser
 from tpm_viz.app.poses import DEMO_KINDS
 from tpm_viz.app.readouts import LOAD_MODES, Load
 from tpm_viz.app.state import AppState
+from tpm_viz.app.transitions import MAX_ACCEL, MAX_FORCE, MAX_POSITION, MAX_SPEED
+from tpm_viz.app.typed import QUIET, Quantity, TypedField, TypedGroup, force_note
 from tpm_viz.params import PARAM_INFO, Params
+from tpm_viz.ui.fields import Note, TypedBox
 from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.text import legend_html
 from tpm_viz.words import Lang
@@ -54,8 +64,45 @@ SHOW_LABELS = {
 }
 
 
+PARAM_NAMES = {"pivot_spacing": "pivot spacing", "stroke": "stroke Δd"}
+"""Name of a parameter in the notes of its field (the others: their own name)."""
+
+VECTORS = {
+    "p": (("p1", "p2"), "mm", MAX_POSITION * 1e3, ("Platform p1 (mm)", "Platform p2 (mm)")),
+    "f_ext": (("f_x", "f_y"), "N", MAX_FORCE, ("Load f_x (N)", "Load f_y (N)")),
+    "dp": (("ṗ1", "ṗ2"), "m/s", MAX_SPEED, ("Velocity ṗ1 (m/s)", "Velocity ṗ2 (m/s)")),
+    "ddp": (("p̈1", "p̈2"), "m/s²", MAX_ACCEL, ("Acceleration p̈1 (m/s²)", "Acceleration p̈2 (m/s²)")),
+}
+"""The typed vectors: keys of their two fields, unit, largest magnitude accepted (the transitions' bounds) and
+labels (the Forces tab: the external load ``f_ext`` on the platform in static mode, its velocity ``ṗ`` and
+acceleration ``p̈`` in dynamic mode)."""
+TYPED_HINT = "Scientific notation (1e-3) and decimal commas (0,5) work; Enter applies (or stop typing for a moment)"
+
+
 def _ui(name: str, value_si: float) -> float:
     return round(value_si * PARAM_INFO[name]["ui_scale"], 6)
+
+
+def _vector(name: str, values=(0.0, 0.0)) -> TypedGroup:
+    """The group of a typed vector (:data:`VECTORS`), applied on Enter or after :data:`QUIET` seconds."""
+    keys, unit, bound, _labels = VECTORS[name]
+    quantities = [Quantity(key, unit, 1.0, -bound, bound) for key in keys]
+    return TypedGroup({q.name: TypedField(q, v) for q, v in zip(quantities, values, strict=True)}, quiet=QUIET)
+
+
+def _vector_box(gui, name: str, values=(0.0, 0.0), hint: str = TYPED_HINT) -> TypedBox:
+    keys, _unit, _bound, labels = VECTORS[name]
+    return TypedBox(gui, _vector(name, values), dict(zip(keys, labels, strict=True)), dict.fromkeys(keys, hint))
+
+
+def _params_group(params: Params) -> TypedGroup:
+    """The parameter fields (UI units: mm, kg), applied together by Enter or *Apply parameters* only."""
+    return TypedGroup(
+        {
+            name: TypedField(Quantity(PARAM_NAMES.get(name, name), PARAM_INFO[name]["ui_unit"]), _ui(name, value))
+            for name, value in ((name, getattr(params, name)) for name in PARAM_LABELS)
+        }
+    )
 
 
 class Panel:
@@ -78,7 +125,7 @@ class Panel:
         )
         tabs = gui.add_tab_group()
         with tabs.add_tab("Move"):
-            self.p = gui.add_vector2("Platform p (mm)", (0.0, 0.0), step=0.1, hint="Or drag the gizmo in 3D")
+            self.p = _vector_box(gui, "p", hint="Or drag the gizmo in 3D")
             self.d = [
                 gui.add_slider(f"Actuator d{i + 1} (mm)", 0.0, stroke_mm, 0.1, 0.0, hint="Forward kinematics")
                 for i in range(2)
@@ -86,21 +133,21 @@ class Panel:
             self.switch_mode = gui.add_button("Switch assembly mode", icon=viser.Icon.SWITCH_HORIZONTAL)
             self.home = gui.add_button("Home (p = 0)", icon=viser.Icon.HOME)
             self.demo = {k: gui.add_button(DEMO_LABELS[k], color="gray") for k in DEMO_KINDS}
+            self.move_note = Note(gui)
         with tabs.add_tab("Forces"):
             self.load_mode = gui.add_dropdown("Load", LOAD_MODES, initial_value="static")
-            self.f_ext = gui.add_vector2("External load on platform f_ext (N)", (0.0, 0.0), step=1.0)
-            self.dp = gui.add_vector2("Platform velocity ṗ (m/s)", (0.0, 0.0), step=0.01)
-            self.ddp = gui.add_vector2("Platform acceleration p̈ (m/s²)", (0.0, 0.0), step=0.1)
+            self.f_ext = _vector_box(gui, "f_ext")
+            self.dp = _vector_box(gui, "dp")
+            self.ddp = _vector_box(gui, "ddp")
+            self.forces_note = Note(gui)
             gui.add_markdown("Trajectories (the paper's line and circle, your CSV): *Player* tab.")
         if extra_tabs is not None:  # the teaching layer's tabs (ui/teaching.py)
             extra_tabs(tabs)
         with tabs.add_tab("Parameters"):
-            self.params = {
-                name: gui.add_number(PARAM_LABELS[name], _ui(name, getattr(state.params, name)), step=0.01)
-                for name in PARAM_LABELS
-            }
+            self.params = TypedBox(gui, _params_group(state.params), PARAM_LABELS, note=False)
             self.apply = gui.add_button("Apply parameters", icon=viser.Icon.CHECK)
             self.paper = gui.add_button("Paper values (Tables 1-2)", color="gray")
+            self.params.add_note(gui)
         with tabs.add_tab("Equations"):
             gui.add_markdown(
                 "The paper's procedure (a)-(e) with the current numbers (refreshed when you release the platform "
@@ -115,6 +162,9 @@ class Panel:
             self.show_toggles = {k: gui.add_checkbox(label, True) for k, label in SHOW_LABELS.items()}
             gui.add_html(legend_html())
             self.frame_camera = gui.add_button("Snapshot the mechanism", icon=viser.Icon.FOCUS_CENTERED)
+            self.presentation = gui.add_checkbox(
+                "Presentation mode", False, hint="Large type, thick lines and a wider panel: for a projector"
+            )
 
     def show(self, frame: Snapshot, lang: Lang = Lang.EN) -> None:
         """Write every value of the frame's state and readout into the widgets (viser skips unchanged ones), the
@@ -134,15 +184,29 @@ class Panel:
             if due:
                 self._put(slider, min(max(round(float(readout.d[i]) * 1e3, 2), 0.0), stroke_mm))
         if due:
-            self._put(self.p, (round(float(readout.p[0]) * 1e3, 2), round(float(readout.p[1]) * 1e3, 2)))
+            self.p.show({"p1": float(readout.p[0]) * 1e3, "p2": float(readout.p[1]) * 1e3})
         if state.load != self._shown_load:
             self._shown_load = load = state.load
             self._put(self.load_mode, load.mode)
-            self._put(self.f_ext, load.f_ext)
-            self._put(self.dp, tuple(round(v, 6) for v in load.dp))
-            self._put(self.ddp, tuple(round(v, 6) for v in load.ddp))
+            for box, values in ((self.f_ext, load.f_ext), (self.dp, load.dp), (self.ddp, load.ddp)):
+                box.show(dict(zip(box.group.fields, map(float, values), strict=True)))
         if state.params != self._shown_params:
             self.show_params(state.params)
+        if due:
+            tau = readout.forces.tau
+            self.forces_note.notes = (note,) if (note := force_note(_largest(tau))) is not None else ()
+            self.draw_notes(lang, now)
+
+    def draw_notes(self, lang: Lang, now: float | None = None) -> None:
+        """Every note of the panel, in ``lang`` (viser gets only the changed ones)."""
+        for box in (self.p, self.f_ext, self.dp, self.ddp, self.params):
+            box.draw(lang, now)
+        for note in (self.move_note, self.forces_note):
+            note.draw(lang)
+
+    def boxes(self) -> dict[str, TypedBox]:
+        """The typed boxes of the panel, by the name of what they hold."""
+        return {"p": self.p, "f_ext": self.f_ext, "dp": self.dp, "ddp": self.ddp, "params": self.params}
 
     def forget(self) -> None:
         """Write every widget again at the next :meth:`show` (after a refused input left the browser's value)."""
@@ -159,18 +223,21 @@ class Panel:
         is a late duplicate of an event already applied, not new user input (viser only reports changes)."""
         return all(self._written.get(id(h), _UNSET) == h.value for h in handles)
 
-    def show_params(self, params: Params) -> None:
-        """Write the parameter inputs (also to revert a refused edit)."""
+    def show_params(self, params: Params, force: bool = False) -> None:
+        """Write the parameters in use into their fields (``force``: over what is typed there, e.g. after *Paper
+        values*)."""
         self._shown_params = params
-        for name, handle in self.params.items():
-            handle.value = _ui(name, getattr(params, name))
-
-    def read_params(self) -> dict[str, object]:
-        """The raw values of the parameter inputs, in UI units (validated by the caller)."""
-        return {name: handle.value for name, handle in self.params.items()}
+        self.params.show({name: _ui(name, getattr(params, name)) for name in PARAM_LABELS}, force)
 
     def tell(self, text: str) -> None:
         """Show a message to this tab only (empty text clears it)."""
         content = f"**{text}**" if text else ""
         if self.message.content != content:  # every commit clears it: skip viser's setter when already clear
             self.message.content = content
+
+
+def _largest(tau) -> float | None:
+    """The largest ``|τ_i|`` [N], or None if the forces are unknown."""
+    if tau is None:
+        return None
+    return max(abs(float(t)) for t in tau)

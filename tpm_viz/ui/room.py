@@ -208,7 +208,7 @@ class Room:
                 doc = sessions.loads(data)
                 self._apply_shared(doc, origin=view)
             except TpmVizError as exc:
-                view.refuse(str(exc), resync=False)
+                view.refuse(exc, resync=False)
                 return
             view.tell("Session opened.")
 

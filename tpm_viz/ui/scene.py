@@ -16,7 +16,7 @@ import numpy as np
 import viser
 
 from tpm_viz import meshes
-from tpm_viz.app.overlays import cached_map
+from tpm_viz.app.overlays import arrow_length, arrow_vector, cached_map
 from tpm_viz.app.palette import PALETTE
 from tpm_viz.app.readouts import Readout
 from tpm_viz.app.state import AppState
@@ -24,20 +24,36 @@ from tpm_viz.paper.workspace import direct_singularity_locus, inverse_singularit
 from tpm_viz.params import Params
 from tpm_viz.ui.snapshot import Snapshot
 
-__all__ = ["COLORS", "FAMILIES", "FORCE_SCALE", "GIZMO_Z", "MechanismScene", "camera_pose"]
+__all__ = [
+    "ARROW_SHORTEST",
+    "COLORS",
+    "FAMILIES",
+    "GIZMO_Z",
+    "LABEL_SCALE",
+    "LINE_SCALE",
+    "MechanismScene",
+    "camera_pose",
+    "line_width",
+]
 
 COLORS = PALETTE
 """RGB colours of the parts, the warning colours and the force arrows (:mod:`tpm_viz.app.palette`)."""
 
-FORCE_SCALE = 1.5e-3
-"""Length of a force arrow per newton [m/N] (1.5 mm per N), clipped at :data:`FORCE_MAX`."""
-FORCE_MAX = 0.3  # m
+ARROW_SHORTEST = 1e-3
+"""[m] A force arrow shorter than this is hidden. Lengths: :func:`tpm_viz.app.overlays.arrow_length` (linear for small
+forces, bounded: every arrow stays near the mechanism however large the force near a singularity)."""
 ARROW_Z = meshes.PIN_Z[1] + 0.02  # m, above every part so that no part hides an arrow
 LOCI_Z = 0.0008  # m
 GIZMO_Z = meshes.PLATFORM_Z[1] + 0.02  # m
 FAMILIES = ("labels", "loci", "circles", "forces")
 """The families of nodes a viewer may hide (*Class & view* tab); ``region`` (the workspace floor) is hidden while
 the explorer shows a map."""
+CIRCLE_WIDTH = 2.0  # screen px
+LOCUS_WIDTH = 2.5  # screen px
+LINE_SCALE = 2.0
+"""Presentation mode: the lines (loci, leg circles) are this many times thicker."""
+LABEL_SCALE = 1.6
+"""Presentation mode: the 3D labels are this many times larger."""
 
 
 def _mesh(scene: viser.SceneApi, name: str, mesh, color, **kwargs):
@@ -70,6 +86,7 @@ class MechanismScene:
         self._drawn: Snapshot | None = None  # the snapshot last drawn (a frame is drawn once, whoever asks)
         self.params: Params | None = None
         self.show = dict.fromkeys((*FAMILIES, "region"), True)
+        self.presentation = False  # thicker lines and larger labels (a tab's private copy: :meth:`set_style`)
         self.slider_bodies: list = [None, None]
         self.circles: list = [None, None]
         self.loci: list = []
@@ -161,7 +178,7 @@ class MechanismScene:
                 f"{r}/slider{i + 1}/circle",
                 meshes.circle_segments(params.l_a, LOCI_Z + 0.001) + centre,
                 COLORS["circle"],
-                thickness=2.0,
+                thickness=CIRCLE_WIDTH * self._line_scale,
                 thickness_units="screen",
                 visible=self.show["circles"],
             )
@@ -221,7 +238,7 @@ class MechanismScene:
                     f"{r}/loci/{kind}",
                     meshes.polyline_segments(curves, LOCI_Z),
                     COLORS[f"locus_{kind}"],
-                    thickness=2.5,
+                    thickness=LOCUS_WIDTH * self._line_scale,
                     thickness_units="screen",
                 )
             )
@@ -235,6 +252,26 @@ class MechanismScene:
     def _leg_colors(near_inverse) -> np.ndarray:
         legs = [COLORS["inverse"] if near_inverse[i] else COLORS[f"leg{i + 1}"] for i in range(2)]
         return np.array([legs[0], legs[0], legs[1], legs[1]], dtype=np.uint8)
+
+    @property
+    def _line_scale(self) -> float:
+        return LINE_SCALE if self.presentation else 1.0
+
+    def styled(self) -> list:
+        """The nodes drawn thicker or larger in presentation mode: the singularity loci, the leg circles, the
+        labels."""
+        lines = [h for h in self.loci if h is not self.region]
+        return [*lines, *self.circles, *self.labels]
+
+    def set_style(self, presentation: bool) -> None:
+        """Presentation mode for this drawing (a tab's private copy; the shared drawing is styled per tab by
+        :mod:`.tabscene`): thicker lines, larger labels."""
+        self.presentation = bool(presentation)
+        for handle in self.styled():
+            if isinstance(handle, viser.LabelHandle):
+                handle.font_screen_scale = LABEL_SCALE if presentation else 1.0
+            else:
+                handle.thickness = line_width(handle) * self._line_scale
 
     def _set(self, key: str, handle, attr: str, value) -> None:
         """Assign ``handle.attr = value`` unless that exact value was the last one sent."""
@@ -310,13 +347,14 @@ class MechanismScene:
 
     def _update_forces(self, state: AppState, readout: Readout) -> None:
         tau = readout.forces.tau
+        params = state.params
         for i in range(2):
             value = 0.0 if tau is None else float(tau[i])
-            visible = self.show["forces"] and tau is not None and abs(value) * FORCE_SCALE > 1e-3
+            length = float(arrow_length(value, params)) * float(np.sign(value))
+            visible = self.show["forces"] and tau is not None and abs(length) > ARROW_SHORTEST
             self._set(f"force_vis{i}", self.forces[i], "visible", visible)
             if not visible:
                 continue
-            length = min(abs(value) * FORCE_SCALE, FORCE_MAX) * np.sign(value)
             tip = np.zeros(3)
             tip[i] = length
             pts = np.array([[[0.0, 0.0, ARROW_Z], [tip[0], tip[1], ARROW_Z]]], dtype=np.float32)
@@ -324,14 +362,18 @@ class MechanismScene:
             color = np.array([COLORS["tau_pos"] if value >= 0 else COLORS["tau_neg"]], dtype=np.uint8)
             self._set(f"force_color{i}", self.forces[i], "colors", color)
         f = np.array(state.load.f_ext) if state.load.mode == "static" else np.zeros(2)
-        norm = float(np.linalg.norm(f))
-        visible = self.show["forces"] and norm * FORCE_SCALE > 1e-3
+        vec = arrow_vector(f, params)
+        visible = self.show["forces"] and float(np.hypot(vec[0], vec[1])) > ARROW_SHORTEST
         self._set("load_vis", self.load_arrow, "visible", visible)
         if visible:
-            vec = f / norm * min(norm * FORCE_SCALE, FORCE_MAX)
             z = meshes.PLATFORM_Z[1] + 0.006
             pts = np.array([[[0.0, 0.0, z], [vec[0], vec[1], z]]], dtype=np.float32)
             self._set("load", self.load_arrow, "points", pts)
+
+
+def line_width(handle) -> float:
+    """The normal width [screen px] of a line node: a singularity locus or a leg circle."""
+    return LOCUS_WIDTH if handle.name.rsplit("/", 2)[-2] == "loci" else CIRCLE_WIDTH
 
 
 def camera_pose(params: Params) -> tuple[np.ndarray, np.ndarray]:

@@ -63,8 +63,8 @@ class View(Protocol):
     def render(self, frame: Snapshot, *, dragging: bool) -> None:
         """Draw ``frame``; ``dragging`` is True while this tab's own gizmo is being dragged."""
 
-    def refuse(self, text: str | Phrase, resync: bool = True) -> None:
-        """Tell this tab (only) that its input was refused, and why."""
+    def refuse(self, text: str | Phrase | BaseException, resync: bool = True) -> None:
+        """Tell this tab (only) that its input was refused, and why (an error: its phrase, in the tab's language)."""
 
     def run_changed(self) -> None:
         """The session's trajectory run changed (loaded, playing, paused): redraw the player."""
@@ -78,7 +78,7 @@ class View(Protocol):
     def drain_drags(self) -> None:
         """Commit the session's pending drags (a tab that leaves hands the session's drain on to another)."""
 
-    def tell(self, text: str) -> None:
+    def tell(self, text: str | Phrase) -> None:
         """Show ``text`` in this tab's message line (empty: clear it)."""
 
 

@@ -8,7 +8,10 @@ is removed):
 - a view option turned off (labels, loci, circles, forces) or the workspace floor under an explorer map: an
   invisible client-scoped frame over each node of that family (its broadcast children are hidden with it);
 - a private copy: an invisible client-scoped frame over the whole shared root, and the copy drawn under ``/own``
-  in the tab's own scope, where the view options are plain visibility flags.
+  in the tab's own scope, where the view options are plain visibility flags;
+- presentation mode (:mod:`.look`): a client-scoped copy of each shared line (loci, leg circles) and label, thicker
+  and larger (:func:`styled_copy`), drawn again when the shared drawing is rebuilt; a private copy is restyled in
+  place (:meth:`~.scene.MechanismScene.set_style`).
 
 The gizmo is always the tab's own (each student drags their own handle); it is written back to the platform's pose
 when this tab is not the one dragging.
@@ -16,12 +19,14 @@ when this tab is not the one dragging.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import viser
 
 from tpm_viz.params import Params
 from tpm_viz.ui._viser import drop_gizmo_echo
-from tpm_viz.ui.scene import FAMILIES, GIZMO_Z, MechanismScene
+from tpm_viz.ui.scene import FAMILIES, GIZMO_Z, LABEL_SCALE, LINE_SCALE, MechanismScene, line_width
 from tpm_viz.ui.snapshot import Snapshot
 
 __all__ = ["PRIVATE_ROOT", "TabScene"]
@@ -40,11 +45,14 @@ class TabScene:
         self.private: MechanismScene | None = None
         self.show = dict.fromkeys(FAMILIES, True)
         self.region_hidden = False
+        self.presentation = False
         """True while the explorer shows a map on the floor (the workspace region would cover it)."""
         self._shadows: dict[str, viser.FrameHandle] = {}  # broadcast node name -> the invisible client frame over it
         self._cover: viser.FrameHandle | None = (
             None  # the invisible client frame over the shared root while the private copy is shown
         )
+        self._styled: dict[str, Any] = {}  # broadcast node name -> this tab's styled copy (presentation mode)
+        self._styled_for: Params | None = None  # the shared parameters those copies were drawn for
         self._gizmo_at: np.ndarray | None = None
         self.gizmo = self._api.add_transform_controls(
             "/gizmo",
@@ -70,12 +78,13 @@ class TabScene:
     # -- which drawing -------------------------------------------------------------------------------------
     def open_private(self, params: Params) -> MechanismScene:
         """Hide the shared mechanism in this tab and draw a private copy (returned: the new session's scene)."""
-        self._set_shadows(set())
+        self._set_shadows(set(), style=False)
         if self._cover is None:
             self._cover = self._api.add_frame(self.shared.root, show_axes=False, visible=False)
         if self.private is None:
             sink = None
             self.private = MechanismScene(self._api, params, root=PRIVATE_ROOT, sink=sink, flush=False)
+            self.private.set_style(self.presentation)
             for what in FAMILIES:
                 self.private.set_visible(what, self.show[what])
             self.private.set_visible("region", not self.region_hidden)
@@ -125,11 +134,34 @@ class TabScene:
             wanted.update(self.shared.family("region"))
         self._set_shadows(wanted)
 
-    def _set_shadows(self, wanted: set[str]) -> None:
+    def _set_shadows(self, wanted: set[str], style: bool = True) -> None:
+        """Hide the shared nodes named in ``wanted``, and in presentation mode (and ``style``) draw this tab's styled
+        copy of every other line and label (none while the private copy is shown)."""
+        styled: dict[str, object] = {}
+        if self.presentation and style and self._cover is None:
+            styled = {h.name: h for h in self.shared.styled() if h.name not in wanted}
+            if self._styled_for is not self.shared.params:  # the shared drawing was rebuilt: copy it again
+                styled_now, self._styled = self._styled, {}
+                for handle in styled_now.values():
+                    handle.remove()
+                self._styled_for = self.shared.params
+        for name in [n for n in self._styled if n not in styled]:
+            self._styled.pop(name).remove()
         for name in [n for n in self._shadows if n not in wanted]:
             self._shadows.pop(name).remove()
         for name in sorted(wanted - set(self._shadows)):
             self._shadows[name] = self._api.add_frame(name, show_axes=False, visible=False)
+        for name in sorted(set(styled) - set(self._styled)):
+            self._styled[name] = styled_copy(self._api, styled[name])
+
+    def set_presentation(self, on: bool) -> None:
+        """Presentation mode in this tab: thicker lines and larger labels (the shared drawing through this tab's own
+        styled copies of its lines and labels, a private copy directly)."""
+        self.presentation = bool(on)
+        if self.private is not None:
+            self.private.set_style(self.presentation)
+        else:
+            self._sync_shadows()
 
     # -- per frame -----------------------------------------------------------------------------------------
     def update(self, frame: Snapshot, dragging: bool = False) -> None:
@@ -137,6 +169,8 @@ class TabScene:
         if dragging:
             self._gizmo_at = None  # written again once the drag is over
             return
+        if self.presentation and self.private is None and self._styled_for is not self.shared.params:
+            self._sync_shadows()  # the shared drawing was rebuilt (new parameters): its styled copies too
         at = np.array([frame.readout.p[0], frame.readout.p[1], GIZMO_Z])
         if self._gizmo_at is None or not np.array_equal(at, self._gizmo_at):
             self.gizmo.position = at
@@ -147,3 +181,19 @@ class TabScene:
         self._gizmo_at = None
         if self.private is not None:
             self.private.forget()
+
+
+def styled_copy(scene: viser.SceneApi, handle: Any) -> Any:
+    """A copy of a line or label node of the shared drawing in ``scene`` (a tab's own), under the same name, in the
+    presentation style (:data:`~.scene.LINE_SCALE` times thicker, :data:`~.scene.LABEL_SCALE` times larger)."""
+    common = {"position": handle.position, "wxyz": handle.wxyz, "visible": handle.visible}
+    if isinstance(handle, viser.LabelHandle):
+        return scene.add_label(handle.name, handle.text, anchor=handle.anchor, font_screen_scale=LABEL_SCALE, **common)
+    return scene.add_line_segments(
+        handle.name,
+        handle.points,
+        handle.colors,
+        thickness=line_width(handle) * LINE_SCALE,
+        thickness_units="screen",
+        **common,
+    )

@@ -21,6 +21,11 @@ at most :data:`MAX_TEXT` characters for a text input), finite; uploads go to upl
 :data:`MAX_UPLOADS` in flight per tab, each freed after :data:`UPLOAD_TIMEOUT` seconds if unfinished. Every drop is a
 rate-limited log line (:func:`~.guard.log_fault`). What passes still goes through the callbacks' own validation
 (:mod:`tpm_viz.app.inputs`). viser's internals are reached through :class:`~._viser.ClientDoor`.
+
+viser's page shows its own toast for every upload, "File uploaded successfully" once the last part is acknowledged,
+whatever the app then makes of the file. That toast is hidden before the last acknowledgement goes out (and the
+button freed when an upload is refused before its end): whether a file was taken is the app's to say, next to the
+upload button (:mod:`.teaching.player`), so that a refused file never gets a success toast.
 """
 
 from __future__ import annotations
@@ -70,7 +75,7 @@ def harden(client: viser.ClientHandle, max_upload_bytes: int = MAX_UPLOAD_BYTES)
     """Install the filters of the module docstring on ``client``'s connection (call once, on connect)."""
     door = ClientDoor(client)
     cid = client.client_id
-    in_flight: dict[str, float] = {}  # transfer uuid -> start time, this tab's unfinished uploads
+    in_flight: dict[str, tuple[float, str, int]] = {}  # transfer uuid -> (start time, button, size): unfinished
 
     async def gui_update(client_id, message) -> None:
         handle = door.widget(message.uuid)
@@ -81,15 +86,17 @@ def harden(client: viser.ClientHandle, max_upload_bytes: int = MAX_UPLOAD_BYTES)
                 return
         await door.gui_update(client_id, message)
 
-    def refuse_upload(text: str) -> None:
+    def refuse_upload(text: str, button: str | None, transfer: str, size: int) -> None:
+        door.end_upload(str(button), transfer, max(0, size))  # no spinner left, the button free again
         if log_fault(cid, "upload", f"upload refused: {text}"):  # at most one notification per second as well
             with contextlib.suppress(Exception):
                 client.add_notification("Upload refused", text, color="red", auto_close_seconds=8.0)
 
     def expire(transfer: str) -> None:
-        if in_flight.pop(transfer, None) is not None and door.upload_state(transfer) is not None:
+        entry = in_flight.pop(transfer, None)
+        if entry is not None and door.upload_state(transfer) is not None:
             door.drop_upload(transfer)
-            refuse_upload(f"the upload did not finish within {UPLOAD_TIMEOUT:g} s")
+            refuse_upload(f"the upload did not finish within {UPLOAD_TIMEOUT:g} s", entry[1], transfer, entry[2])
 
     def upload_start(client_id, message) -> None:
         size, parts = message.size_bytes, message.part_count
@@ -98,15 +105,20 @@ def harden(client: viser.ClientHandle, max_upload_bytes: int = MAX_UPLOAD_BYTES)
         if not isinstance(door.widget(message.source_component_uuid), viser.GuiUploadButtonHandle):
             log_fault(cid, "upload", "upload dropped: not aimed at an upload button")
             return
+        button, transfer = message.source_component_uuid, message.transfer_uuid
         if not (0 <= size <= max_upload_bytes and 0 <= parts <= max(1, size)):
-            refuse_upload(f"the file is too large ({size} bytes; at most {max_upload_bytes} bytes)")
+            refuse_upload(
+                f"the file is too large ({size} bytes; at most {max_upload_bytes} bytes)", button, transfer, size
+            )
             return
-        if len(in_flight) >= MAX_UPLOADS or message.transfer_uuid in in_flight:
-            refuse_upload(f"at most {MAX_UPLOADS} uploads at a time")
+        if len(in_flight) >= MAX_UPLOADS or transfer in in_flight:
+            refuse_upload(f"at most {MAX_UPLOADS} uploads at a time", button, transfer, size)
             return
-        in_flight[message.transfer_uuid] = time.monotonic()
+        in_flight[transfer] = (time.monotonic(), str(button), size)
         with contextlib.suppress(RuntimeError):  # called on the server's event loop
-            asyncio.get_running_loop().call_later(UPLOAD_TIMEOUT, expire, message.transfer_uuid)
+            asyncio.get_running_loop().call_later(UPLOAD_TIMEOUT, expire, transfer)
+        if parts == 0:  # an empty file: viser finishes it at once
+            door.end_upload(str(button), transfer)
         door.upload_start(client_id, message)
 
     def upload_part(client_id, message) -> None:
@@ -116,8 +128,16 @@ def harden(client: viser.ClientHandle, max_upload_bytes: int = MAX_UPLOAD_BYTES)
         if state["transferred_bytes"] + len(message.content) > state["total_bytes"]:
             door.drop_upload(message.transfer_uuid)
             in_flight.pop(message.transfer_uuid, None)
-            refuse_upload("the file sent more bytes than it announced")
+            refuse_upload(
+                "the file sent more bytes than it announced",
+                message.source_component_uuid,
+                message.transfer_uuid,
+                state["total_bytes"],
+            )
             return
+        parts, count = state["parts"], state["part_count"]
+        if message.part_index not in parts and 0 <= message.part_index < count and len(parts) + 1 >= count:
+            door.end_upload(str(message.source_component_uuid), message.transfer_uuid)  # the last part: before its ack
         door.upload_part(client_id, message)
         if door.upload_state(message.transfer_uuid) is None:
             in_flight.pop(message.transfer_uuid, None)

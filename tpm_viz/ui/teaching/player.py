@@ -3,7 +3,10 @@ play / pause / scrub it at 0.01x-1x, watch the path being traced and the charts'
 run as CSV and the force plot as PNG.
 
 The run and the playback belong to the session (:mod:`.runs`); this view only reads widgets, calls
-:class:`~.runs.RunHub` and draws. During playback the charts and the trace are refreshed at most
+:class:`~.runs.RunHub` and draws. The duration is a typed field (:class:`~tpm_viz.ui.fields.TypedBox`: ``5e-1`` and
+``0,5`` are 0.5 s; applied on Enter or after a quiet time; the value in use and the plausibility notes under it);
+the player's refusals (upload, choice, playback, exports) are shown under the upload button, to that tab only, and
+the next success clears them. During playback the charts and the trace are refreshed at most
 :data:`CHART_HZ` times a second (the kinematic charts every other time), with the time slider and the summary;
 the 3D platform moves at every frame, and the last frame is always drawn in full.
 """
@@ -16,17 +19,20 @@ import numpy as np
 import viser
 
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES, read_number, read_upload
-from tpm_viz.app.runs import Source
+from tpm_viz.app.runs import MAX_DURATION, MIN_DURATION, Source
+from tpm_viz.app.typed import QUIET, Quantity, TypedField, TypedGroup, duration_note, force_note
 from tpm_viz.csvio import format_columns
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.figures import force_plot_png, force_plot_svg
 from tpm_viz.paper.trajectories import DEFAULT_DURATIONS
+from tpm_viz.ui.fields import Note, TypedBox
 from tpm_viz.ui.guard import guarded
 from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.teaching.charts import Charts
 from tpm_viz.ui.teaching.player_text import summary_html
 from tpm_viz.ui.teaching.playing import RunHub, following
 from tpm_viz.ui.teaching.trace import PathTrace
+from tpm_viz.words import Phrase
 
 __all__ = ["CHART_HZ", "SPEEDS", "PlayerView"]
 
@@ -72,10 +78,18 @@ class PlayerView:
             f"{MAX_UPLOAD_BYTES / 2**20:g} MiB; it must stay inside the stroke and clear of the singularities."
         )
         self.choice = gui.add_dropdown("Trajectory", (NONE, *PAPER), initial_value=NONE)
-        self.duration = gui.add_number("Duration T (s)", 0.2, min=0.01, max=100.0, step=0.01)
+        quantity = Quantity("T", "s", 1.0, MIN_DURATION, MAX_DURATION)
+        self.duration = TypedBox(
+            gui,
+            TypedGroup({"T": TypedField(quantity, DEFAULT_DURATIONS["line"])}, quiet=QUIET),
+            {"T": "Duration T (s)"},
+            {"T": "Of the paper's line or circle; 5e-1 and 0,5 work; Enter applies (or stop typing for a moment)"},
+        )
         self.upload = gui.add_upload_button(
             "Upload CSV (t, p1, p2 in s, m)", icon=viser.Icon.UPLOAD, mime_type=".csv,text/csv,text/plain"
         )
+        self.note = Note(gui)
+        """Refusals of the player's controls (upload, choice, playback, exports), under the upload button."""
         self.controls = gui.add_button_group("Playback", ("Play", "Pause", "To start"))
         self.time = gui.add_slider("Time t (s)", 0.0, 0.2, 0.001, 0.0)
         self.speed = gui.add_dropdown("Speed", tuple(SPEEDS), initial_value="0.05×")
@@ -87,7 +101,7 @@ class PlayerView:
         self.export_svg = gui.add_button("Download the force plot (SVG)", icon=viser.Icon.VECTOR, color="gray")
         self.charts.show_run(None, None)
         self.choice.on_update(self._on_choice)
-        self.duration.on_update(self._on_duration)
+        self.view.typing.add(self.duration, self._apply_duration)
         self.upload.on_upload(self._on_upload)
         self.controls.on_click(self._on_controls)
         self.time.on_update(self._on_time)
@@ -109,14 +123,28 @@ class PlayerView:
         return all(self._written.get(id(h), _UNSET) == h.value for h in handles)
 
     def _guard(self, event, fn, *args) -> None:
-        """Run ``fn`` for a user event (not a server echo); refused input is told to this tab only."""
+        """Run ``fn`` for a user event (not a server echo); refused input is told to this tab only, under the upload
+        button; a success clears an earlier refusal there (a load: once it is computed, :meth:`_loaded`)."""
         if getattr(event, "client", None) is None or getattr(self.view, "closed", False) or self.session is None:
             return
         try:
             fn(*args)
         except TpmVizError as exc:
+            self._refused(exc)
+        else:
             with self.view.hub.lock:
-                self.view.refuse(str(exc))
+                self.note.tell(None, self.view.lang)
+
+    def _refused(self, error: Exception) -> None:
+        """Tell this tab why its player input was refused, under the upload button (any thread)."""
+        with self.view.hub.lock:
+            if not getattr(self.view, "closed", False):
+                phrase = error.args[0] if error.args and isinstance(error.args[0], Phrase) else str(error)
+                self.view.refuse(phrase, where=self.note)
+
+    def _load(self, source: Source) -> None:
+        """Load ``source`` for this tab's session; its refusal is shown under the upload button."""
+        self.runs.load(self.session, source, origin=self.view, on_refused=self._refused)
 
     def speed_value(self) -> float:
         """The chosen playback speed (x real time)."""
@@ -133,17 +161,20 @@ class PlayerView:
     # -- callbacks -----------------------------------------------------------------------------------------
     @guarded(on_error=_internal_error)
     def _on_choice(self, event) -> None:
-        self._guard(event, self._choose, True)
+        self._guard(event, self._choose)
 
-    @guarded(on_error=_internal_error)
-    def _on_duration(self, event) -> None:
-        self._guard(event, self._choose, False)
+    def _apply_duration(self, values) -> None:
+        """The typed duration T [s], settled (under the lock): the chosen paper trajectory, that long."""
+        label = self.choice.value
+        if label not in PAPER:
+            raise InputError(Phrase("the duration T is for the paper's line and circle: choose one under Trajectory"))
+        self._choose(values["T"])
 
-    def _choose(self, new_kind: bool) -> None:
+    def _choose(self, duration: float | None = None) -> None:
         """Load the chosen trajectory: a newly chosen paper trajectory with its default duration
-        (``docs/conventions.md``: line 0.2 s, circle 0.5 s), a typed duration otherwise."""
+        (``docs/conventions.md``: line 0.2 s, circle 0.5 s), or with the typed ``duration`` [s]."""
         with self.view.hub.lock:
-            if self._is_echo(self.choice, self.duration):
+            if duration is None and self._is_echo(self.choice):
                 return
             label = self.choice.value
             sources = self._sources()
@@ -156,15 +187,10 @@ class PlayerView:
                 return
             if source is None:
                 kind = PAPER[label]
-                if new_kind:
-                    duration = DEFAULT_DURATIONS[kind]
-                else:
-                    duration = read_number(self.duration.value, "duration T", lo=0.01, hi=100.0)
-                source = Source.paper(kind, duration)
+                source = Source.paper(kind, DEFAULT_DURATIONS[kind] if duration is None else duration)
             if run is not None and run.source == source and source.kind != "csv":
                 return
-            session = self.session
-        self.runs.load(session, source, origin=self.view)
+        self._load(source)
 
     @guarded(on_error=_internal_error)
     def _on_upload(self, event) -> None:
@@ -172,8 +198,7 @@ class PlayerView:
 
     def _uploaded(self) -> None:
         file = self.upload.value
-        source = Source.from_trajectory(read_upload(file.content, file.name))
-        self.runs.load(self.session, source, origin=self.view)
+        self._load(Source.from_trajectory(read_upload(file.content, file.name)))
 
     @guarded(on_error=_internal_error)
     def _on_controls(self, event) -> None:
@@ -270,6 +295,9 @@ class PlayerView:
                 self._put(self.time, float(np.clip(round(t, 4), 0.0, self.time.max)))
         if due or new_run or force:
             self.summary.content = summary_html(ps, run, self._shown_t if self._shown_t is not _UNSET else t)
+            self.duration.notes = () if run is None else (duration_note(run.duration), force_note(run.peak))
+            self.duration.draw(self.view.lang)
+            self.note.draw(self.view.lang)
 
     def _set_run(self, run) -> None:
         self._run = run
@@ -283,8 +311,8 @@ class PlayerView:
                 self._put(self.choice, NONE)
             return
         self._put(self.choice, _option(run.source))
-        self._put(self.duration, round(run.duration, 6))
-        self.duration.disabled = run.source.kind not in ("line", "circle")
+        self.duration.show({"T": run.duration})
+        self.duration.disable(run.source.kind not in ("line", "circle"))
         self.time.max = run.duration
         self.time.step = max(run.duration / 400.0, 1e-4)
 

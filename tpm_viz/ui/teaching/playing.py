@@ -90,8 +90,10 @@ class RunHub:
             self._sessions[session] = PlayerSession(run=old.run, uploaded=old.uploaded, extra=old.extra)
 
     # -- loading -----------------------------------------------------------------------------------------------
-    def load(self, session: Session, source: Source, origin=None, on_done=None) -> None:
-        """Compute ``source`` for the session's parameters in the background; then show its start."""
+    def load(self, session: Session, source: Source, origin=None, on_done=None, on_refused=None) -> None:
+        """Compute ``source`` for the session's parameters in the background; then show its start and call
+        ``on_done(run)``. A refused trajectory is told to ``on_refused(error)`` if given, else to the ``origin``
+        tab's top line (if that tab is still open)."""
         with self.hub.lock:
             if origin is not None:
                 self.hub.authorize(origin, session)  # presenter mode: before anything changes
@@ -108,11 +110,14 @@ class RunHub:
                 ps.loading = None
                 if error is not None:
                     if origin is not None and not getattr(origin, "closed", False):
-                        origin.refuse(str(error))
+                        if on_refused is not None:
+                            on_refused(error)
+                        else:
+                            origin.refuse(str(error))
                     self._refresh(session)
                     return
                 if session.state.params != params:  # the mechanism changed meanwhile: again, for the new one
-                    self.load(session, source, origin, on_done)
+                    self.load(session, source, origin, on_done, on_refused)
                     return
                 if ps.run is not None and ps.run.source is not source:
                     ps.previous = (ps.run.source.label, ps.run.peak)

@@ -1,0 +1,263 @@
+"""Typed numbers and messages next to their controls, through a real server (a protocol-level client sends what a
+browser sends: the whole text of a field at each keystroke, Enter as the form's submit, uploads as transfer parts).
+
+Expected values are the numbers the texts spell (``5e-1`` s is 0.5 s, ``0,25`` s is 0.25 s) and the paper's peak
+forces scaled by ``1/T²`` (``docs/conventions.md``: 177 N on the circle at T = 0.5 s).
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+import uuid
+
+import numpy as np
+import pytest
+
+from tests.support.protocol import ProtocolClient, decode_batch, wait_for
+from tpm_viz import Params
+from tpm_viz.app.typed import QUIET
+
+P = Params.paper()
+
+
+def _state(view):
+    with view.hub.lock:
+        return view.session.state
+
+
+def _run(view):
+    with view.hub.lock:
+        return view.teaching.services.runs.of(view.session).run
+
+
+def _keystrokes(client, handle, text: str, gap: float = 0.03) -> None:
+    """Type ``text`` one character at a time, as a browser sends it (the whole text at each keystroke)."""
+    for k in range(1, len(text) + 1):
+        client.set_value(handle, text[:k])
+        time.sleep(gap)
+
+
+def _circle(client, view, label: str = "circle (Fig. 5)") -> None:
+    client.set_value(view.teaching.player.choice, label)
+    kind = label.split()[0]
+    wait_for(lambda: (r := _run(view)) is not None and r.source.kind == kind, what=f"the {kind}")
+
+
+def test_a_number_typed_one_key_at_a_time_is_applied_once_when_typing_stops(connect):
+    """``5e-1`` into Duration: no prefix (``5`` s, ``5e``, ``5e-``) is ever applied; once typing stops for the quiet
+    time, T = 0.5 s is in use and the field still shows what was typed."""
+    client, view = connect()
+    _circle(client, view, "line (Fig. 4)")  # T = 0.2 s
+    field = view.teaching.player.duration.inputs["T"]
+    loads = []
+    original = view.teaching.services.runs.load
+    view.teaching.services.runs.load = lambda session, source, *a, **k: (
+        loads.append(source) or original(session, source, *a, **k)
+    )
+    client.set_value(field, "")  # the old text deleted first
+    _keystrokes(client, field, "5e-1")
+    time.sleep(0.5 * QUIET)
+    assert loads == []  # nothing mid-typing, nothing yet
+    wait_for(lambda: (r := _run(view)) is not None and r.duration == 0.5, timeout=QUIET + 5, what="T = 0.5 s")
+    assert [s.duration for s in loads] == [0.5]  # once
+    time.sleep(QUIET)
+    assert len(loads) == 1 and field.value == "5e-1"
+    assert view.teaching.player.duration.note.handle.content == ""  # it shows the value in use: nothing to say
+
+
+def test_a_decimal_comma_and_enter(connect):
+    client, view = connect()
+    _circle(client, view)
+    client.enter(view.teaching.player.duration, {"T": "0,25"})
+    wait_for(lambda: (r := _run(view)) is not None and r.duration == 0.25, what="T = 0.25 s")
+    assert view.teaching.player.duration.inputs["T"].value == "0,25"
+
+
+def test_a_very_short_duration_is_applied_with_its_plausibility_notes(connect):
+    client, view = connect()
+    _circle(client, view)
+    client.enter(view.teaching.player.duration, {"T": "1e-2"})
+    wait_for(lambda: (r := _run(view)) is not None and r.duration == 0.01, what="T = 10 ms")
+    assert _run(view).peak == pytest.approx(177.1 * (0.5 / 0.01) ** 2, rel=0.01)  # peak ∝ 1/T²: ~443 kN
+    note = view.teaching.player.duration.note.handle
+    wait_for(lambda: "T = 10 ms is very short" in note.content, what="the duration note")
+    assert "|τ| = 4.43e+05 N is more than 10 times the usual 200 N" in note.content
+
+
+def test_a_prefix_is_never_applied_and_a_value_out_of_range_is_refused_next_to_the_field(connect):
+    """``-100000`` mm into p1: ``-1``, ``-10``, ... are never applied; Enter refuses the whole text (beyond ±10 m)
+    under the fields, with the value in use; the app keeps its pose."""
+    client, view = connect()
+    before = _state(view)
+    field = view.panel.p.inputs["p1"]
+    _keystrokes(client, field, "-100000")
+    time.sleep(0.3)
+    assert _state(view) is before
+    client.enter(view.panel.p)
+    note = view.panel.p.note.handle
+    wait_for(lambda: "out of range" in note.content, what="the refusal under p")
+    assert "p1: -100000 mm is out of range; type a value from -10000 to 10000 mm (in use: 0 mm)" in note.content
+    assert _state(view) is before and field.value == "-100000"
+    assert view.panel.message.content == ""  # not at the top of the panel
+    client.enter(view.panel.p, {"p1": "-5e1"})  # a later success clears it
+    wait_for(lambda: np.allclose(_state(view).pose.p, (-0.05, 0.0)), what="p1 = -50 mm")
+    wait_for(lambda: note.content == "", what="the note cleared")
+
+
+def test_letters_are_refused_next_to_the_field_and_the_field_keeps_them(connect):
+    client, view = connect()
+    _other, other = connect()
+    before = _state(view)
+    client.enter(view.panel.f_ext, {"f_x": "abc"})
+    note = view.panel.f_ext.note.handle
+    wait_for(lambda: "not a number" in note.content, what="the refusal under f_ext")
+    assert "f_x [N]: &#x27;abc&#x27; is not a number" in note.content and "(in use: 0 N)" in note.content
+    assert _state(view) is before and view.panel.f_ext.inputs["f_x"].value == "abc"
+    assert other.panel.f_ext.note.handle.content == ""  # to that tab only
+    client.enter(view.panel.f_ext, {"f_x": "12", "f_y": "-3,5"})
+    wait_for(lambda: _state(view).load.f_ext == (12.0, -3.5), what="f_ext = (12, -3.5) N")
+    wait_for(lambda: note.content == "", what="the note cleared")
+    assert other.panel.f_ext.inputs["f_x"].value == "12"  # the shared mechanism: the other tab shows it
+
+
+def test_a_force_beyond_a_few_kilonewtons_gets_a_note(connect):
+    client, view = connect()
+    client.enter(view.panel.f_ext, {"f_y": "-1e4"})  # 10 kN at home, J = I: τ2 = 10 kN
+    wait_for(lambda: _state(view).load.f_ext == (0.0, -1e4), what="f_ext")
+    note = view.panel.forces_note.handle
+    wait_for(lambda: "more than 10 times the usual 200 N" in note.content, what="the plausibility note")
+    client.enter(view.panel.f_ext, {"f_y": "-20"})
+    wait_for(lambda: note.content == "", what="no note for 20 N")
+
+
+def test_parameters_wait_for_apply_and_say_what_is_typed(connect):
+    """The Parameters apply together on Enter or Apply only (never by themselves); after the quiet time the note
+    says what is typed and what is in use. ``1e9`` kg is read as a billion kilograms (not 19 kg) and refused."""
+    client, view = connect()
+    before = _state(view)
+    field = view.panel.params.inputs["m_p"]
+    _keystrokes(client, field, "1e9")
+    note = view.panel.params.note.handle
+    wait_for(lambda: "not applied yet" in note.content, timeout=QUIET + 5, what="the pending note")
+    assert "m_p: 1e+09 kg typed, not applied yet (press Enter or Apply); in use: 2.21 kg" in note.content
+    time.sleep(0.5)
+    assert _state(view) is before
+    client.click(view.panel.apply)
+    wait_for(lambda: "Refused" in note.content, what="the refusal under Apply")
+    assert "m_p must be between" in note.content and "got 1e+09 kg" in note.content
+    assert _state(view) is before and field.value == "1e9"
+    client.enter(view.panel.params, {"m_p": "4,5"})
+    wait_for(lambda: _state(view).params.m_p == 4.5, what="m_p = 4.5 kg")
+    wait_for(lambda: note.content == "", what="the refusal cleared by the success")
+
+
+def test_the_field_follows_the_value_in_use_unless_it_is_being_typed_in(connect):
+    client, view = connect()
+    other_client, other = connect()
+    other_client.enter(other.panel.p, {"p1": "30", "p2": "20"})  # another tab moves the shared platform
+    wait_for(lambda: view.panel.p.inputs["p1"].value == "30", what="p1 shown in this tab")
+    assert view.panel.p.inputs["p2"].value == "20"
+    client.set_value(view.panel.p.inputs["p1"], "4")  # this tab starts typing
+    other_client.enter(other.panel.p, {"p1": "10"})
+    wait_for(lambda: np.allclose(_state(view).pose.p, (0.01, 0.02)), what="the other tab's move")
+    time.sleep(0.2)
+    assert view.panel.p.inputs["p1"].value == "4"  # never overwritten while typing
+
+
+class Recorder(ProtocolClient):
+    """A protocol client that also keeps the upload acknowledgements and notification messages it is sent."""
+
+    def __init__(self, port: int) -> None:
+        self.seen: list[dict] = []
+        self.lock = threading.Lock()
+        super().__init__(port)
+
+    def _drain(self) -> None:
+        while not self._stop.is_set():
+            try:
+                raw = self.ws.recv(timeout=0.2)
+            except TimeoutError:
+                continue
+            except Exception:
+                return
+            for m in decode_batch(raw):
+                if m["type"] in ("FileTransferPartAck", "RemoveNotificationMessage", "NotificationShowMessage"):
+                    with self.lock:
+                        self.seen.append(m)
+
+
+def _upload(client, button, name: str, content: bytes, declared: int | None = None) -> str:
+    transfer = str(uuid.uuid4())
+    parts = [content[i : i + 65536] for i in range(0, len(content), 65536)]
+    head = {"source_component_uuid": button._impl.uuid, "transfer_uuid": transfer}
+    size = len(content) if declared is None else declared
+    client.send(type="FileTransferStartUpload", **head, filename=name, mime_type="text/csv", part_count=len(parts),
+                size_bytes=size)  # fmt: skip
+    if declared is None:
+        for k, part in enumerate(parts):
+            client.send(type="FileTransferPart", **head, part_index=k, content=part)
+    return transfer
+
+
+def test_a_refused_upload_gets_no_success_toast_and_its_refusal_is_under_the_upload_button(app):
+    client = Recorder(app.port)
+    try:
+        view = wait_for(lambda: next(iter(app.views.values()), None), what="the tab")
+        wait_for(lambda: view.session.readout is not None, what="the first render")
+        player = view.teaching.player
+        bad = b"t,p1,p2\n0,0,0\n0.1,0.1,0\n0.2,0.4,0\n0.3,0.1,0\n"  # 400 mm: out of reach
+        transfer = _upload(client, player.upload, "far.csv", bad)
+        wait_for(lambda: "out of reach" in player.note.handle.content, what="the refusal under the upload button")
+        with client.lock:
+            seen = [
+                m for m in client.seen if m.get("transfer_uuid") == transfer or m.get("uuid") == f"upload-{transfer}"
+            ]
+        kinds = [m["type"] for m in seen]
+        # the page's own toast ("File uploaded successfully" once all bytes are acknowledged) is hidden first
+        assert kinds == ["RemoveNotificationMessage", "FileTransferPartAck"], kinds
+        assert seen[1]["transferred_bytes"] == seen[1]["total_bytes"] == len(bad)  # the button is free again
+        assert view.panel.message.content == ""
+
+        huge = _upload(client, player.upload, "huge.csv", b"", declared=50 << 20)  # refused before any byte
+        wait_for(lambda: any(m.get("transfer_uuid") == huge for m in client.seen), what="the early refusal")
+        with client.lock:
+            early = [m for m in client.seen if m.get("transfer_uuid") == huge or m.get("uuid") == f"upload-{huge}"]
+        assert [m["type"] for m in early] == ["RemoveNotificationMessage", "FileTransferPartAck"]
+        assert early[1]["transferred_bytes"] == early[1]["total_bytes"] == 50 << 20  # no spinner left
+
+        t = np.linspace(0.0, 1.0, 21)
+        good = "t,p1,p2\n" + "".join(f"{a},{0.05 * np.sin(np.pi * a)},0\n" for a in t)
+        _upload(client, player.upload, "wave.csv", good.encode())
+        wait_for(lambda: (r := _run(view)) is not None and r.source.kind == "csv", what="the good upload")
+        wait_for(lambda: player.note.handle.content == "", what="the refusal cleared by the later success")
+    finally:
+        client.close()
+
+
+def test_the_quiet_timer_is_one_thread_at_most_whatever_the_keystrokes():
+    """:class:`~tpm_viz.ui.fields.Waker`: a thousand keystrokes (later and later wake-up times) leave one timer
+    thread at most; it fires once, at the earliest time asked for; an earlier time replaces it; closed, it never
+    fires again."""
+    from tpm_viz.ui.fields import Waker
+
+    def timers() -> int:
+        return sum(t.name == "tpm-viz-typing" for t in threading.enumerate())
+
+    fired: list[float] = []
+    waker = Waker(lambda: fired.append(time.monotonic()))
+    before = timers()  # other tabs' (none, unless a test left one finishing)
+    t0 = time.monotonic()
+    for k in range(1000):
+        waker.at(t0 + 0.2 + k * 1e-4)
+        assert timers() <= before + 1
+    wait_for(lambda: fired, what="the timer")
+    assert len(fired) == 1 and fired[0] - t0 >= 0.2
+    waker.at(time.monotonic() + 5.0)
+    waker.at(time.monotonic() + 0.05)  # earlier: replaces the pending timer
+    wait_for(lambda: len(fired) == 2, what="the earlier wake-up")
+    assert fired[1] - fired[0] < 2.0
+    waker.at(time.monotonic() + 0.05)
+    waker.close()
+    time.sleep(0.2)
+    assert len(fired) == 2 and not waker.pending

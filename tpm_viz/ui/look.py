@@ -1,0 +1,247 @@
+"""How one tab looks on its screen: the phone layout, presentation mode, and a camera framed for the tab's canvas.
+
+**Layout.** On a wide screen the control panel is docked to the right edge (viser's dock, :func:`dock_panel`): the
+3D canvas is the rest of the window, so the panel never hides the mechanism. On a phone (a window at most 36em
+wide: viser's own breakpoint, where it shows the panel as a sheet along the bottom) the style sheet
+:data:`PHONE_CSS` makes the sheet the full width and :data:`SHEET` of the height and shrinks the canvas to the part
+above it (all but the sheet's handle while the sheet is collapsed), and makes every control at least :data:`TOUCH` CSS
+pixels across (wide equations scroll sideways in their own boxes).
+Either way the canvas is the free part of the screen, so the camera frames the mechanism in the whole canvas
+(:mod:`tpm_viz.app.framing`): the server only needs the canvas's aspect ratio, which each camera message carries.
+The camera is framed again when that ratio changes (a rotated phone, a resized window, a collapsed panel), not
+when the viewer orbits or zooms.
+
+**Presentation mode** (a checkbox of the *Class & view* tab, per tab): large type (the readouts
+:data:`READOUT_PX` CSS pixels, every label darker and larger), a wider panel (:data:`PRESENTATION_WIDTH`), thicker
+lines and larger labels in 3D (:mod:`.tabscene`), and a box of the banner and the two forces that floats over the
+bottom of the canvas whenever the panel is collapsed to its rail (a separate viser panel, shown by the style sheet
+only then; the framing keeps its band free). All of it is this tab's own: the style sheet is an HTML element of
+the tab's GUI, and every tab's GUI is its own.
+
+Nothing here computes; the style sheets are constants, and the messages are words of :mod:`tpm_viz.words`.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import viser
+
+from tpm_viz import meshes
+from tpm_viz.app.framing import LIVE_BAND, frame_box
+from tpm_viz.params import Params
+from tpm_viz.ui.guard import guarded
+from tpm_viz.ui.language import KEEP_ALL
+from tpm_viz.ui.scene import camera_pose
+from tpm_viz.words import Lang, T
+
+__all__ = [
+    "HANDLE",
+    "LIVE_LABEL",
+    "PANEL_WIDTH",
+    "PHONE_CSS",
+    "PRESENTATION_CSS",
+    "PRESENTATION_WIDTH",
+    "READOUT_PX",
+    "SHEET",
+    "TOUCH",
+    "Look",
+    "dock_panel",
+    "frame_camera",
+    "mechanism_box",
+]
+
+PANEL_WIDTH = 384
+"""Width of the docked panel [CSS px] (viser's ``control_width="large"``, 24em)."""
+PRESENTATION_WIDTH = 440
+"""Width of the docked panel in presentation mode [CSS px]: the readouts at :data:`READOUT_PX` fit on one line."""
+READOUT_PX = 22
+"""Font size of the readouts and forces in presentation mode [CSS px] (at least 20 px on a 1024 x 768 projector)."""
+SHEET = 0.45
+"""Height of the panel's sheet on a phone [fraction of the window height]; the canvas is the rest above it."""
+TOUCH = 24
+"""Least width and height of a control on a phone [CSS px] (WCAG 2.2 target size, level AA)."""
+ASPECT_CHANGE = 0.01
+"""Relative change of a canvas's aspect ratio that frames the camera again (a pixel of rounding does not)."""
+LIVE_WIDTH = 560
+"""Width of the box of banner and forces [CSS px] (presentation mode, while the panel is collapsed)."""
+LIVE_GAP = 12
+"""Gap between that box and the canvas's left and bottom edges [CSS px]."""
+LIVE_CHROME = 64
+"""Height of that box's frame [CSS px]: its grip, its tab and :data:`LIVE_GAP`; the box, frame included, stays
+within the bottom :data:`~tpm_viz.app.framing.LIVE_BAND` of the window that the framing keeps free."""
+LIVE_LABEL = T("Warnings and forces")
+"""Tab name of the box of banner and forces (presentation mode; shown in the tab's language on the way out)."""
+
+_PHONE = "(max-width: 36em)"  # viser's mobile breakpoint (Mantine's xs): the panel is a bottom sheet
+_SHEET_CSS = '.mantine-Paper-root[style*="position: fixed"]'  # viser's sheet (its only fixed Paper)
+_OPEN = 'div[style*="width: 20em"] > [aria-hidden="false"]'  # the sheet's contents, shown
+_SHUT = 'div[style*="width: 20em"] > [aria-hidden="true"]'  # the sheet's contents, collapsed to its handle
+HANDLE = 48
+"""Height of the phone sheet's handle [CSS px] (viser: 3.5em of its 13.3 px type): the canvas is the rest while the
+sheet is collapsed to it."""
+_SHEET_PCT = round(SHEET * 100)
+PHONE_CSS = f"""<style>
+@media {_PHONE} {{
+  {_SHEET_CSS} {{ width: 100% !important; left: 0 !important; right: 0 !important; }}
+  {_SHEET_CSS} {{ max-height: {_SHEET_PCT}vh !important; }}
+  {_SHEET_CSS}:has({_OPEN}) {{ height: {_SHEET_PCT}vh !important; }}
+  {_SHEET_CSS} div[style*="width: 20em"] {{ width: 100% !important; }}
+  div:has(> div > canvas[data-engine]) {{ height: {100 - _SHEET_PCT}vh !important; }}
+  body:has({_SHEET_CSS} {_SHUT}) div:has(> div > canvas[data-engine]) {{
+    height: calc(100vh - {HANDLE}px) !important; }}
+}}
+@media {_PHONE}, (pointer: coarse) {{
+  .mantine-Slider-root {{ min-height: {TOUCH}px; }}
+  .mantine-Slider-thumb {{ width: {TOUCH}px !important; height: {TOUCH}px !important; border-radius: 50% !important;
+    background: #fff !important; }}
+  .mantine-Checkbox-input, .mantine-Checkbox-inner {{ width: {TOUCH}px !important; height: {TOUCH}px !important; }}
+  .mantine-Button-root, .mantine-Input-input, .mantine-Tabs-tab {{ min-height: {TOUCH}px !important; }}
+  .mantine-ActionIcon-root {{ min-width: {TOUCH}px !important; min-height: {TOUCH}px !important; }}
+}}
+</style>"""
+"""The phone layout and touch targets (by viewport and pointer: no switch), in every tab."""
+
+PRESENTATION_CSS = f"""<style>
+div:has(> [data-q="banner"]) {{ color: #0f172a; }}
+[data-q="banner"] {{ font-size: 19px !important; }}
+div:has(> [data-q="banner"]) td {{ font-size: 17px !important; color: #0f172a !important; }}
+div:has(> [data-q="banner"]) > div:last-child, div:has(> [data-q="banner"]) > div:last-child div {{
+  font-size: 17px !important; color: #0f172a !important; }}
+div:has(> [data-q="banner"]) td [data-q], [data-q="tau1"], [data-q="tau2"] {{ font-size: {READOUT_PX}px !important; }}
+div:has(> [data-q="banner"]) [style*="grid-template-columns"] {{ grid-template-columns: 1.4em 1fr 6.4em !important; }}
+div:has(> [data-q="banner"]) [style*="grid-template-columns"] > span {{ white-space: nowrap; }}
+.mantine-Paper-root label, .mantine-Button-label, .mantine-Tabs-tab, .mantine-Checkbox-label,
+.mantine-Paper-root .mantine-Text-root {{ font-size: 15px !important; color: #0f172a; letter-spacing: 0 !important; }}
+[data-floating-window]:has([data-live]) {{ visibility: hidden; pointer-events: none; }}
+body:has([data-dock-rail-root]) [data-floating-window]:has([data-live]) {{ visibility: visible; pointer-events: auto; }}
+[data-live] {{ max-height: calc({round(LIVE_BAND * 100)}vh - {LIVE_CHROME}px); overflow-y: auto; }}
+[data-live] [data-q="banner"] {{ font-size: 18px !important; }}
+[data-live] > div > div:last-child > div:not(:first-child) {{ font-size: 15px !important; }}
+[data-live] table, [data-live] > div > div:last-child > div:first-child {{ display: none; }}
+@media {_PHONE} {{ div:has(> div > [data-live]) {{ display: none !important; }} }}
+</style>"""
+"""Presentation mode: large, dark type; the box of banner and forces shown only while the panel is collapsed."""
+
+
+def mechanism_box(params: Params) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper corners [m] of the box around the mechanism: the base plate up to the top of the pins."""
+    lo, hi = meshes.base_extent(params)
+    return np.array([lo, lo, -0.012]), np.array([hi, hi, meshes.PIN_Z[1]])
+
+
+def _canvas(client: viser.ClientHandle) -> tuple[float, float] | None:
+    """The tab's vertical field of view [rad] and canvas aspect ratio, or None before its canvas has a size."""
+    try:
+        camera = client.camera
+        width, height, fov = camera.image_width, camera.image_height, float(camera.fov)
+    except AssertionError:  # no camera message yet
+        return None
+    if width <= 0 or height <= 0 or not 0.0 < fov < math.pi:
+        return None
+    return fov, width / height
+
+
+def frame_camera(client: viser.ClientHandle, params: Params, presentation: bool = False) -> float | None:
+    """Point the tab's camera at the whole mechanism, framed for its canvas; return the aspect ratio framed for
+    (None: the canvas has no size yet, and the default pose of :func:`~.scene.camera_pose` is used)."""
+    canvas = _canvas(client)
+    if canvas is None:
+        position, look_at = camera_pose(params)
+    else:
+        framing = frame_box(*mechanism_box(params), canvas[0], canvas[1], presentation)
+        position, look_at = framing.position, framing.look_at
+    client.camera.position = position
+    client.camera.look_at = look_at
+    return None if canvas is None else canvas[1]
+
+
+def dock_panel(gui: Any, width: float = PANEL_WIDTH) -> None:
+    """Dock the control panel to the right edge, ``width`` CSS pixels wide (``server.gui`` or a tab's ``gui``)."""
+    panel = gui.main_panel
+    panel.dock_right()
+    panel.set_width(width)
+
+
+class Look:
+    """The look of one tab (``view``: its :class:`~.client.ClientView`): its style sheet, presentation mode, the
+    box of banner and forces, and the camera framing that follows the canvas's aspect ratio."""
+
+    def __init__(self, view: Any) -> None:
+        self.view = view
+        self.presentation = False
+        self._aspect: float | None = None  # the canvas aspect the camera was last framed for
+        gui = view.client.gui
+        self.style = gui.add_html(PHONE_CSS)
+        self.live: Any = None  # the box of banner and forces (a viser panel), made when first needed
+        self.live_html: Any = None
+        self.live_style: Any = None
+        view.client.camera.on_update(self._on_camera)
+        view.panel.presentation.on_update(self._on_presentation)
+
+    # -- the camera ---------------------------------------------------------------------------------------------
+    def frame(self, params: Params) -> None:
+        """Frame the camera on the mechanism for this tab's canvas (under the hub's lock)."""
+        self._aspect = frame_camera(self.view.client, params, self.presentation)
+
+    @guarded
+    def _on_camera(self, camera: Any) -> None:
+        """A camera message: frame again if the canvas's aspect ratio changed (not for an orbit or a zoom)."""
+        canvas = _canvas(camera.client)
+        if canvas is None:
+            return
+        if self._aspect is not None and abs(canvas[1] / self._aspect - 1.0) <= ASPECT_CHANGE:
+            return
+        view = self.view
+        with view.hub.lock:
+            if view.closed or getattr(view, "session", None) is None:
+                return
+            view.frame_camera(view.session.state.params)
+            view.client.flush()
+
+    # -- presentation mode -------------------------------------------------------------------------------------
+    @guarded
+    def _on_presentation(self, event: Any) -> None:
+        if getattr(event, "client", None) is None:  # the server's own write, echoed
+            return
+        view = self.view
+        with view.hub.lock:
+            if view.closed:
+                return
+            self.set_presentation(bool(view.panel.presentation.value))
+            view.client.flush()
+
+    def set_presentation(self, on: bool) -> None:
+        """Turn presentation mode on or off for this tab (under the hub's lock)."""
+        on = bool(on)
+        if on == self.presentation:
+            return
+        self.presentation = on
+        client = self.view.client
+        self.style.content = PHONE_CSS + (PRESENTATION_CSS if on else "")
+        dock_panel(client.gui, PRESENTATION_WIDTH if on else PANEL_WIDTH)
+        if on and self.live is None:
+            self.live = client.gui.add_panel()
+            with self.live.add_tab(LIVE_LABEL.template):
+                self.live_html = client.gui.add_html("")
+                # the panel's style sheets are unmounted with it when it collapses: this box carries its own
+                self.live_style = client.gui.add_html("")
+            self.live.float(x=LIVE_GAP, y=-LIVE_GAP, width=LIVE_WIDTH)
+        if self.live is not None:
+            self.live.visible = on
+        self.view.scene.set_presentation(on)
+        self.show()
+        self.view.frame_camera(self.view.session.state.params)
+
+    def show(self) -> None:
+        """Copy the panel's dashboard into the box of banner and forces (presentation mode only)."""
+        if not self.presentation or self.live_html is None:
+            return
+        content = f'<div data-live="1">{self.view.panel.dashboard.content}</div>'
+        if self.live_html.content != content:
+            self.live_html.content = content
+        style = PRESENTATION_CSS + (KEEP_ALL if self.view.lang is Lang.KO else "")
+        if self.live_style.content != style:
+            self.live_style.content = style
