@@ -44,6 +44,8 @@ def test_a_tab_that_comes_back_gets_its_own_copy_and_view_options(classroom_app)
     wait_for(lambda: view.session.state.params.l_a == pytest.approx(0.28), what="l_a applied")
     page.set("Labels O, A_i, B_i, P", False)
     wait_for(lambda: not view.scene.show["labels"], what="labels hidden")
+    page.set("Presentation mode", True)
+    wait_for(lambda: view.look.presentation, what="presentation mode")
     with app.hub.lock:
         app.services.runs.load(view.session, Source.paper("line"))
     wait_for(lambda: app.services.runs.of(view.session).run is not None, what="the run")
@@ -62,6 +64,8 @@ def test_a_tab_that_comes_back_gets_its_own_copy_and_view_options(classroom_app)
     assert bv.session.state.params.l_a == pytest.approx(0.28) and not bv.scene.show["labels"]
     assert "Welcome back" in bv.panel.message.content
     wait_for(lambda: back.value("Work on my own copy") is True, what="the box ticked in the page")
+    assert bv.look.presentation and not ov.look.presentation  # presentation mode back in that tab only
+    wait_for(lambda: back.value("Presentation mode") is True, what="presentation ticked in the page")
     assert app.hub.shared.state.params.l_a == pytest.approx(0.26)  # the shared one never changed
     for p in (back, other):
         p.close()

@@ -4,7 +4,7 @@ viser gives every websocket connection a new client id, and its page sends nothi
 it reconnects (no URL parameters, no storage of its own on reconnect). What does survive is the browser's cookie
 (:mod:`.classroom`): a tab is recognised by its browser, and when the browser has several tabs, by the camera it
 sends first (a reconnecting page keeps its camera). :class:`Away` keeps each tab that left (its own copy or
-not, parameters, pose, load, trajectory and player time, view options, language) for
+not, parameters, pose, load, trajectory and player time, view options and presentation mode, language) for
 :data:`~tpm_viz.app.sessions.KEEP_SECONDS`; the app restores it when it can tell which tab is back, and otherwise
 offers *Restore my own copy from before the drop* in that tab (it never puts a student on the shared mechanism
 without saying so).
@@ -35,7 +35,10 @@ from tpm_viz.ui.session import Session
 from tpm_viz.ui.teaching.playing import RunHub, following
 from tpm_viz.words import Lang
 
-__all__ = ["SAVE_SECONDS", "Away", "Store", "default_path", "reload", "restore", "saved_of"]
+__all__ = ["PRESENTATION", "SAVE_SECONDS", "Away", "Store", "default_path", "reload", "restore", "saved_of"]
+
+PRESENTATION = "presentation"
+"""The key of presentation mode (:mod:`.look`) among a saved tab's view options."""
 
 SAVE_SECONDS = 2.0
 """Longest time a change to the shared mechanism waits before it is on disk."""
@@ -195,6 +198,7 @@ def saved_of(view: Any) -> Saved:
     ps = view.teaching.services.runs.of(view.session)
     source = ps.run.source if ps.run is not None else ps.loading
     show = {what: bool(widget_value(h)) for what, h in view.panel.show_toggles.items()}
+    show[PRESENTATION] = bool(view.look.presentation)
     return Saved(view.session.state, source, view.session.state.trajectory.t, show, view.lang.value)
 
 
@@ -218,6 +222,9 @@ def restore(view: Any, saved: Saved | None, private: bool) -> None:
     trajectory and player time) or the shared mechanism, its view options and its language (under the hub's lock)."""
     if saved is not None:
         view.words.set(Lang.parse(saved.lang, default=view.lang))
+        if saved.show.get(PRESENTATION, False) != view.look.presentation:
+            view.panel.presentation.value = saved.show[PRESENTATION]  # echoed with client=None: ignored
+            view.look.set_presentation(saved.show[PRESENTATION])
         for what, visible in saved.show.items():
             handle = view.panel.show_toggles.get(what)
             if handle is not None and bool(widget_value(handle)) != visible:
