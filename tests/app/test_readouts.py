@@ -18,6 +18,7 @@ from tpm_viz import (
 from tpm_viz.app.moves import Pose, drive_to
 from tpm_viz.app.poses import preset_pose
 from tpm_viz.app.readouts import Load, evaluate
+from tpm_viz.paper.jacobians import jacobians
 
 P = Params.paper()
 POSE = Pose.working(P, (0.04, -0.03))
@@ -55,7 +56,7 @@ def test_dynamic_forces_are_eq_31():
     load = Load("dynamic", dp=(0.5, -0.2), ddp=(3.0, 4.0))
     r = evaluate(P, POSE, load)
     np.testing.assert_allclose(r.forces.tau, inverse_dynamics(P, POSE.p, load.dp, load.ddp))
-    assert r.forces.tau_ref is None and "no reference" in r.forces.note
+    assert r.forces.tau_ref is None and "no reference" in str(r.forces.note)
 
 
 def test_reference_and_difference():
@@ -71,7 +72,7 @@ def test_reference_errors_become_a_note_not_an_exception():
         raise ArithmeticError("diverged")
 
     r = evaluate(P, POSE, reference=broken)
-    assert r.forces.tau_ref is None and "diverged" in r.forces.note
+    assert r.forces.tau_ref is None and "diverged" in str(r.forces.note)
 
 
 def test_reference_is_skipped_off_the_working_branch():
@@ -81,7 +82,7 @@ def test_reference_is_skipped_off_the_working_branch():
     if np.all(other.branch(P) > 0):
         pytest.skip("the other mode is on the working branch here")
     r = evaluate(P, other, reference=lambda *a: np.zeros(2))
-    assert r.forces.tau_ref is None and "working mode" in r.forces.note
+    assert r.forces.tau_ref is None and "working mode" in str(r.forces.note)
 
 
 @pytest.mark.parametrize("kind", ["inverse", "direct", "stroke"])
@@ -89,6 +90,19 @@ def test_alerts_at_the_demo_poses(kind):
     r = evaluate(P, preset_pose(P, kind).pose, Load("static", f_ext=(10.0, 10.0)))
     assert kind in {a.kind for a in r.alerts}
     assert _finite_numbers(r)
+    (text,) = [str(a.text) for a in r.alerts if a.kind == kind]
+    pose = preset_pose(P, kind).pose
+    jac = jacobians(P, pose.p, pose.d)
+    # plain words first (what happens to the machine), then the number and the equation (issue 13)
+    if kind == "direct":
+        assert "stiffness" in text and "without bound" in text
+        assert text.endswith(f"(cos(θ1+θ2) = {float(jac.det_jx):.3f}, eq. 12)")
+    elif kind == "inverse":
+        i = int(np.argmin(np.abs(np.diag(jac.jq))))
+        assert f"perpendicular to rail {i + 1}" in text
+        assert text.endswith(f"(cos θ{i + 1} = {float(jac.jq[i, i]):.3f}, eq. 11)")
+    else:
+        assert "end-stop" in text and "back into the stroke" in text
 
 
 def test_other_assembly_mode_is_the_other_circle_intersection():

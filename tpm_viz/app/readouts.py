@@ -22,13 +22,15 @@ import numpy as np
 
 from tpm_viz.app.moves import Pose
 from tpm_viz.errors import InputError, TpmVizError
+from tpm_viz.numbers import fixed
 from tpm_viz.paper.dynamics import inverse_dynamics
 from tpm_viz.paper.jacobians import jacobians
 from tpm_viz.paper.kinematics import forward_kinematics_both
 from tpm_viz.paper.status import WARN, SingularityThresholds
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase, T
 
-__all__ = ["LOAD_MODES", "Alert", "Forces", "Load", "Readout", "Reference", "evaluate"]
+__all__ = ["LOAD_MODES", "Alert", "Forces", "Load", "Readout", "Reference", "evaluate", "joined", "reason"]
 
 LOAD_MODES = ("static", "dynamic")
 
@@ -49,10 +51,26 @@ def _vec2(value, name: str) -> tuple[float, float]:
     try:
         x, y = (float(v) for v in value)
     except (TypeError, ValueError):
-        raise InputError(f"{name} must be two numbers, got {value!r}") from None
+        raise InputError(Phrase("{name} must be two numbers, got {got}", name=name, got=repr(value))) from None
     if not (math.isfinite(x) and math.isfinite(y)):
-        raise InputError(f"{name} must be finite, got ({x:g}, {y:g})")
+        raise InputError(Phrase("{name} must be finite, got ({x:g}, {y:g})", name=name, x=x, y=y))
     return (x, y)
+
+
+def reason(exc: BaseException) -> Phrase:
+    """The words of an error as a phrase (its own phrase, or its English text), to quote in another phrase."""
+    first = exc.args[0] if exc.args else None
+    return first if isinstance(first, Phrase) else Phrase("{text}", text=str(exc))
+
+
+def joined(lines: list[Phrase]) -> Phrase | str:
+    """``lines`` as one line, separated by ``"; "`` (empty if none)."""
+    if not lines:
+        return ""
+    out = lines[0]
+    for line in lines[1:]:
+        out = Phrase("{first}; {then}", first=out, then=line)
+    return out
 
 
 @dataclass(frozen=True)
@@ -70,7 +88,7 @@ class Load:
 
     def __post_init__(self) -> None:
         if self.mode not in LOAD_MODES:
-            raise InputError(f"load mode must be 'static' or 'dynamic', got {self.mode!r}")
+            raise InputError(Phrase("load mode must be 'static' or 'dynamic', got {mode}", mode=repr(self.mode)))
         for name in ("f_ext", "dp", "ddp"):
             object.__setattr__(self, name, _vec2(getattr(self, name), name))
 
@@ -92,8 +110,8 @@ class Forces:
     """Reference model (Pinocchio), shape (2,); None if unavailable (see ``note``)."""
     equation: str
     """Which equation produced ``tau``, for the label."""
-    note: str = ""
-    """Why ``tau`` or ``tau_ref`` is missing (one line), else empty."""
+    note: str | Phrase = ""
+    """Why ``tau`` or ``tau_ref`` is missing (one line; rendered with ``say``), else empty."""
 
     @property
     def diff(self) -> np.ndarray | None:
@@ -107,7 +125,8 @@ class Alert(NamedTuple):
     """One warning line and its kind: ``"inverse"``, ``"direct"`` or ``"stroke"``."""
 
     kind: str
-    text: str
+    text: Phrase
+    """The line (rendered in a tab's language with ``say``; ``str()``: English)."""
 
 
 @dataclass(frozen=True)
@@ -144,26 +163,26 @@ def _condition(j: np.ndarray) -> float:
 def _forces(params: Params, pose: Pose, load: Load, reference: Reference | None) -> Forces:
     dp, ddp, f_ext = load.motion()
     equation = "eq. 13: τ = J⁻ᵀ(−f_ext)" if load.mode == "static" else "eq. 31"
-    notes = []
+    notes: list[Phrase] = []
     try:
         tau = inverse_dynamics(params, pose.p, dp, ddp, f_ext, d=pose.d)
     except TpmVizError as exc:
-        tau, notes = None, [str(exc)]
+        tau, notes = None, [reason(exc)]
     if not _finite(tau):
         tau = None
     tau_ref = None
     if reference is None:
-        notes.append("no reference model")
+        notes.append(T("no reference model"))
     elif np.any(pose.branch(params) < 0):
-        notes.append("the Pinocchio model covers the working mode (eq. 4) only")
+        notes.append(T("the Pinocchio model covers the working mode (eq. 4) only"))
     else:
         try:
             tau_ref = np.asarray(reference(params, pose.p, dp, ddp, f_ext), dtype=float).reshape(2)
         except (TpmVizError, ArithmeticError, np.linalg.LinAlgError) as exc:
-            notes.append(f"reference model: {exc}")
+            notes.append(Phrase("reference model: {why}", why=reason(exc)))
         if not _finite(tau_ref):
             tau_ref = None
-    return Forces(tau, tau_ref, equation, "; ".join(notes))
+    return Forces(tau, tau_ref, equation, joined(notes))
 
 
 def evaluate(
@@ -193,12 +212,42 @@ def evaluate(
     for i in range(2):
         if stroke_end[i]:
             end = 0.0 if stroke_end[i] < 0 else params.stroke * 1e3
-            alerts.append(Alert("stroke", f"Actuator {i + 1} at its stroke end: d{i + 1} = {end:.1f} mm"))
+            alerts.append(
+                Alert(
+                    "stroke",
+                    Phrase(
+                        "Slider {i} is against its end-stop (d{i} = {end} mm): actuator {i} can only move it back "
+                        "into the stroke",
+                        i=i + 1,
+                        end=fixed(end, ".1f"),
+                    ),
+                )
+            )
     if near_direct:
-        alerts.append(Alert("direct", f"Near the direct singularity: cos(θ1+θ2) = {det_jx:.3f} (eq. 12)"))
+        alerts.append(
+            Alert(
+                "direct",
+                Phrase(
+                    "Near the direct singularity: the platform is losing its stiffness in one direction and the "
+                    "actuator forces grow without bound for a load along it (cos(θ1+θ2) = {value}, eq. 12)",
+                    value=fixed(det_jx, ".3f"),
+                ),
+            )
+        )
     for i in range(2):
         if near_inverse[i]:
-            alerts.append(Alert("inverse", f"Near an inverse singularity: cos θ{i + 1} = {cos[i]:.3f} (eq. 11)"))
+            alerts.append(
+                Alert(
+                    "inverse",
+                    Phrase(
+                        "Near an inverse singularity: the links of leg {i} stand almost perpendicular to rail {i}, "
+                        "so slider {i} must move far for a small platform motion along them (cos θ{i} = {value}, "
+                        "eq. 11)",
+                        i=i + 1,
+                        value=fixed(cos[i], ".3f"),
+                    ),
+                )
+            )
     return Readout(
         p=pose.p.copy(),
         d=pose.d.copy(),
