@@ -29,21 +29,10 @@ import numpy as np
 
 from tpm_viz.errors import InputError
 from tpm_viz.numbers import UNITS, parse_number, shorten, unit_factor
+from tpm_viz.words import Phrase, T
 
-__all__ = [
-    "MAX_BYTES",
-    "MAX_LINE",
-    "MAX_ROWS",
-    "OPTIONAL_COLUMNS",
-    "Table",
-    "decode_text",
-    "format_columns",
-    "parse_columns",
-    "read_columns",
-    "read_text",
-    "time_unit_note",
-    "write_columns",
-]
+__all__ = ["MAX_BYTES", "MAX_LINE", "MAX_ROWS", "OPTIONAL_COLUMNS", "Table", "decode_text", "format_columns"]
+__all__ += ["parse_columns", "read_columns", "read_text", "time_unit_note", "write_columns"]
 
 OPTIONAL_COLUMNS = ("t",)
 """Columns read when present and passed through to the output (time [s])."""
@@ -58,6 +47,20 @@ CHUNK = 65_536
 DELIMITERS = (";", "\t", ",")
 """Delimiters sniffed from the header line, in order of preference on a tie."""
 _ALIASES = {"time": "t"}
+
+# Refusals too long for their raise, marked for the catalogue (gettext's N_ idiom); raised as Phrase(X.template, ...)
+_NOT_TEXT = T("{source}: line {line} is not valid {code}; save the file as UTF-8")
+_TOO_BIG = T("{source} is larger than {mib} MiB (the limit); split the file")
+_BINARY = T("{source} is not a text CSV file (binary content on line {line})")
+_LONG_LINE = T("{source}: line {line} is longer than {most} characters (the limit)")
+_FILE_TOO_BIG = T("{source} is {size} MiB; inputs are limited to {mib} MiB")
+_NOT_CSV = T("{source}: line {line}: not valid CSV ({why})")
+_TWICE = T("{source}: column {name} appears twice in the header {header}")
+_MISSING = T("{source}: missing column {name} (need {need}); found header {header}")
+_CELLS = T("{source}: row {row} has {cells} cells, the header has {width}")
+_TOO_MANY = T("{source} has more than {limit} data rows (the limit); split the file")
+
+
 _QUANTITIES = "ddp:acceleration ddd:acceleration dp:velocity dd:velocity tau:force theta:angle p:length d:length"
 
 
@@ -112,7 +115,7 @@ def _binary_lines(raw, source: str, max_bytes: int) -> Iterator[str]:
         try:
             line = readline(MAX_LINE + 1)
         except UnicodeDecodeError:
-            raise InputError(f"{source}: line {n + 1} is not valid {enc.upper()}; save the file as UTF-8") from None
+            raise InputError(Phrase(_NOT_TEXT.template, source=source, line=n + 1, code=enc.upper())) from None
         if not line:
             return
         n += 1
@@ -123,11 +126,11 @@ def _binary_lines(raw, source: str, max_bytes: int) -> Iterator[str]:
                 line = _decode_line(line.encode("utf-8", "surrogateescape"))
         total += len(line)
         if total > max_bytes:
-            raise InputError(f"{source} is larger than {max_bytes // 1048576} MiB (the limit); split the file")
+            raise InputError(Phrase(_TOO_BIG.template, source=source, mib=max_bytes // 1048576))
         if "\x00" in line:
-            raise InputError(f"{source} is not a text CSV file (binary content on line {n})")
+            raise InputError(Phrase(_BINARY.template, source=source, line=n))
         if len(line) > MAX_LINE:
-            raise InputError(f"{source}: line {n} is longer than {MAX_LINE} characters (the limit)")
+            raise InputError(Phrase(_LONG_LINE.template, source=source, line=n, most=MAX_LINE))
         yield line.lstrip("\ufeff") if n == 1 else line
 
 
@@ -148,9 +151,8 @@ def _open_lines(path: str, max_bytes: int) -> tuple[Iterator[str], IO[bytes] | N
         raw = fh = open(path, "rb")
         try:
             if raw.seekable() and raw.seek(0, 2) > max_bytes:
-                raise InputError(
-                    f"{path} is {raw.tell() // 1048576} MiB; inputs are limited to {max_bytes // 1048576} MiB"
-                )
+                size, mib = raw.tell() // 1048576, max_bytes // 1048576
+                raise InputError(Phrase(_FILE_TOO_BIG.template, source=path, size=size, mib=mib))
             raw.seek(0)
         except BaseException:
             fh.close()
@@ -178,15 +180,17 @@ def read_columns(path: str, required: Sequence[str], max_rows: int = MAX_ROWS, m
             fh.close()
 
 
-def parse_columns(text: str, required: Sequence[str], source: str = "input", max_rows: int = MAX_ROWS) -> Table:
+def parse_columns(
+    text: str, required: Sequence[str], source: str | Phrase = "input", max_rows: int = MAX_ROWS
+) -> Table:
     """Parse CSV text into SI columns ``required`` (+ ``t`` if present); rules in the module docstring."""
     return parse_lines(_text_lines(text, source), required, source, max_rows)
 
 
-def _text_lines(text: str, source: str) -> Iterator[str]:
+def _text_lines(text: str, source: str | Phrase) -> Iterator[str]:
     for n, line in enumerate(io.StringIO(text, newline=""), start=1):
         if len(line) > MAX_LINE:
-            raise InputError(f"{source}: line {n} is longer than {MAX_LINE} characters (the limit)")
+            raise InputError(Phrase(_LONG_LINE.template, source=source, line=n, most=MAX_LINE))
         yield line.lstrip("\ufeff") if n == 1 else line
 
 
@@ -197,7 +201,7 @@ def _sniff(line: str) -> str:
 
 
 def parse_lines(
-    lines: Iterable[str], required: Sequence[str], source: str = "input", max_rows: int = MAX_ROWS
+    lines: Iterable[str], required: Sequence[str], source: str | Phrase = "input", max_rows: int = MAX_ROWS
 ) -> Table:
     """The streaming core of :func:`parse_columns` and :func:`read_columns` (``lines`` keep their line ends)."""
     lines = iter(lines)
@@ -214,7 +218,7 @@ def parse_lines(
         break
     need = ",".join(required)
     if header_line is None:
-        raise InputError(f"{source} is empty: expected a header with columns {need}")
+        raise InputError(Phrase("{source} is empty: expected a header with columns {need}", source=source, need=need))
     delimiter = delimiter or _sniff(header_line)
 
     def chained() -> Iterator[str]:
@@ -225,7 +229,8 @@ def parse_lines(
     try:
         return _read_records(reader, required, source, max_rows, skipped - 1, header_line)
     except csv.Error as exc:
-        raise InputError(f"{source}: line {skipped - 1 + reader.line_num}: not valid CSV ({exc})") from None
+        at = skipped - 1 + reader.line_num
+        raise InputError(Phrase(_NOT_CSV.template, source=source, line=at, why=str(exc))) from None
 
 
 def _read_records(reader, required, source, max_rows, offset, header_line) -> Table:
@@ -240,12 +245,13 @@ def _read_records(reader, required, source, max_rows, offset, header_line) -> Ta
             continue
         name, unit = _split_header(cell)
         if name in names and name in (*required, *OPTIONAL_COLUMNS):
-            raise InputError(f"{source}: column {name!r} appears twice in the header {shown}")
+            raise InputError(Phrase(_TWICE.template, source=source, name=repr(name), header=shown))
         names.setdefault(name, j)
         units.setdefault(name, unit)
     missing = [c for c in required if c not in names]
     if missing:
-        raise InputError(f"{source}: missing column {missing[0]!r} (need {','.join(required)}); found header {shown}")
+        need = ",".join(required)
+        raise InputError(Phrase(_MISSING.template, source=source, name=repr(missing[0]), need=need, header=shown))
     used = [c for c in OPTIONAL_COLUMNS if c in names and c not in required] + list(required)
     idx = [names[c] for c in used]
     factors = [
@@ -261,11 +267,11 @@ def _read_records(reader, required, source, max_rows, offset, header_line) -> Ta
             if not row or row[0].lstrip().startswith("#") or not any(c.strip() for c in row):
                 continue  # blank and comment lines
             if len(row) < width or any(c.strip() for c in row[width:]):
-                raise InputError(f"{source}: row {line} has {len(row)} cells, the header has {width}")
+                raise InputError(Phrase(_CELLS.template, source=source, row=line, cells=len(row), width=width))
         buf.append(row)
         where.append(line)
         if len(where) + CHUNK * len(chunks) > max_rows:
-            raise InputError(f"{source} has more than {max_rows} data rows (the limit); split the file")
+            raise InputError(Phrase(_TOO_MANY.template, source=source, limit=max_rows))
         if len(buf) == CHUNK:
             chunks.append(_numbers(buf, where, used, idx, source))
             buf, where = [], []
@@ -273,7 +279,7 @@ def _read_records(reader, required, source, max_rows, offset, header_line) -> Ta
         chunks.append(_numbers(buf, where, used, idx, source))
     data = np.concatenate(chunks)
     if len(data) == 0:
-        raise InputError(f"{source} has a header but no data rows")
+        raise InputError(Phrase("{source} has a header but no data rows", source=source))
     table = Table()
     for k, (c, (mul, div)) in enumerate(zip(used, factors, strict=True)):
         col = data[:, k]
@@ -284,7 +290,7 @@ def _read_records(reader, required, source, max_rows, offset, header_line) -> Ta
     return table
 
 
-def _numbers(rows: list[list[str]], where: list[int], used, idx, source: str) -> np.ndarray:
+def _numbers(rows: list[list[str]], where: list[int], used, idx, source: str | Phrase) -> np.ndarray:
     """The used cells of ``rows`` as floats ``(len(rows), len(used))``; one-line errors name row and column."""
     data = np.empty((len(rows), len(used)))
     for k, (c, j) in enumerate(zip(used, idx, strict=True)):
@@ -298,8 +304,10 @@ def _numbers(rows: list[list[str]], where: list[int], used, idx, source: str) ->
         bad = ~np.isfinite(data[:, k])
         if np.any(bad):
             r = int(np.argmax(bad))
-            what = "is not finite" if any(w in cells[r].lower() for w in ("nan", "inf")) else "is too large"
-            raise InputError(f"{source}: row {where[r]}, column {c!r}: {shorten(cells[r].strip())} {what}")
+            cell = {"source": source, "row": where[r], "column": repr(c), "text": shorten(cells[r].strip())}
+            if any(w in cells[r].lower() for w in ("nan", "inf")):
+                raise InputError(Phrase("{source}: row {row}, column {column}: {text} is not finite", **cell))
+            raise InputError(Phrase("{source}: row {row}, column {column}: {text} is too large", **cell))
     return data
 
 

@@ -3,6 +3,7 @@ example trajectories and the parameter presets; the Demos tab on a lecturer's ow
 
 from __future__ import annotations
 
+import html
 import pathlib
 import re
 import shutil
@@ -244,6 +245,19 @@ def test_the_demos_tab_takes_a_lecturers_lessons_and_lists_the_refused_files(tmp
     assert empty.choice.disabled and empty.play.disabled and "No lessons" in empty.text.content
     default = DemosView(SimpleNamespace(lang=Lang.EN), None, None, lambda: 1.0)
     assert default.lessons == DEMOS and default.problems == ()
+
+
+def test_a_refused_lesson_file_is_listed_in_the_tabs_language(tmp_path):
+    from tpm_viz.ui.teaching.lessons import problems_html
+
+    folder = _folder(tmp_path, {"01-a.toml": GOOD, "02-b.toml": GOOD.replace("[pose]", "[pose]\nmode = 2")})
+    _lessons, (problem,) = load_lessons(folder)
+    where = f"{folder / '02-b.toml'}:5: "
+    assert problem == where + "pose.mode must be 1 (working) or -1, got 2"  # English: the command line, the log
+    korean = problems_html((problem,), Lang.KO)
+    assert html.escape(where) in korean and "pose.mode" in korean and "1 (작업)" in korean
+    words = korean.replace(html.escape(where), "")  # the folder's name is the test's, in English
+    assert "must be" not in words and "refused" not in words
 
 
 def test_a_lecturer_lesson_without_camera_is_shown_in_the_app(request, tmp_path):

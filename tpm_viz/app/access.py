@@ -26,6 +26,7 @@ import time
 import weakref
 
 from tpm_viz.errors import InputError
+from tpm_viz.words import Phrase
 
 __all__ = ["LOCKOUT_SECONDS", "MAX_FAILURES", "MAX_FAILURES_SERVER", "MAX_LOCKOUT_SECONDS", "Access", "AccessDenied"]
 
@@ -35,7 +36,7 @@ MAX_LOCKOUT_SECONDS = 900.0
 MAX_FAILURES_SERVER = 30
 MAX_TOKEN_CHARS = 256
 
-DENIED = (
+DENIED = Phrase(
     "only the presenter can change the shared mechanism; tick 'Work on my own copy' (Class & view) "
     "to try it on your own copy"
 )
@@ -110,11 +111,17 @@ class Access:
         with self._lock:
             until, count = self._lockouts.get(where, (0.0, 0))
             if now < until:
-                raise InputError(f"too many wrong presenter tokens from this address; try again in {until - now:.0f} s")
+                raise InputError(
+                    Phrase(
+                        "too many wrong presenter tokens from this address; try again in {wait:.0f} s", wait=until - now
+                    )
+                )
             self._server_failures = [t for t in self._server_failures if now - t < LOCKOUT_SECONDS]
             if len(self._server_failures) >= MAX_FAILURES_SERVER:
                 wait = LOCKOUT_SECONDS - (now - self._server_failures[0])
-                raise InputError(f"too many wrong presenter tokens on this server; try again in {wait:.0f} s")
+                raise InputError(
+                    Phrase("too many wrong presenter tokens on this server; try again in {wait:.0f} s", wait=wait)
+                )
             text = attempt if isinstance(attempt, str) else ""
             ok = len(text) <= MAX_TOKEN_CHARS and hmac.compare_digest(text.encode(), self._token)
             if ok:

@@ -16,35 +16,26 @@ import importlib.util
 import math
 import pathlib
 import re
-import tomllib
-from typing import NoReturn
 
 import numpy as np
 
 from tpm_viz.app.demos import CHECK_NAMES, LANGUAGES, Camera, Check, Demo, Motion, demo_params, demo_pose, demo_source
+from tpm_viz.app.lesson_toml import MAX_FILE_BYTES, LessonError, Problem, Reader, line_of, parse
 from tpm_viz.app.moves import check, why_not
 from tpm_viz.app.overlays import MAP_KINDS
+from tpm_viz.app.readouts import reason
 from tpm_viz.app.runs import check_path
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.paper.trajectories import parse_trajectory_csv
 from tpm_viz.params import PARAM_INFO, Params
+from tpm_viz.words import Phrase, T
 
 __all__ = ["MAX_FILE_BYTES", "LessonError", "assets_dir", "load_lesson", "load_lessons", "load_preset"]
 
-MAX_FILE_BYTES = 256 * 1024
-"""Largest lesson, preset or lesson CSV file [bytes]."""
 MOTION_KINDS = ("line", "circle", "segment", "csv")
 TOP_KEYS = ("key", "title", "text", "params", "pose", "motion", "camera", "view", "checks")
 CHECK_SAMPLES = 101
 """Samples at which a lesson's motion is checked when it is loaded."""
-
-
-class LessonError(InputError):
-    """A lesson or preset file is refused: ``line`` (1-based) and what is wrong."""
-
-    def __init__(self, message: str, line: int = 1) -> None:
-        super().__init__(message)
-        self.line = line
 
 
 def assets_dir() -> pathlib.Path:
@@ -56,153 +47,44 @@ def assets_dir() -> pathlib.Path:
     return pathlib.Path(__file__).resolve().parents[2] / "assets"
 
 
-# --- where a key is written -------------------------------------------------------------------------------------
-
-_HEADER = re.compile(r"^\s*\[\s*([^\[\]]+?)\s*\]")
-_KEY = re.compile(r'^\s*((?:"[^"]*"|[A-Za-z0-9_-]+)(?:\s*\.\s*(?:"[^"]*"|[A-Za-z0-9_-]+))*)\s*=')
-
-
-def _dotted(name: str) -> list[str]:
-    return [part.strip().strip('"') for part in name.split(".")] if name else []
-
-
-def line_of(text: str, table: str, key: str = "") -> int:
-    """1-based line where ``key`` is set in ``[table]`` (``table`` "" for the top level, ``key`` "" for the table
-    itself: its header, or its first dotted key such as ``text.en = ...``); 1 if not found."""
-    target = _dotted(table) + ([key] if key else [])
-    current: list[str] = []
-    in_string = False
-    for number, line in enumerate(text.splitlines(), 1):
-        was_in_string = in_string
-        if line.count('"""') % 2 or line.count("'''") % 2:
-            in_string = not in_string
-        if was_in_string:
-            continue
-        header = _HEADER.match(line)
-        if header:
-            current = _dotted(header.group(1))
-            if current == target:
-                return number
-            continue
-        found = _KEY.match(line)
-        if found and target and (current + _dotted(found.group(1)))[: len(target)] == target:
-            return number
-    return 1
-
-
-class _Reader:
-    """Typed access to one parsed file, raising :class:`LessonError` at the line of the offending key."""
-
-    def __init__(self, text: str, data: dict) -> None:
-        self.text = text
-        self.data = data
-
-    def fail(self, table: str, key: str, message: str) -> NoReturn:
-        raise LessonError(message, line_of(self.text, table, key))
-
-    def table(self, name: str, known: tuple[str, ...] | None, required: bool = False) -> dict:
-        value = self.data.get(name)
-        if value is None:
-            if required:
-                self.fail("", "", f"missing [{name}]")
-            return {}
-        if not isinstance(value, dict):
-            self.fail("", name, f"{name} must be a table ([{name}])")
-        if known is not None:
-            for key in value:
-                if key not in known:
-                    self.fail(name, key, f"unknown key {name}.{key}; known: {', '.join(known)}")
-        return value
-
-    def number(self, table: str, values: dict, key: str, lo: float = -math.inf, hi: float = math.inf) -> float:
-        value = values[key]
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            self.fail(table, key, f"{_name(table, key)} must be a finite number, got {value!r}")
-        if not lo <= value <= hi:
-            self.fail(table, key, f"{_name(table, key)} must be from {lo:g} to {hi:g}, got {value!r}")
-        return float(value)
-
-    def vector(self, table: str, values: dict, key: str, size: int) -> tuple[float, ...]:
-        value = values[key]
-        ok = isinstance(value, list) and len(value) == size
-        if not ok or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in value):
-            self.fail(table, key, f"{_name(table, key)} must be a list of {size} numbers [SI], got {value!r}")
-        out = tuple(float(v) for v in value)
-        if not all(math.isfinite(v) for v in out):
-            self.fail(table, key, f"{_name(table, key)} must be finite, got {value!r}")
-        return out
-
-    def string(self, table: str, values: dict, key: str, choices: tuple[str, ...] | None = None) -> str:
-        value = values[key]
-        if not isinstance(value, str) or not value.strip():
-            self.fail(table, key, f"{_name(table, key)} must be a non-empty string, got {value!r}")
-        if choices is not None and value not in choices:
-            self.fail(table, key, f"{_name(table, key)} must be one of {', '.join(choices)}; got {value!r}")
-        return value
-
-
-def _name(table: str, key: str) -> str:
-    return f"{table}.{key}" if table else key
-
-
-def _parse(path: pathlib.Path) -> tuple[str, dict]:
-    """The text and the TOML data of ``path`` (:class:`LessonError` with the line on any problem)."""
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise LessonError(f"cannot read: {exc.strerror or exc}") from None
-    if len(raw) > MAX_FILE_BYTES:
-        raise LessonError(f"larger than {MAX_FILE_BYTES // 1024} KiB")
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise LessonError("not UTF-8 text", raw[: exc.start].count(b"\n") + 1) from None
-    try:
-        return text, tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        found = re.search(r"\(at line (\d+), column (\d+)\)", str(exc))
-        what = re.sub(r"\s*\(at line \d+, column \d+\)|\s*\(at end of document\)", "", str(exc))
-        if found:
-            raise LessonError(f"TOML: {what} (column {found.group(2)})", int(found.group(1))) from None
-        raise LessonError(f"TOML: {what}", text.count("\n") + 1) from None
-
-
-def _params(r: _Reader) -> tuple[tuple[str, float], ...]:
+def _params(r: Reader) -> tuple[tuple[str, float], ...]:
     values = r.table("params", tuple(PARAM_INFO))
     overrides = tuple((key, r.number("params", values, key)) for key in values)
     try:
         Params.paper().replace(**dict(overrides))
     except TpmVizError as exc:
         named = [key for key, _ in overrides if re.search(rf"\b{re.escape(key)}\b", str(exc))]
-        r.fail("params", named[0] if named else "", f"parameters refused: {exc}")
+        r.fail("params", named[0] if named else "", Phrase("parameters refused: {why}", why=reason(exc)))
     return overrides
 
 
-def _motion(r: _Reader, path: pathlib.Path) -> tuple[Motion | None, tuple[float, ...]]:
+def _motion(r: Reader, path: pathlib.Path) -> tuple[Motion | None, tuple[float, ...]]:
     t = "motion"
     values = r.table(t, ("kind", "duration", "start", "end", "file", "compare"))
     if not values:
         return None, ()
     if "kind" not in values:
-        r.fail(t, "", "[motion] needs kind")
+        r.fail(t, "", Phrase("[motion] needs kind"))
     kind = r.string(t, values, "kind", MOTION_KINDS)
     if "duration" not in values and kind != "csv":
-        r.fail(t, "", f"a {kind} motion needs motion.duration [s]")
+        r.fail(t, "", Phrase("a {kind} motion needs motion.duration [s]", kind=kind))
     duration = r.number(t, values, "duration", 0.01, 100.0) if "duration" in values else math.nan
     compare: tuple[float, ...] = ()
     if "compare" in values:
         raw = values["compare"]
         if not isinstance(raw, list) or len(raw) != 2:
-            r.fail(t, "compare", f"motion.compare must be a list of 2 durations [s], got {raw!r}")
+            r.fail(t, "compare", Phrase("motion.compare must be a list of 2 durations [s], got {got}", got=repr(raw)))
         compare = r.vector(t, values, "compare", 2)
         if not all(0.01 <= v <= 100.0 for v in compare):
-            r.fail(t, "compare", f"motion.compare durations must be from 0.01 to 100 s, got {raw!r}")
+            r.fail(
+                t, "compare", Phrase("motion.compare durations must be from 0.01 to 100 s, got {got}", got=repr(raw))
+            )
     needs = {"segment": ("start", "end"), "csv": ("file",)}.get(kind, ())
     for key in ("start", "end", "file"):
         if key in needs and key not in values:
-            r.fail(t, "kind", f"a {kind} motion needs motion.{key}")
+            r.fail(t, "kind", Phrase("a {kind} motion needs motion.{key}", kind=kind, key=key))
         if key not in needs and key in values:
-            r.fail(t, key, f"motion.{key} does not apply to a {kind} motion")
+            r.fail(t, key, Phrase("motion.{key} does not apply to a {kind} motion", key=key, kind=kind))
     if kind == "segment":
         start, end = r.vector(t, values, "start", 2), r.vector(t, values, "end", 2)
         return Motion(kind, duration, start, end), compare  # type: ignore[arg-type]
@@ -211,46 +93,50 @@ def _motion(r: _Reader, path: pathlib.Path) -> tuple[Motion | None, tuple[float,
         try:
             csv = (path.parent / name).read_bytes()
             if len(csv) > MAX_FILE_BYTES:
-                raise InputError(f"larger than {MAX_FILE_BYTES // 1024} KiB")
+                raise InputError(Phrase("larger than {limit} KiB", limit=MAX_FILE_BYTES // 1024))
             traj = parse_trajectory_csv(csv.decode("utf-8-sig"), name=pathlib.Path(name).stem)
         except OSError as exc:
-            r.fail(t, "file", f"motion.file {name!r}: {exc.strerror or exc}")
+            r.fail(t, "file", Phrase("motion.file {name}: {why}", name=repr(name), why=exc.strerror or str(exc)))
         except (TpmVizError, UnicodeDecodeError) as exc:
-            r.fail(t, "file", f"motion.file {name!r}: {exc}")
+            r.fail(t, "file", Phrase("motion.file {name}: {why}", name=repr(name), why=reason(exc)))
         if math.isnan(duration):
             duration = traj.duration  # the file's own timing
         return Motion(kind, duration, file=name, trajectory=traj), compare
     return Motion(kind, duration), compare
 
 
-def _pose(r: _Reader) -> dict:
+def _pose(r: Reader) -> dict:
     values = r.table("pose", ("p", "d", "mode"))
     out: dict = {}
     if "p" in values and "d" in values:
-        r.fail("pose", "d", "give pose.p (platform) or pose.d (actuators), not both")
+        r.fail("pose", "d", Phrase("give pose.p (platform) or pose.d (actuators), not both"))
     if "p" in values:
         out["p"] = r.vector("pose", values, "p", 2)
     if "d" in values:
         out["d"] = r.vector("pose", values, "d", 2)
     if "mode" in values:
         if values["mode"] not in (1, -1) or isinstance(values["mode"], bool):
-            r.fail("pose", "mode", f"pose.mode must be 1 (working) or -1, got {values['mode']!r}")
+            r.fail("pose", "mode", Phrase("pose.mode must be 1 (working) or -1, got {got}", got=repr(values["mode"])))
         if "d" not in values:
-            r.fail("pose", "mode", "pose.mode applies to pose.d only (pose.p is in the working mode)")
+            r.fail("pose", "mode", Phrase("pose.mode applies to pose.d only (pose.p is in the working mode)"))
         out["mode"] = values["mode"]
     return out
 
 
-def _checks(r: _Reader) -> tuple[Check, ...]:
+def _checks(r: Reader) -> tuple[Check, ...]:
     values = r.table("checks", tuple(CHECK_NAMES))
     out = []
     for name, value in values.items():
         if isinstance(value, dict):
             for key in value:
                 if key not in ("value", "tol"):
-                    r.fail("checks", name, f"checks.{name}: unknown key {key!r}; known: value, tol")
+                    r.fail(
+                        "checks",
+                        name,
+                        Phrase("checks.{name}: unknown key {key}; known: value, tol", name=name, key=repr(key)),
+                    )
             if "value" not in value:
-                r.fail("checks", name, f"checks.{name} needs a value")
+                r.fail("checks", name, Phrase("checks.{name} needs a value", name=name))
             stated = r.number("checks", value, "value")
             tol = r.number("checks", value, "tol", 0.0) if "tol" in value else None
             out.append(Check(name, stated, tol))
@@ -267,41 +153,41 @@ def _key_of(path: pathlib.Path) -> str:
 def load_lesson(path) -> Demo:
     """One lesson file (raises :class:`LessonError`; its ``line`` says where)."""
     path = pathlib.Path(path)
-    text, data = _parse(path)
-    r = _Reader(text, data)
+    text, data = parse(path)
+    r = Reader(text, data)
     for key in data:
         if key not in TOP_KEYS:
-            r.fail("", key, f"unknown key {key!r}; known: {', '.join(TOP_KEYS)}")
+            r.fail("", key, Phrase("unknown key {key}; known: {known}", key=repr(key), known=", ".join(TOP_KEYS)))
     if "title" not in data:
-        r.fail("", "", "missing title")
+        r.fail("", "", Phrase("missing title"))
     title = r.string("", data, "title")
     key = r.string("", data, "key") if "key" in data else _key_of(path)
     if isinstance(data.get("text"), str):
-        r.fail("", "text", 'text must be a table of languages: [text] en = "..."')
+        r.fail("", "text", Phrase('text must be a table of languages: [text] en = "..."'))
     texts = r.table("text", LANGUAGES, required=True)
     if "en" not in texts:
-        r.fail("text", "", "missing text.en (the English paragraph)")
+        r.fail("text", "", Phrase("missing text.en (the English paragraph)"))
     paragraphs = {lang: " ".join(r.string("text", texts, lang).split()) for lang in texts}
     camera_values = r.table("camera", ("position", "look_at"))
     camera = None
     if camera_values:
         for name in ("position", "look_at"):
             if name not in camera_values:
-                r.fail("camera", "", f"[camera] needs {name}")
+                r.fail("camera", "", Phrase("[camera] needs {name}", name=name))
         position, look_at = (r.vector("camera", camera_values, k, 3) for k in ("position", "look_at"))
         camera = Camera(position, look_at)  # type: ignore[arg-type]
     view = r.table("view", ("map", "ellipses"))
     map_kind = r.string("view", view, "map", tuple(MAP_KINDS)) if "map" in view else "off"
     ellipses = view.get("ellipses", False)
     if not isinstance(ellipses, bool):
-        r.fail("view", "ellipses", f"view.ellipses must be true or false, got {ellipses!r}")
+        r.fail("view", "ellipses", Phrase("view.ellipses must be true or false, got {got}", got=repr(ellipses)))
     params = _params(r)
     motion, compare = _motion(r, path)
     pose = _pose(r)
     if motion is not None and pose:
-        r.fail("pose", "", "give [pose] or [motion], not both (a motion starts at its first point)")
+        r.fail("pose", "", Phrase("give [pose] or [motion], not both (a motion starts at its first point)"))
     if motion is None and not pose:
-        r.fail("", "", "a lesson needs [pose] (p or d) or [motion]")
+        r.fail("", "", Phrase("a lesson needs [pose] (p or d) or [motion]"))
     demo = Demo(
         key=key,
         title=title,
@@ -321,7 +207,7 @@ def load_lesson(path) -> Demo:
     return demo
 
 
-def _check_scene(r: _Reader, demo: Demo) -> None:
+def _check_scene(r: Reader, demo: Demo) -> None:
     """Refuse a pose or a motion that leaves the valid set (the same rules as a drag or an upload)."""
     params = demo_params(demo)
     where = ("motion", "") if demo.motion is not None else ("pose", "")
@@ -330,17 +216,22 @@ def _check_scene(r: _Reader, demo: Demo) -> None:
         source = demo_source(demo)
         if source is not None:
             t = np.linspace(0.0, source.duration, CHECK_SAMPLES)
-            check_path(params, t, source.motion(t)[0], what="the motion")
+            check_path(params, t, source.motion(t)[0], what=T("the motion"))
         else:
             status = check(params, pose)
             if status:
-                raise InputError(f"the pose: {why_not(params, status, pose.p, pose.d)}")
+                raise InputError(Phrase("the pose: {why}", why=why_not(params, status, pose.p, pose.d)))
     except TpmVizError as exc:
-        what = str(exc)
-        r.fail(*where, what if what.startswith(("the pose", "the motion")) else f"the {where[0]}: {what}")
+        why = reason(exc)
+        if str(why).startswith(("the pose", "the motion")):
+            r.fail(*where, why)
+        r.fail(
+            *where,
+            Phrase("the motion: {why}", why=why) if demo.motion is not None else Phrase("the pose: {why}", why=why),
+        )
 
 
-def load_lessons(directory) -> tuple[tuple[Demo, ...], tuple[str, ...]]:
+def load_lessons(directory) -> tuple[tuple[Demo, ...], tuple[Problem, ...]]:
     """Every ``*.toml`` lesson of ``directory`` (or the one lesson file it names) in file-name order, and one line
     ``file:line: what is wrong`` per file refused (the others still load). A key or a title used by an earlier file
     is refused too."""
@@ -348,13 +239,13 @@ def load_lessons(directory) -> tuple[tuple[Demo, ...], tuple[str, ...]]:
     if directory.is_file() and directory.suffix == ".toml":
         files = [directory]  # one lesson file
     elif not directory.is_dir():
-        return (), (f"{directory}: not a folder of lessons",)
+        return (), (Problem(Phrase("{path}: not a folder of lessons", path=str(directory))),)
     else:
         files = sorted(p for p in directory.glob("*.toml") if not p.name.startswith("."))  # no editor backups
     if not files:
-        return (), (f"{directory}: no lesson files (*.toml)",)
+        return (), (Problem(Phrase("{path}: no lesson files (*.toml)", path=str(directory))),)
     lessons: list[Demo] = []
-    problems: list[str] = []
+    problems: list[Problem] = []
     for path in files:
         try:
             demo = load_lesson(path)
@@ -362,9 +253,17 @@ def load_lessons(directory) -> tuple[tuple[Demo, ...], tuple[str, ...]]:
                 for what in ("key", "title"):
                     if getattr(other, what) == getattr(demo, what):
                         line = line_of(path.read_text(encoding="utf-8-sig"), "", what)
-                        raise LessonError(f"{what} {getattr(demo, what)!r} is already used by {other.source}", line)
+                        raise LessonError(
+                            Phrase(
+                                "{what} {value} is already used by {other}",
+                                what=what,
+                                value=repr(getattr(demo, what)),
+                                other=other.source,
+                            ),
+                            line,
+                        )
         except LessonError as exc:
-            problems.append(f"{path}:{exc.line}: {exc}")
+            problems.append(Problem(Phrase("{path}:{line}: {why}", path=str(path), line=exc.line, why=reason(exc))))
             continue
         lessons.append(demo)
     return tuple(lessons), tuple(problems)
@@ -374,11 +273,11 @@ def load_preset(path) -> Params:
     """A parameter preset (``assets/presets/*.toml``): ``name``, ``description`` and a ``[params]`` table of
     overrides of the paper's prototype in SI units; raises :class:`LessonError` (with the line) if refused."""
     path = pathlib.Path(path)
-    text, data = _parse(path)
-    r = _Reader(text, data)
+    text, data = parse(path)
+    r = Reader(text, data)
     for key in data:
         if key not in ("name", "description", "params"):
-            r.fail("", key, f"unknown key {key!r}; known: name, description, params")
+            r.fail("", key, Phrase("unknown key {key}; known: name, description, params", key=repr(key)))
     for key in ("name", "description"):
         if key in data:
             r.string("", data, key)

@@ -246,7 +246,7 @@ def drag_to(params: Params, pose: Pose, p_req, limits: SingularityThresholds = M
     """
     p_req = np.asarray(p_req, dtype=float).reshape(-1)
     if p_req.shape != (2,) or not np.all(np.isfinite(p_req)):
-        raise InputError(f"requested platform position must be two finite numbers, got {p_req!r}")
+        raise InputError(Phrase("requested platform position must be two finite numbers, got {got}", got=repr(p_req)))
     branch, mode = pose.branch(params), pose.mode(params)
     codes_of = _drag_codes(params, branch, mode, limits)
     p0 = pose.p.astype(float)
@@ -317,7 +317,7 @@ def drive_to(params: Params, pose: Pose, d_req, limits: SingularityThresholds = 
     """
     d_req = np.asarray(d_req, dtype=float).reshape(-1)
     if d_req.shape != (2,) or not np.all(np.isfinite(d_req)):
-        raise InputError(f"requested actuator positions must be two finite numbers, got {d_req!r}")
+        raise InputError(Phrase("requested actuator positions must be two finite numbers, got {got}", got=repr(d_req)))
     branch, mode = pose.branch(params), pose.mode(params)
 
     def codes_of(d: np.ndarray) -> np.ndarray:
@@ -354,7 +354,7 @@ def place(params: Params, pose: Pose, p, limits: SingularityThresholds = MOVE_LI
     """Jump to ``p`` [m] in the working mode (eq. 4), e.g. a trajectory sample; refused if not valid there."""
     p = np.asarray(p, dtype=float).reshape(-1)
     if p.shape != (2,) or not np.all(np.isfinite(p)):
-        raise InputError(f"platform position must be two finite numbers, got {p!r}")
+        raise InputError(Phrase("platform position must be two finite numbers, got {got}", got=repr(p)))
     d = ik_branch(params, p, (1.0, 1.0))
     if not np.all(np.isfinite(d)):
         return Move(pose, True, Phrase("refused: {why}", why=why_not(params, PoseStatus.UNREACHABLE, p, d)))

@@ -24,9 +24,11 @@ from enum import Enum
 import numpy as np
 
 from tpm_viz.errors import InputError
+from tpm_viz.numbers import fixed
 from tpm_viz.paper.jacobians import classify
-from tpm_viz.paper.status import MOVE_LIMITS, PoseStatus, SingularityThresholds
+from tpm_viz.paper.status import MOVE_LIMITS, STATUS_WORDS, PoseStatus, SingularityThresholds
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase
 
 __all__ = [
     "CHECK_STEP",
@@ -119,7 +121,7 @@ class GeometricPath:
             return np.where(arc, tangent, self.direction[k])
         if order == 2:
             return np.where(arc, -radial / safe_r, 0.0)
-        raise InputError(f"path derivative order must be 0, 1 or 2, got {order!r}")
+        raise InputError(Phrase("path derivative order must be 0, 1 or 2, got {got}", got=repr(order)))
 
     def __call__(self, s, order: int = 0) -> np.ndarray:
         """Same as :meth:`evaluate` (the call signature of toppra's geometric paths)."""
@@ -163,7 +165,7 @@ def _chain(kind: PathKind, name: str, pieces: list[tuple]) -> GeometricPath:
                     (radius * abs(sweep), (0.0, 0.0), (1.0, 0.0), centre, radius, phi0, math.copysign(1, sweep))
                 )
     if not rows:
-        raise InputError("the path has zero length: give two distinct points at least")
+        raise InputError(Phrase("the path has zero length: give two distinct points at least"))
     seg_len = np.array([r[0] for r in rows])
     return GeometricPath(
         kind=kind,
@@ -187,7 +189,7 @@ def line_path(start=(-0.100, -0.050), end=(0.100, 0.050)) -> GeometricPath:
 def circle_path(centre=(0.0, 0.0), radius: float = 0.100) -> GeometricPath:
     """The circle of the paper's Fig. 5: one counter-clockwise turn from ``centre + (radius, 0)`` [m]."""
     if not (math.isfinite(radius) and radius > 0):
-        raise InputError(f"the circle radius must be a positive number of metres, got {radius!r}")
+        raise InputError(Phrase("the circle radius must be a positive number of metres, got {got}", got=repr(radius)))
     return _chain(PathKind.CIRCLE, "circle", [("arc", tuple(centre), float(radius), 0.0, 2 * math.pi)])
 
 
@@ -199,16 +201,20 @@ def _polyline(kind: PathKind, name: str, points, radius: float) -> GeometricPath
     """
     pts = np.asarray(points, dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 2:
-        raise InputError(f"a path needs at least two points (x, y), got an array of shape {pts.shape}")
+        raise InputError(
+            Phrase("a path needs at least two points (x, y), got an array of shape {shape}", shape=str(pts.shape))
+        )
     if not np.all(np.isfinite(pts)):
-        raise InputError("a waypoint is not finite (NaN or inf)")
+        raise InputError(Phrase("a waypoint is not finite (NaN or inf)"))
     if not (math.isfinite(radius) and radius >= 0):
-        raise InputError(f"the corner radius must be zero or a positive number of metres, got {radius!r}")
+        raise InputError(
+            Phrase("the corner radius must be zero or a positive number of metres, got {got}", got=repr(radius))
+        )
     seg = np.diff(pts, axis=0)
     lengths = np.hypot(seg[:, 0], seg[:, 1])
     if np.any(lengths < 1e-9):
         k = int(np.argmax(lengths < 1e-9))
-        raise InputError(f"waypoints {k + 1} and {k + 2} coincide: remove one of them")
+        raise InputError(Phrase("waypoints {k} and {next} coincide: remove one of them", k=k + 1, next=k + 2))
     units = seg / lengths[:, None]
     pieces: list[tuple] = []
     cursor = pts[0]
@@ -217,10 +223,10 @@ def _polyline(kind: PathKind, name: str, points, radius: float) -> GeometricPath
         cross = u_in[0] * u_out[1] - u_in[1] * u_out[0]
         turn = math.atan2(cross, float(u_in @ u_out))  # signed turn angle α [rad]
         if abs(turn) > math.pi - 1e-6:
-            raise InputError(f"the path reverses direction at waypoint {k + 1}: split it into two moves")
+            raise InputError(Phrase("the path reverses direction at waypoint {k}: split it into two moves", k=k + 1))
         if abs(turn) < 1e-9 or radius == 0:
             if radius == 0 and abs(turn) >= 1e-9:
-                raise InputError(f"a sharp corner at waypoint {k + 1} needs a corner radius above zero")
+                raise InputError(Phrase("a sharp corner at waypoint {k} needs a corner radius above zero", k=k + 1))
             continue
         half = math.tan(abs(turn) / 2)
         r = min(radius, 0.5 * min(lengths[k - 1], lengths[k]) / half)
@@ -251,9 +257,13 @@ def pick_and_place(start=(0.0, 0.0), size: PickSize = DEFAULT_PICK) -> Geometric
     """
     h, w, r = float(size.h), float(size.w), float(size.r)
     if not all(math.isfinite(x) and x > 0 for x in (h, w)):
-        raise InputError(f"pick-and-place rise and span must be positive lengths, got h={h!r}, w={w!r}")
+        raise InputError(
+            Phrase("pick-and-place rise and span must be positive lengths, got h={h}, w={w}", h=repr(h), w=repr(w))
+        )
     if not (math.isfinite(r) and 0 < r <= h and 2 * r <= w):
-        raise InputError(f"the corner radius {r * 1e3:g} mm must be above 0, at most h and at most w/2")
+        raise InputError(
+            Phrase("the corner radius {r} mm must be above 0, at most h and at most w/2", r=fixed(r, "g", 1e3))
+        )
     x, y = float(start[0]), float(start[1])
     pts = [(x, y), (x, y + h), (x + w, y + h), (x + w, y)]
     return _polyline(PathKind.PICK, "pick", pts, r)
@@ -273,8 +283,15 @@ def check_path(params: Params, path: GeometricPath, thresholds: SingularityThres
     if bad.size:
         k = int(bad[0])
         raise InputError(
-            f"the {path.name} path leaves the valid region at ({p[k, 0] * 1e3:.1f}, {p[k, 1] * 1e3:.1f}) mm "
-            f"({s[k] * 1e3:.1f} mm along it): {PoseStatus(int(status[k])).label}; move or shrink the path"
+            Phrase(
+                "the {name} path leaves the valid region at ({x}, {y}) mm ({along} mm along it): {why}; move or "
+                "shrink the path",
+                name=path.name,
+                x=fixed(p[k, 0], ".1f", 1e3),
+                y=fixed(p[k, 1], ".1f", 1e3),
+                along=fixed(s[k], ".1f", 1e3),
+                why=STATUS_WORDS[PoseStatus(int(status[k]))],
+            )
         )
 
 
@@ -284,7 +301,7 @@ def _valid_centre(params: Params, thresholds: SingularityThresholds) -> np.ndarr
     grid = np.stack(np.meshgrid(xs, xs), -1).reshape(-1, 2)
     ok = classify(params, grid, thresholds) == PoseStatus.REGULAR
     if not np.any(ok):
-        raise InputError("the parameters leave no valid workspace: change the stroke or the lengths")
+        raise InputError(Phrase("the parameters leave no valid workspace: change the stroke or the lengths"))
     return grid[ok].mean(axis=0)
 
 
@@ -310,7 +327,7 @@ def default_pick(
         except InputError:
             continue
         return path
-    raise InputError("no pick-and-place cycle fits in the valid workspace of these parameters")
+    raise InputError(Phrase("no pick-and-place cycle fits in the valid workspace of these parameters"))
 
 
 def path_for(
@@ -325,7 +342,13 @@ def path_for(
     try:
         kind = PathKind(kind)
     except ValueError:
-        raise InputError(f"path kind must be one of {', '.join(k.value for k in PathKind)}, got {kind!r}") from None
+        raise InputError(
+            Phrase(
+                "path kind must be one of {kinds}, got {got}",
+                kinds=", ".join(k.value for k in PathKind),
+                got=repr(kind),
+            )
+        ) from None
     radius = DEFAULT_CORNER_RADIUS if corner_radius is None else float(corner_radius)
     if kind is PathKind.LINE:
         path = line_path()
@@ -337,7 +360,7 @@ def path_for(
         path = pick_and_place(np.asarray(points, float).reshape(-1, 2)[0], pick or DEFAULT_PICK)
     else:
         if points is None:
-            raise InputError("a waypoint path needs its points")
+            raise InputError(Phrase("a waypoint path needs its points"))
         path = waypoint_path(points, radius)
     check_path(params, path)
     return path

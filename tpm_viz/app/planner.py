@@ -39,6 +39,7 @@ from tpm_viz.errors import InputError
 from tpm_viz.paper.dynamics import inverse_dynamics
 from tpm_viz.paper.jacobians import actuator_velocity
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase, T
 
 __all__ = ["CHECK_RATE", "DEFAULT_GRID", "Limits", "Plan", "PlanSamples", "plan_cycle", "plan_path"]
 
@@ -53,17 +54,23 @@ MAX_DURATION = 1e4
 MAX_CHECK = 200_000
 
 
-def _limit(value, name: str, unit: str, top: float = 1e9) -> float | None:
+def _limit(value, name: str | Phrase, unit: str | Phrase, top: float = 1e9) -> float | None:
     if value is None:
         return None
     try:
         value = float(value)
     except (TypeError, ValueError):
-        raise InputError(f"{name} must be a number of {unit}, got {value!r}") from None
+        raise InputError(
+            Phrase("{name} must be a number of {unit}, got {got}", name=name, unit=unit, got=repr(value))
+        ) from None
     if not math.isfinite(value) or value <= 0:
-        raise InputError(f"{name} must be a positive, finite number of {unit}, got {value:g}")
+        raise InputError(
+            Phrase("{name} must be a positive, finite number of {unit}, got {got:g}", name=name, unit=unit, got=value)
+        )
     if not 1e-6 <= value <= top:
-        raise InputError(f"{name} must be from 1e-06 to {top:g} {unit}, got {value:g}")
+        raise InputError(
+            Phrase("{name} must be from 1e-06 to {top:g} {unit}, got {got:g}", name=name, unit=unit, top=top, got=value)
+        )
     return value
 
 
@@ -76,9 +83,9 @@ class Limits:
     actuator_speed: float | None = None
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "force", _limit(self.force, "the force limit", "newtons"))
-        object.__setattr__(self, "speed", _limit(self.speed, "the speed limit", "m/s"))
-        object.__setattr__(self, "actuator_speed", _limit(self.actuator_speed, "the actuator speed limit", "m/s"))
+        object.__setattr__(self, "force", _limit(self.force, T("the force limit"), T("newtons")))
+        object.__setattr__(self, "speed", _limit(self.speed, T("the speed limit"), "m/s"))
+        object.__setattr__(self, "actuator_speed", _limit(self.actuator_speed, T("the actuator speed limit"), "m/s"))
 
 
 @dataclass(frozen=True)
@@ -194,7 +201,9 @@ def _toppra_speeds(rows: tuple, s_grid: np.ndarray) -> np.ndarray:
     algo.compute_parameterization(0.0, 0.0)
     data = algo.problem_data
     if data.return_code != ParameterizationReturnCode.Ok or data.sd_vec is None:
-        raise InputError(f"no feasible timing within the limits along this path ({data.return_code.value})")
+        raise InputError(
+            Phrase("no feasible timing within the limits along this path ({code})", code=data.return_code.value)
+        )
     return np.maximum(np.asarray(data.sd_vec, float).ravel(), 0.0)
 
 
@@ -214,10 +223,16 @@ def _plan_one(params: Params, path: GeometricPath, limits: Limits, grid: int, ra
     xmax = _speed_bound(params, path, s_grid, limits) / lam**2
     sd = lam * _toppra_speeds(_interpolation_rows(start, end, xmax, s_grid / lam), s_grid / lam)
     if not np.all(sd[1:-1] > 0):
-        raise InputError("no feasible timing within the limits along this path: raise the limits or the grid")
+        raise InputError(Phrase("no feasible timing within the limits along this path: raise the limits or the grid"))
     law = _TimeLaw.from_speeds(s_grid, sd)
     if not law.t_grid[-1] <= MAX_DURATION:
-        raise InputError(f"the motion would last {law.t_grid[-1]:.3g} s (over {MAX_DURATION:g} s): raise the limits")
+        raise InputError(
+            Phrase(
+                "the motion would last {t:.3g} s (over {most:g} s): raise the limits",
+                t=float(law.t_grid[-1]),
+                most=MAX_DURATION,
+            )
+        )
     t = np.linspace(0.0, law.t_grid[-1], min(max(math.ceil(law.t_grid[-1] * rate) + 1, 2), MAX_CHECK))
     peak = float(np.max(np.abs(_state(params, path, law, t)[-1]))) / limits.force
     return law.scaled(math.sqrt(peak)) if peak > 1.0 else law
@@ -285,11 +300,15 @@ class Plan:
 
     def samples(self, rate: float = CHECK_RATE) -> PlanSamples:
         """The states at ``t = k / rate`` [s], plus the start and end of every move (exact times)."""
-        checked = _limit(rate, "the sample rate", "Hz")
+        checked = _limit(rate, T("the sample rate"), "Hz")
         rate = CHECK_RATE if checked is None else checked
         n = math.floor(self.duration * rate) + 1
         if n > MAX_SAMPLES:
-            raise InputError(f"{n} samples are too many: lower the sample rate (at most {MAX_SAMPLES} samples)")
+            raise InputError(
+                Phrase(
+                    "{n} samples are too many: lower the sample rate (at most {most} samples)", n=n, most=MAX_SAMPLES
+                )
+            )
         marks = np.append(self.starts, self.duration)
         ticks = np.arange(n) / rate
         ticks = ticks[np.min(np.abs(ticks[:, None] - marks[None, :]), axis=1) > 1e-9 / rate]
@@ -316,7 +335,11 @@ class PlanSamples:
 
 def _check_grid(grid) -> int:
     if isinstance(grid, bool) or not isinstance(grid, (int, np.integer)) or not 10 <= grid <= MAX_GRID:
-        raise InputError(f"the grid must be a whole number of points from 10 to {MAX_GRID}, got {grid!r}")
+        raise InputError(
+            Phrase(
+                "the grid must be a whole number of points from 10 to {most}, got {got}", most=MAX_GRID, got=repr(grid)
+            )
+        )
     return int(grid)
 
 

@@ -25,8 +25,10 @@ from tpm_viz.app.paths import GeometricPath, path_for
 from tpm_viz.app.planner import Limits, Plan, PlanSamples, plan_cycle, plan_path
 from tpm_viz.app.sizing import Sizing, size_motion, size_trajectory
 from tpm_viz.errors import InputError
+from tpm_viz.numbers import shorten
 from tpm_viz.paper.dynamics import inverse_dynamics
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase
 
 __all__ = [
     "INDUSTRY",
@@ -51,19 +53,23 @@ MAX_WAYPOINTS = 50
 def parse_waypoints(text: str) -> np.ndarray:
     """``"x,y; x,y; ..."`` in mm -> ``(n, 2)`` [m]; a one-line :class:`InputError` otherwise."""
     if not isinstance(text, str) or len(text) > 2000:
-        raise InputError("waypoints: type them as 'x,y; x,y' in mm")
+        raise InputError(Phrase("waypoints: type them as 'x,y; x,y' in mm"))
     points = []
     for k, item in enumerate(p for p in re.split(r"[;\n]", text) if p.strip()):
         parts = [v for v in re.split(r"[,\s]+", item.strip()) if v]
         try:
             x, y = (float(v) for v in parts)
         except ValueError:
-            raise InputError(f"waypoint {k + 1} ({item.strip()!r}) must be two numbers 'x,y' in mm") from None
+            raise InputError(
+                Phrase("waypoint {k} ({text}) must be two numbers 'x,y' in mm", k=k + 1, text=shorten(item.strip()))
+            ) from None
         if not (math.isfinite(x) and math.isfinite(y)):
-            raise InputError(f"waypoint {k + 1} is not finite")
+            raise InputError(Phrase("waypoint {k} is not finite", k=k + 1))
         points.append((x * 1e-3, y * 1e-3))
     if not 2 <= len(points) <= MAX_WAYPOINTS:
-        raise InputError(f"give 2 to {MAX_WAYPOINTS} waypoints 'x,y; x,y' in mm, got {len(points)}")
+        raise InputError(
+            Phrase("give 2 to {most} waypoints 'x,y; x,y' in mm, got {n}", most=MAX_WAYPOINTS, n=len(points))
+        )
     return np.array(points)
 
 
@@ -88,7 +94,7 @@ def cubic_strokes(params: Params, paths: tuple[GeometricPath, ...], peak: float)
     unit = [_cubic_samples(params, path, 1.0) for path in paths]
     peak1 = max(float(np.max(np.abs(inverse_dynamics(params, p, dp, ddp)))) for _t, p, dp, ddp in unit)
     if not (peak > 0 and math.isfinite(peak1) and peak1 > 0):
-        raise InputError("the cubic law has no force along this path")
+        raise InputError(Phrase("the cubic law has no force along this path"))
     duration = math.sqrt(peak1 / peak)
     parts = [_cubic_samples(params, path, duration) for path in paths]
     t = np.concatenate([part[0] + k * duration for k, part in enumerate(parts)])
@@ -130,7 +136,7 @@ def solve(params: Params, kind: str, force: float, speed: float | None = None, w
     if kind == "waypoints":
         points = tuple(map(tuple, parse_waypoints(waypoints).tolist()))
     elif kind not in PATH_KINDS.values():
-        raise InputError(f"unknown path {kind!r}")
+        raise InputError(Phrase("unknown path {kind}", kind=repr(kind)))
     path = _path(params, kind, points)
     limits = Limits(force, speed)
     plan = plan_path(params, path, limits) if kind == "circle" else plan_cycle(params, path, limits)

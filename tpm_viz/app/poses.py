@@ -52,7 +52,7 @@ def home_pose(params: Params, near=(0.0, 0.0), limits: SingularityThresholds = M
     """
     near = np.asarray(near, dtype=float).reshape(-1)
     if near.shape != (2,) or not np.all(np.isfinite(near)):
-        raise InputError(f"near must be two finite numbers, got {near!r}")
+        raise InputError(Phrase("near must be two finite numbers, got {got}", got=repr(near)))
     d_near = ik_branch(params, near, _WORKING)
     if np.all(np.isfinite(d_near)) and pose_codes(params, near, d_near, 1, _WORKING, limits) == PoseStatus.REGULAR:
         return Pose(near, d_near)
@@ -180,7 +180,9 @@ def preset_pose(
     away from the condition, returns the closest valid pose with ``clamped=True`` and a one-line explanation.
     """
     if kind not in DEMO_KINDS:
-        raise InputError(f"demo pose kind must be one of {', '.join(DEMO_KINDS)}, got {kind!r}")
+        raise InputError(
+            Phrase("demo pose kind must be one of {kinds}, got {got}", kinds=", ".join(DEMO_KINDS), got=repr(kind))
+        )
     current = near.mode(params) if isinstance(near, Pose) else None
     near = np.asarray(near.p if isinstance(near, Pose) else near, dtype=float).reshape(-1)
     modes = (1, -1) if current is None else (current, -current)

@@ -21,13 +21,15 @@ from typing import Literal
 import numpy as np
 
 from tpm_viz.app.moves import ik_branch, pose_codes, why_not
-from tpm_viz.app.readouts import Reference
+from tpm_viz.app.readouts import Reference, reason
 from tpm_viz.errors import InputError, TpmVizError
+from tpm_viz.numbers import fixed
 from tpm_viz.paper.dynamics import inverse_dynamics_detail
 from tpm_viz.paper.spline import CubicSpline
 from tpm_viz.paper.status import MOVE_LIMITS, PoseStatus
 from tpm_viz.paper.trajectories import DEFAULT_DURATIONS, Trajectory, circle_state, line_state
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase, T
 
 __all__ = ["RUN_SAMPLES", "Run", "Source", "build_run", "check_path", "peak_force"]
 
@@ -59,7 +61,7 @@ class Source:
     def paper(cls, kind: str, duration: float | None = None) -> Source:
         """The paper's line (Fig. 4) or circle (Fig. 5); default durations from ``docs/conventions.md``."""
         if kind not in DEFAULT_DURATIONS:
-            raise InputError(f"trajectory must be 'line' or 'circle', got {kind!r}")
+            raise InputError(Phrase("trajectory must be 'line' or 'circle', got {kind}", kind=repr(kind)))
         duration = _duration(DEFAULT_DURATIONS[kind] if duration is None else duration)
         paper_kind: SourceKind = "line" if kind == "line" else "circle"
         figure = "Fig. 4" if paper_kind == "line" else "Fig. 5"
@@ -96,20 +98,29 @@ class Source:
         if self.kind == "csv" and self.knots is not None:
             spline = CubicSpline(*self.knots)
             return spline(t, 0), spline(t, 1), spline(t, 2)
-        raise InputError(f"unknown trajectory source {self.kind!r}")
+        raise InputError(Phrase("unknown trajectory source {kind}", kind=repr(self.kind)))
 
 
 def _duration(value) -> float:
     try:
         duration = float(value)
     except (TypeError, ValueError):
-        raise InputError(f"duration must be a number of seconds, got {value!r}") from None
+        raise InputError(Phrase("duration must be a number of seconds, got {got}", got=repr(value))) from None
     if not (math.isfinite(duration) and MIN_DURATION <= duration <= MAX_DURATION):
-        raise InputError(f"duration must be from {MIN_DURATION:g} s to {MAX_DURATION:g} s, got {value!r}")
+        raise InputError(
+            Phrase(
+                "duration must be from {low:g} s to {high:g} s, got {got}",
+                low=MIN_DURATION,
+                high=MAX_DURATION,
+                got=repr(value),
+            )
+        )
     return duration
 
 
-def check_path(params: Params, t: np.ndarray, p: np.ndarray, what: str = "the trajectory", limits=MOVE_LIMITS) -> None:
+def check_path(
+    params: Params, t: np.ndarray, p: np.ndarray, what: str | Phrase = T("the trajectory"), limits=MOVE_LIMITS
+) -> None:
     """Raise :class:`InputError` at the first sample of ``p`` (``(n, 2)`` [m] at times ``t``) that is not a
     valid working-mode pose in the assembly mode of the first sample."""
     d = ik_branch(params, p, (1.0, 1.0))
@@ -120,8 +131,16 @@ def check_path(params: Params, t: np.ndarray, p: np.ndarray, what: str = "the tr
     bad = np.flatnonzero(codes != PoseStatus.REGULAR)
     if bad.size:
         k = int(bad[0])
-        where = f"at t = {t[k]:.3f} s, p = ({p[k, 0] * 1e3:.1f}, {p[k, 1] * 1e3:.1f}) mm"
-        raise InputError(f"{what}: {where}: {why_not(params, int(codes[k]), p[k], d[k])}")
+        raise InputError(
+            Phrase(
+                "{what}: at t = {t} s, p = ({x}, {y}) mm: {why}",
+                what=what,
+                t=fixed(t[k], ".3f"),
+                x=fixed(p[k, 0], ".1f", 1e3),
+                y=fixed(p[k, 1], ".1f", 1e3),
+                why=why_not(params, int(codes[k]), p[k], d[k]),
+            )
+        )
 
 
 @dataclass(frozen=True)
@@ -193,14 +212,14 @@ def build_run(params: Params, source: Source, reference: Reference | None = None
     """Sample, check and evaluate ``source`` (see the module docstring); one-line :class:`InputError`."""
     t = np.linspace(0.0, source.duration, int(samples))
     p, dp, ddp = source.motion(t)
-    what = f"the trajectory {source.label}"
+    what = Phrase("the trajectory {label}", label=source.label)
     if source.knots is not None:  # the user's own samples, then the spline between them
         check_path(params, source.knots[0], source.knots[1], what)
     check_path(params, t, p, what)
     try:
         res = inverse_dynamics_detail(params, p, dp, ddp)
     except TpmVizError as exc:
-        raise InputError(f"{what}: {exc}") from None
+        raise InputError(Phrase("{what}: {why}", what=what, why=reason(exc))) from None
     tau_ref, note = None, "no reference model"
     if reference is not None:
         try:

@@ -23,13 +23,13 @@ import numpy as np
 
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES, MAX_UPLOAD_ROWS
 from tpm_viz.app.moves import Pose, check
-from tpm_viz.app.readouts import Load
+from tpm_viz.app.readouts import Load, reason
 from tpm_viz.app.runs import Source
 from tpm_viz.app.state import AppState, TrajectorySample
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.paper.trajectories import Trajectory
 from tpm_viz.params import PARAM_INFO, Params
-from tpm_viz.words import Lang
+from tpm_viz.words import Lang, Phrase
 
 __all__ = [
     "FORMAT",
@@ -137,24 +137,24 @@ def dumps(doc: Document, saved_at: float | None = None) -> str:
 # -- reading ----------------------------------------------------------------------------------------------------------
 def _get(obj: Any, name: str, kind: type | tuple[type, ...], where: str) -> Any:
     if not isinstance(obj, dict) or name not in obj or not isinstance(obj[name], kind) or isinstance(obj[name], bool):
-        raise InputError(f"session file: {where}{name} is missing or not the right type")
+        raise InputError(Phrase("session file: {where}{name} is missing or not the right type", where=where, name=name))
     return obj[name]
 
 
 def _number(obj: Any, name: str, where: str) -> float:
     value = float(_get(obj, name, (int, float), where))
     if not math.isfinite(value):
-        raise InputError(f"session file: {where}{name} is not finite")
+        raise InputError(Phrase("session file: {where}{name} is not finite", where=where, name=name))
     return value
 
 
 def _pair(obj: Any, name: str, where: str) -> tuple[float, float]:
     value = _get(obj, name, list, where)
     if len(value) != 2 or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
-        raise InputError(f"session file: {where}{name} must be two numbers")
+        raise InputError(Phrase("session file: {where}{name} must be two numbers", where=where, name=name))
     out = (float(value[0]), float(value[1]))
     if not all(math.isfinite(v) for v in out):
-        raise InputError(f"session file: {where}{name} is not finite")
+        raise InputError(Phrase("session file: {where}{name} is not finite", where=where, name=name))
     return out
 
 
@@ -168,13 +168,19 @@ def _read_source(raw: Any) -> Source | None:
     if kind == "segment":
         return Source.segment(_pair(raw, "start", "trajectory."), _pair(raw, "end", "trajectory."), duration)
     if kind != "csv":
-        raise InputError(f"session file: trajectory kind must be one of {', '.join(_SOURCE_KINDS)}")
+        raise InputError(Phrase("session file: trajectory kind must be one of {kinds}", kinds=", ".join(_SOURCE_KINDS)))
     t = np.asarray(_get(raw, "t", list, "trajectory."), dtype=float)
     p = np.asarray(_get(raw, "p", list, "trajectory."), dtype=float)
     if t.ndim != 1 or not 4 <= t.size <= MAX_UPLOAD_ROWS or p.shape != (t.size, 2):
-        raise InputError(f"session file: an uploaded trajectory needs 4 to {MAX_UPLOAD_ROWS} samples of (t, p1, p2)")
+        raise InputError(
+            Phrase(
+                "session file: an uploaded trajectory needs 4 to {most} samples of (t, p1, p2)", most=MAX_UPLOAD_ROWS
+            )
+        )
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(p)) and np.all(np.diff(t) > 0)):
-        raise InputError("session file: the uploaded trajectory's times must increase and every value be finite")
+        raise InputError(
+            Phrase("session file: the uploaded trajectory's times must increase and every value be finite")
+        )
     label = _get(raw, "label", str, "trajectory.")[:200]
     name = label.rsplit(", T =", 1)[0]
     zeros = np.zeros_like(p)
@@ -185,13 +191,13 @@ def _read_saved(raw: Any, where: str) -> Saved:
     params_raw = _get(raw, "params", dict, where)
     unknown = set(params_raw) - set(PARAM_INFO)
     if unknown:
-        raise InputError(f"session file: unknown parameter {sorted(unknown)[0]!r}")
+        raise InputError(Phrase("session file: unknown parameter {name}", name=repr(sorted(unknown)[0])))
     params = Params(**{k: v for k, v in params_raw.items()})  # validated: one-line InvalidParametersError
     pose = Pose(np.array(_pair(raw, "p", where)), np.array(_pair(raw, "d", where)))
     if check(params, pose) != 0:
         pose = Pose.working(params, pose.p)  # not valid as saved: the working-mode pose at the same p
         if check(params, pose) != 0:
-            raise InputError("session file: the saved pose is not a valid pose of the saved parameters")
+            raise InputError(Phrase("session file: the saved pose is not a valid pose of the saved parameters"))
     load_raw = _get(raw, "load", dict, where)
     load = Load(
         _get(load_raw, "mode", str, where + "load."),
@@ -217,15 +223,21 @@ def loads(text: str | bytes, now: float | None = None) -> Document:
     """Read a session document; raises one-line :class:`~tpm_viz.InputError` if it is not a valid one of this
     version. Away tabs older than :data:`KEEP_SECONDS` (at ``now``, wall clock) are dropped."""
     if len(text) > MAX_DOCUMENT_BYTES:
-        raise InputError(f"session file: larger than {MAX_DOCUMENT_BYTES >> 20} MiB")
+        raise InputError(Phrase("session file: larger than {limit} MiB", limit=MAX_DOCUMENT_BYTES >> 20))
     try:
         raw = json.loads(text)
     except (ValueError, UnicodeDecodeError) as exc:
-        raise InputError(f"session file: not JSON ({str(exc)[:80]})") from None
+        raise InputError(Phrase("session file: not JSON ({why})", why=str(exc)[:80])) from None
     if not isinstance(raw, dict) or raw.get("format") != FORMAT:
-        raise InputError("session file: not a tpm-viz session")
+        raise InputError(Phrase("session file: not a tpm-viz session"))
     if raw.get("version") != VERSION:
-        raise InputError(f"session file: version {raw.get('version')!r}, this tpm-viz reads version {VERSION}")
+        raise InputError(
+            Phrase(
+                "session file: version {version}, this tpm-viz reads version {ours}",
+                version=repr(raw.get("version")),
+                ours=VERSION,
+            )
+        )
     try:
         shared = _read_saved(raw.get("shared"), "shared.")
         step = raw.get("lesson_step", 0)
@@ -245,10 +257,12 @@ def loads(text: str | bytes, now: float | None = None) -> Document:
             if kept:
                 tabs[str(key)[:200]] = kept
     except TpmVizError as exc:
-        text_ = str(exc)
-        raise InputError(text_ if text_.startswith("session file") else f"session file: {text_}") from None
+        why = reason(exc)
+        raise InputError(
+            why if str(why).startswith("session file") else Phrase("session file: {why}", why=why)
+        ) from None
     except (TypeError, ValueError, AttributeError) as exc:
-        raise InputError(f"session file: malformed ({type(exc).__name__})") from None
+        raise InputError(Phrase("session file: malformed ({kind})", kind=type(exc).__name__)) from None
     return Document(shared, step, tabs)
 
 
@@ -258,7 +272,7 @@ def read_file(path: Path) -> Document:
         with open(path, "rb") as handle:
             data = handle.read(MAX_DOCUMENT_BYTES + 1)
     except OSError as exc:
-        raise InputError(f"session file {path}: {exc.strerror or exc}") from None
+        raise InputError(Phrase("session file {path}: {why}", path=str(path), why=exc.strerror or str(exc))) from None
     return loads(data)
 
 

@@ -29,6 +29,7 @@ from tpm_viz.errors import InputError
 from tpm_viz.paper.dynamics import inverse_dynamics
 from tpm_viz.paper.jacobians import actuator_velocity
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase, T
 
 __all__ = ["SIZING_COLUMNS", "Sizing", "format_sizing", "size_motion", "size_trajectory", "sizing_columns"]
 
@@ -82,13 +83,13 @@ class Sizing:
         return [(q, u, float(a), float(b)) for q, u, a, b in rows]
 
 
-def _nonnegative(value, name: str) -> float:
+def _nonnegative(value, name: str | Phrase) -> float:
     try:
         value = float(value)
     except (TypeError, ValueError):
-        raise InputError(f"{name} must be a number, got {value!r}") from None
+        raise InputError(Phrase("{name} must be a number, got {got}", name=name, got=repr(value))) from None
     if not math.isfinite(value) or value < 0:
-        raise InputError(f"{name} must be zero or a positive, finite number, got {value:g}")
+        raise InputError(Phrase("{name} must be zero or a positive, finite number, got {got:g}", name=name, got=value))
     return value
 
 
@@ -113,15 +114,22 @@ def size_motion(t, tau, dd, dwell: float = 0.0, motor_constant: float | None = N
     if t.ndim != 1 or t.size < 2 or tau.shape != (t.size, 2) or dd.shape != (t.size, 2):
         raise InputError(f"need t (n,), tau (n, 2), dd (n, 2) with n >= 2; got {t.shape}, {tau.shape}, {dd.shape}")
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(tau)) and np.all(np.isfinite(dd))):
-        raise InputError("the motion contains a non-finite value (NaN or inf)")
+        raise InputError(Phrase("the motion contains a non-finite value (NaN or inf)"))
     h = np.diff(t)
     if np.any(h < 0):
         k = int(np.argmax(h < 0))
-        raise InputError(f"times must not decrease: t = {t[k + 1]:g} s after t = {t[k]:g} s (row {k + 2})")
+        raise InputError(
+            Phrase(
+                "times must not decrease: t = {later:g} s after t = {earlier:g} s (row {row})",
+                later=float(t[k + 1]),
+                earlier=float(t[k]),
+                row=k + 2,
+            )
+        )
     motion = float(t[-1] - t[0])
     if motion <= 0:
-        raise InputError("the motion must last longer than zero seconds")
-    dwell = _nonnegative(dwell, "the dwell")
+        raise InputError(Phrase("the motion must last longer than zero seconds"))
+    dwell = _nonnegative(dwell, T("the dwell"))
     cycle = motion + dwell
     hh = h[:, None]
     sq = np.sum(hh * (tau[:-1] ** 2 + tau[:-1] * tau[1:] + tau[1:] ** 2) / 3.0, axis=0)  # ∫ τ² dt, exact on lines
@@ -137,9 +145,9 @@ def size_motion(t, tau, dd, dwell: float = 0.0, motor_constant: float | None = N
         platform = float(np.max(np.hypot(dp[:, 0], dp[:, 1])))
     copper = (None, None, None)
     if motor_constant is not None:
-        km = _nonnegative(motor_constant, "the motor constant")
+        km = _nonnegative(motor_constant, T("the motor constant"))
         if km == 0:
-            raise InputError("the motor constant must be a positive number of N/sqrt(W), got 0")
+            raise InputError(Phrase("the motor constant must be a positive number of N/sqrt(W), got 0"))
         copper = (peak_force**2 / km**2, sq / cycle / km**2, sq / km**2)
         motor_constant = km
     return Sizing(

@@ -30,6 +30,7 @@ from tpm_viz.multibody.model import model_for
 from tpm_viz.paper.control import ControlLaw, ControllerKind, Gains, model_with_errors, reference_state
 from tpm_viz.paper.trajectories import Trajectory, paper_duration, positive_seconds
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase, T
 
 __all__ = ["COLUMNS", "DEFAULT_RATE", "MAX_PLANT_STEP", "MAX_SAMPLES", "ControlRun", "ControlSetup", "simulate"]
 
@@ -168,7 +169,7 @@ def _horizon(reference, duration, horizon) -> tuple[str, float]:
         name, base = reference.name, reference.duration
     else:
         name, base = str(reference), paper_duration(reference, duration)
-    return name, base if horizon is None else positive_seconds(horizon, "horizon")
+    return name, base if horizon is None else positive_seconds(horizon, T("horizon"))
 
 
 def simulate(
@@ -193,7 +194,7 @@ def simulate(
     name, span = _horizon(reference, duration, horizon)
     n = max(1, math.ceil(span * setup.rate - 1e-9))
     if n > MAX_SAMPLES:
-        raise InputError(f"horizon x rate = {n} samples exceeds the limit of {MAX_SAMPLES}")
+        raise InputError(Phrase("horizon x rate = {n} samples exceeds the limit of {most}", n=n, most=MAX_SAMPLES))
     t = np.arange(n + 1) / setup.rate
     start = float(reference.t[0]) if isinstance(reference, Trajectory) else 0.0  # run time 0 = the path's start
     p_ref, dp_ref, ddp_ref = reference_state(reference, t + start, duration)
@@ -238,9 +239,11 @@ def simulate(
                 p1, p2 = p1 + h6 * (v1 + 2 * y1 + 2 * w1 + s1), p2 + h6 * (v2 + 2 * y2 + 2 * w2 + s2)
                 v1, v2 = v1 + h6 * (a11 + 2 * a21 + 2 * a31 + a41), v2 + h6 * (a12 + 2 * a22 + 2 * a32 + a42)
     except (TpmVizError, ZeroDivisionError, OverflowError, ValueError) as exc:
+        at = k * period
         if isinstance(exc, TpmVizError):
-            raise type(exc)(f"at t = {k * period:.4f} s: {exc}") from None
-        raise InputError(f"at t = {k * period:.4f} s the simulation diverged (unstable loop?)") from None
+            first = exc.args[0] if exc.args and isinstance(exc.args[0], Phrase) else str(exc)
+            raise type(exc)(Phrase("at t = {t:.4f} s: {why}", t=at, why=first)) from None
+        raise InputError(Phrase("at t = {t:.4f} s the simulation diverged (unstable loop?)", t=at)) from None
     return ControlRun(
         name=name,
         setup=setup,

@@ -25,6 +25,8 @@ import numpy as np
 from tpm_viz.errors import SingularConfigurationError, UnreachablePoseError
 from tpm_viz.multibody.assembly import DOF, NEWTON_FLOOR, NEWTON_MAX_ITER, NEWTON_TOL
 from tpm_viz.multibody.rank import ranked_svd
+from tpm_viz.numbers import fixed
+from tpm_viz.words import Phrase
 
 __all__ = ["PlatformPlant", "forward_dynamics", "project"]
 
@@ -106,8 +108,13 @@ class PlatformPlant:
         r1, r2 = la2 - p2 * p2, la2 - p1 * p1
         if not (r1 > 1e-12 * la2 and r2 > 1e-12 * la2):  # also catches NaN
             raise UnreachablePoseError(
-                f"the simulated platform reached ({p1 * 1e3:.1f}, {p2 * 1e3:.1f}) mm: |p_j| must stay below l_a "
-                f"= {self._la * 1e3:.1f} mm (unstable motion?)"
+                Phrase(
+                    "the simulated platform reached ({x}, {y}) mm: |p_j| must stay below l_a = {l_a} mm "
+                    "(unstable motion?)",
+                    x=fixed(p1, ".1f", 1e3),
+                    y=fixed(p2, ".1f", 1e3),
+                    l_a=fixed(self._la, ".1f", 1e3),
+                )
             )
         return math.sqrt(r1), math.sqrt(r2)
 

@@ -27,6 +27,7 @@ from tpm_viz.multibody.model import model_for
 from tpm_viz.paper.dynamics import inverse_dynamics
 from tpm_viz.paper.trajectories import circle_state, line_state, paper_duration, positive_seconds
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase, T
 
 __all__ = ["DEFAULT_DT", "MAX_STEPS", "MIN_STEPS", "ReplayResult", "replay"]
 
@@ -71,10 +72,12 @@ class ReplayResult:
 
 
 def _steps(duration: float, dt: float | None) -> int:
-    dt = min(DEFAULT_DT, duration / MIN_STEPS) if dt is None else positive_seconds(dt, "time step")
+    dt = min(DEFAULT_DT, duration / MIN_STEPS) if dt is None else positive_seconds(dt, T("time step"))
     steps = max(1, math.ceil(duration / dt - 1e-9))
     if steps > MAX_STEPS:
-        raise InputError(f"duration / dt = {steps} steps exceeds the limit of {MAX_STEPS}")
+        raise InputError(
+            Phrase("duration / dt = {steps} steps exceeds the limit of {most}", steps=steps, most=MAX_STEPS)
+        )
     return steps
 
 

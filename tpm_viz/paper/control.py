@@ -31,6 +31,7 @@ from enum import StrEnum
 import numpy as np
 
 from tpm_viz.errors import InputError, SingularConfigurationError, UnreachablePoseError
+from tpm_viz.numbers import fixed
 
 # _procedure: the scalar steps (b)-(e) of eqs. (9)-(31); the public single-state inverse_dynamics adds numpy
 # checks that cost ~25 µs per call, too slow for a 1 kHz loop in Python (the checks are done here in floats).
@@ -39,6 +40,7 @@ from tpm_viz.paper.jacobians import actuator_velocity
 from tpm_viz.paper.kinematics import inverse_kinematics
 from tpm_viz.paper.trajectories import Trajectory, circle_state, line_state, paper_duration
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase
 
 __all__ = [
     "ControlLaw",
@@ -252,11 +254,15 @@ class ControlLaw:
             r1, r2 = la * la - p2 * p2, la * la - p1 * p1
             if not (r1 > 0.0 and r2 > 0.0):
                 raise UnreachablePoseError(
-                    f"the measured platform position ({p1 * 1e3:.1f}, {p2 * 1e3:.1f}) mm is outside |p_j| < l_a"
+                    Phrase(
+                        "the measured platform position ({x}, {y}) mm is outside |p_j| < l_a",
+                        x=fixed(p1, ".1f", 1e3),
+                        y=fixed(p2, ".1f", 1e3),
+                    )
                 )
             c1, c2 = math.sqrt(r1), math.sqrt(r2)
             if abs(c1 * c2 - p1 * p2) < 1e-9 * la * la:
-                raise SingularConfigurationError("the measured pose is at the direct singularity (eq. 12)")
+                raise SingularConfigurationError(Phrase("the measured pose is at the direct singularity (eq. 12)"))
             return c1, c2
 
         def pd(row, p1, p2, dp1, dp2, ff1, ff2):

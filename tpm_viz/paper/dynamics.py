@@ -30,6 +30,7 @@ from tpm_viz.errors import SingularConfigurationError
 from tpm_viz.paper.jacobians import actuator_velocity, eq14_row
 from tpm_viz.paper.kinematics import as_xy, finite_result, inverse_kinematics, leg_components
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase, T
 
 __all__ = ["DynamicsResult", "inverse_dynamics", "inverse_dynamics_detail", "kinetic_energy"]
 
@@ -99,9 +100,9 @@ _SINGULAR_TOL = 1e-12
 def _check_regular(params: Params, c1, c2, p1, p2) -> None:
     l2 = params.l_a**2
     if np.any(np.abs(c1 * c2) < _SINGULAR_TOL * l2):
-        raise SingularConfigurationError("singular configuration: cos θ1 cos θ2 = 0 (eq. 11)")
+        raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq="cos θ1 cos θ2 = 0 (eq. 11)"))
     if np.any(np.abs(c1 * c2 - p1 * p2) < _SINGULAR_TOL * l2):
-        raise SingularConfigurationError("singular configuration: cos(θ1 + θ2) = 0 (eq. 12)")
+        raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq="cos(θ1 + θ2) = 0 (eq. 12)"))
 
 
 def _vectorised(params: Params, p, dp, ddp, f_ext, d) -> tuple:
@@ -137,7 +138,7 @@ def inverse_dynamics_detail(params: Params, p, dp, ddp, f_ext=None, d=None) -> D
     """
     p, dp, ddp, d, out = _vectorised(params, p, dp, ddp, f_ext, d)
     dd, ddd, v, w, lam, tau = (np.stack(out[k : k + 2], -1) for k in range(0, 12, 2))
-    finite_result(tau, "the actuator forces")
+    finite_result(tau, T("the actuator forces"))
     return DynamicsResult(p=p, dp=dp, ddp=ddp, d=d, dd=dd, ddd=ddd, v=v, w=w, lam=lam, tau=tau)
 
 
@@ -169,7 +170,7 @@ def _inverse_dynamics_one(params: Params, p, dp, ddp, f_ext, d=None) -> np.ndarr
         out = _procedure(params, p1, p2, dp1, dp2, ddp1, ddp2, c1, c2, f1, f2)
     except OverflowError:
         out = (math.inf,) * 12
-    return finite_result(np.array(out[10:12]), "the actuator forces")
+    return finite_result(np.array(out[10:12]), T("the actuator forces"))
 
 
 def inverse_dynamics(params: Params, p, dp, ddp, f_ext=None, d=None) -> np.ndarray:
@@ -183,7 +184,7 @@ def inverse_dynamics(params: Params, p, dp, ddp, f_ext=None, d=None) -> np.ndarr
             tau = _inverse_dynamics_one(params, p, dp, ddp, f_ext, d)
             if tau is not None:
                 return tau
-    return finite_result(np.stack(_vectorised(params, p, dp, ddp, f_ext, d)[4][10:12], -1), "the actuator forces")
+    return finite_result(np.stack(_vectorised(params, p, dp, ddp, f_ext, d)[4][10:12], -1), T("the actuator forces"))
 
 
 def kinetic_energy(params: Params, p, dp, d=None) -> np.ndarray:

@@ -19,6 +19,7 @@ import numpy as np
 from tpm_viz.errors import SingularConfigurationError
 from tpm_viz.paper.jacobians import jacobians
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase
 
 __all__ = ["Ellipse", "ManipulabilityEllipses", "ellipse_outline", "manipulability_ellipses"]
 
@@ -43,10 +44,12 @@ def manipulability_ellipses(params: Params, p, max_ratio: float = 1e6) -> Manipu
     """
     j = jacobians(params, p).j
     if j.shape != (2, 2) or not np.all(np.isfinite(j)):
-        raise SingularConfigurationError("manipulability ellipses need one regular pose (cos θ_i != 0)")
+        raise SingularConfigurationError(Phrase("manipulability ellipses need one regular pose (cos θ_i != 0)"))
     _, sigma, vt = np.linalg.svd(j)
     if sigma[-1] <= sigma[0] / max_ratio:
-        raise SingularConfigurationError("manipulability ellipses are degenerate at the direct singularity (eq. 12)")
+        raise SingularConfigurationError(
+            Phrase("manipulability ellipses are degenerate at the direct singularity (eq. 12)")
+        )
     axes = vt.T  # columns v_k
     return ManipulabilityEllipses(velocity=Ellipse(axes, 1.0 / sigma), force=Ellipse(axes, sigma.copy()))
 

@@ -23,6 +23,7 @@ from tpm_viz.errors import SingularConfigurationError
 from tpm_viz.paper.kinematics import as_xy, finite_result, in_stroke, inverse_kinematics, leg_components, reachable
 from tpm_viz.paper.status import STATUS_LABELS, WARN, PoseStatus, SingularityThresholds
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase, T
 
 __all__ = [
     "STATUS_LABELS",
@@ -105,7 +106,7 @@ def _check_regular(jac: Jacobians, which: str) -> None:
     det = jac.det_jq if which == "inverse" else jac.det_jx
     if np.any(np.abs(det) < 1e-12):
         eq = "cos θ1 cos θ2 = 0 (eq. 11)" if which == "inverse" else "cos(θ1 + θ2) = 0 (eq. 12)"
-        raise SingularConfigurationError(f"singular configuration: {eq}")
+        raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq=eq))
 
 
 def actuator_velocity(params: Params, p, dp, d=None) -> np.ndarray:
@@ -113,7 +114,7 @@ def actuator_velocity(params: Params, p, dp, d=None) -> np.ndarray:
     jac = jacobians(params, p, d)
     _check_regular(jac, "inverse")
     with np.errstate(over="ignore", invalid="ignore"):
-        return finite_result(np.einsum("...ij,...j->...i", jac.j, as_xy(dp, "dp")), "the actuator velocities")
+        return finite_result(np.einsum("...ij,...j->...i", jac.j, as_xy(dp, "dp")), T("the actuator velocities"))
 
 
 def platform_velocity(params: Params, p, dd, d=None) -> np.ndarray:
@@ -122,7 +123,7 @@ def platform_velocity(params: Params, p, dd, d=None) -> np.ndarray:
     _check_regular(jac, "direct")
     with np.errstate(over="ignore", invalid="ignore"):
         rhs = np.einsum("...ij,...j->...i", jac.jq, as_xy(dd, "dd"))
-        return finite_result(np.linalg.solve(jac.jx, rhs[..., None])[..., 0], "the platform velocity")
+        return finite_result(np.linalg.solve(jac.jx, rhs[..., None])[..., 0], T("the platform velocity"))
 
 
 def theta_dot(params: Params, p, dp, d=None) -> np.ndarray:
@@ -131,7 +132,7 @@ def theta_dot(params: Params, p, dp, d=None) -> np.ndarray:
     if np.any(np.abs(cos) < 1e-12):
         raise SingularConfigurationError("singular configuration: cos θ1 cos θ2 = 0 (eq. 11)")
     with np.errstate(over="ignore", invalid="ignore"):
-        return finite_result(as_xy(dp, "dp")[..., ::-1] / (params.l_a * cos), "the leg angular rates")
+        return finite_result(as_xy(dp, "dp")[..., ::-1] / (params.l_a * cos), T("the leg angular rates"))
 
 
 def eq14_row(pi, pj, dpi, dpj, ddpi, ddpj, ci, ddi):
@@ -166,7 +167,7 @@ def actuator_acceleration(params: Params, p, dp, ddp, d=None, dd=None) -> np.nda
             eq14_row(p[..., i], p[..., j], dp[..., i], dp[..., j], ddp[..., i], ddp[..., j], c[..., i], dd[..., i])
             for i, j in ((0, 1), (1, 0))
         ]
-    return finite_result(np.stack(rows, -1), "the actuator accelerations")
+    return finite_result(np.stack(rows, -1), T("the actuator accelerations"))
 
 
 def actuator_forces_from_platform_force(params: Params, p, f, d=None) -> np.ndarray:
@@ -184,7 +185,7 @@ def actuator_forces_from_platform_force(params: Params, p, f, d=None) -> np.ndar
     jxt = np.swapaxes(jac.jx, -1, -2)
     with np.errstate(over="ignore", invalid="ignore"):
         g = np.linalg.solve(jxt, as_xy(f, "f")[..., None])[..., 0]
-        return finite_result(np.einsum("...ij,...j->...i", jac.jq, g), "the actuator forces")
+        return finite_result(np.einsum("...ij,...j->...i", jac.jq, g), T("the actuator forces"))
 
 
 def platform_force_from_actuator_forces(params: Params, p, tau, d=None) -> np.ndarray:
@@ -192,4 +193,4 @@ def platform_force_from_actuator_forces(params: Params, p, tau, d=None) -> np.nd
     jac = jacobians(params, p, d)
     _check_regular(jac, "inverse")
     with np.errstate(over="ignore", invalid="ignore"):
-        return finite_result(np.einsum("...ji,...j->...i", jac.j, as_xy(tau, "tau")), "the platform force")
+        return finite_result(np.einsum("...ji,...j->...i", jac.j, as_xy(tau, "tau")), T("the platform force"))

@@ -18,8 +18,10 @@ from typing import NamedTuple
 import numpy as np
 
 from tpm_viz.errors import InputError, SingularConfigurationError, UnreachablePoseError
+from tpm_viz.numbers import fixed
 from tpm_viz.paper.status import FK_STATUS, FkStatus
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase
 
 __all__ = [
     "FK_STATUS",
@@ -45,20 +47,20 @@ def as_xy(x, name: str = "p") -> np.ndarray:
     if arr.ndim == 0 or arr.shape[-1] != 2:
         raise InputError(f"{name} must have shape (..., 2), got {arr.shape}")
     if not np.all(np.isfinite(arr)):
-        raise InputError(f"{name} contains a non-finite value (NaN or inf)")
+        raise InputError(Phrase("{name} contains a non-finite value (NaN or inf)", name=name))
     return arr
 
 
 def _mm(x: float) -> str:
     """A length [m] as millimetres for a message (no overflow warning for absurd values)."""
     mm = float(x) * 1e3  # Python floats overflow to inf silently
-    return f"{mm:.1f}" if abs(mm) < 1e9 else f"{mm:.3g}"
+    return fixed(mm, ".1f") if abs(mm) < 1e9 else fixed(mm, ".3g")
 
 
-def finite_result(arr: np.ndarray, what: str) -> np.ndarray:
+def finite_result(arr: np.ndarray, what: str | Phrase) -> np.ndarray:
     """``arr`` unchanged if every entry is finite; otherwise an :class:`InputError` (overflow)."""
     if not np.all(np.isfinite(arr)):
-        raise InputError(f"{what} overflowed: the inputs are too large for finite results")
+        raise InputError(Phrase("{what} overflowed: the inputs are too large for finite results", what=what))
     return arr
 
 
@@ -93,8 +95,12 @@ def inverse_kinematics(params: Params, p) -> np.ndarray:
     if not np.all(ok):
         bad = p[~ok][0] if p.ndim > 1 else p
         raise UnreachablePoseError(
-            f"platform position ({_mm(bad[0])}, {_mm(bad[1])}) mm is unreachable: "
-            f"each |p_j| must be below l_a = {params.l_a * 1e3:.1f} mm"
+            Phrase(
+                "platform position ({x}, {y}) mm is unreachable: each |p_j| must be below l_a = {l_a:.1f} mm",
+                x=_mm(bad[0]),
+                y=_mm(bad[1]),
+                l_a=params.l_a * 1e3,
+            )
         )
     return _ik_unchecked(params, p)
 
@@ -186,11 +192,18 @@ def _raise_if_missing(params: Params, d: np.ndarray, sol: FkSolutions) -> None:
     k = params.offset
     if abs(float(bad[0]) - k) + abs(float(bad[1]) - k) <= 1e-12 * params.l_a:
         raise SingularConfigurationError(
-            f"d1 = d2 = a - b = {k * 1e3:.1f} mm: the two leg circles coincide, the platform position "
-            "is undetermined (direct singularity, eq. 12)"
+            Phrase(
+                "d1 = d2 = a - b = {k} mm: the two leg circles coincide, the platform position is undetermined "
+                "(direct singularity, eq. 12)",
+                k=_mm(k),
+            )
         )
     raise UnreachablePoseError(
-        f"actuators at ({_mm(bad[0])}, {_mm(bad[1])}) mm cannot be assembled: the leg circles are more than 2 l_a apart"
+        Phrase(
+            "actuators at ({d1}, {d2}) mm cannot be assembled: the leg circles are more than 2 l_a apart",
+            d1=_mm(bad[0]),
+            d2=_mm(bad[1]),
+        )
     )
 
 

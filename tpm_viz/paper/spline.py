@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from tpm_viz.errors import InputError
+from tpm_viz.words import Phrase
 
 __all__ = ["CubicSpline"]
 
@@ -27,13 +28,21 @@ class CubicSpline:
         if t.ndim != 1 or y.shape[0] != t.shape[0]:
             raise InputError(f"spline needs t of shape (n,) and y of shape (n, m), got {t.shape} and {y.shape}")
         if t.size < 2:
-            raise InputError(f"a spline needs at least 2 samples, got {t.size}")
+            raise InputError(Phrase("a spline needs at least 2 samples, got {n}", n=t.size))
         if not (np.all(np.isfinite(t)) and np.all(np.isfinite(y))):
-            raise InputError("spline samples contain a non-finite value (NaN or inf)")
+            raise InputError(Phrase("spline samples contain a non-finite value (NaN or inf)"))
         h = np.diff(t)
         if np.any(h <= 0):
             k = int(np.argmax(h <= 0)) + 1
-            raise InputError(f"time must increase strictly: t[{k}] = {t[k]:g} s after t[{k - 1}] = {t[k - 1]:g} s")
+            raise InputError(
+                Phrase(
+                    "time must increase strictly: t[{k}] = {later:g} s after t[{before}] = {earlier:g} s",
+                    k=k,
+                    later=float(t[k]),
+                    before=k - 1,
+                    earlier=float(t[k - 1]),
+                )
+            )
         self.t, self.y, self._h = t, y, h
         self.m = self._second_derivatives(h, y)
 

@@ -13,7 +13,18 @@ from __future__ import annotations
 from enum import IntEnum
 from typing import NamedTuple
 
-__all__ = ["FK_STATUS", "MOVE_LIMITS", "STATUS_LABELS", "WARN", "FkStatus", "PoseStatus", "SingularityThresholds"]
+from tpm_viz.words import Phrase, T
+
+__all__ = [
+    "FK_STATUS",
+    "MOVE_LIMITS",
+    "STATUS_LABELS",
+    "STATUS_WORDS",
+    "WARN",
+    "FkStatus",
+    "PoseStatus",
+    "SingularityThresholds",
+]
 
 
 class PoseStatus(IntEnum):
@@ -45,6 +56,14 @@ _POSE_LABELS = {
 
 STATUS_LABELS = {int(s): s.label for s in PoseStatus}
 """``{code: label}`` of :class:`PoseStatus` (kept for the public API and CSV output)."""
+STATUS_WORDS: dict[PoseStatus, Phrase] = {
+    PoseStatus.REGULAR: T("regular"),
+    PoseStatus.NEAR_INVERSE: T("near inverse singularity"),
+    PoseStatus.NEAR_DIRECT: T("near direct singularity"),
+    PoseStatus.OUT_OF_STROKE: T("out of stroke"),
+    PoseStatus.UNREACHABLE: T("unreachable"),
+}
+"""The labels of :class:`PoseStatus` as phrases, for messages shown to people (``str()``: the English label)."""
 
 
 class FkStatus(IntEnum):

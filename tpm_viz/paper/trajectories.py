@@ -22,6 +22,7 @@ import numpy as np
 from tpm_viz.csvio import parse_columns
 from tpm_viz.errors import InputError
 from tpm_viz.paper.spline import CubicSpline
+from tpm_viz.words import Phrase, T
 
 __all__ = [
     "DEFAULT_DURATIONS",
@@ -63,27 +64,31 @@ class Trajectory:
         return float(self.t[-1] - self.t[0])
 
 
-def positive_seconds(value, what: str = "duration") -> float:
+def positive_seconds(value, what: str | Phrase = T("duration")) -> float:
     """``value`` as a positive, finite number of seconds, or a one-line :class:`InputError` naming ``what``."""
     try:
         value = float(value)
     except (TypeError, ValueError):
-        raise InputError(f"{what} must be a number of seconds, got {value!r}") from None
+        raise InputError(Phrase("{what} must be a number of seconds, got {got}", what=what, got=repr(value))) from None
     if not math.isfinite(value) or value <= 0:
-        raise InputError(f"{what} must be a positive, finite number of seconds, got {value:g}")
+        raise InputError(
+            Phrase("{what} must be a positive, finite number of seconds, got {got:g}", what=what, got=value)
+        )
     return value
 
 
 def paper_duration(kind: str, duration: float | None = None) -> float:
     """The validated duration [s] of the paper's ``kind`` trajectory (its default when ``duration`` is None)."""
     if kind not in DEFAULT_DURATIONS:
-        raise InputError(f"trajectory kind must be 'line' or 'circle', got {kind!r}")
+        raise InputError(Phrase("trajectory kind must be 'line' or 'circle', got {kind}", kind=repr(kind)))
     return DEFAULT_DURATIONS[kind] if duration is None else positive_seconds(duration)
 
 
 def _check_samples(samples: int) -> int:
     if isinstance(samples, bool) or int(samples) != samples or not 2 <= samples <= MAX_SAMPLES:
-        raise InputError(f"samples must be a whole number from 2 to {MAX_SAMPLES}, got {samples!r}")
+        raise InputError(
+            Phrase("samples must be a whole number from 2 to {most}, got {got}", most=MAX_SAMPLES, got=repr(samples))
+        )
     return int(samples)
 
 
@@ -142,7 +147,7 @@ def trajectory_from_samples(t, p, name: str = "custom") -> Trajectory:
     if t.ndim != 1 or p.shape != (t.size, 2):
         raise InputError(f"need t of shape (n,) and p of shape (n, 2), got {t.shape} and {p.shape}")
     if t.size < 4:
-        raise InputError(f"a trajectory needs at least 4 samples, got {t.size}")
+        raise InputError(Phrase("a trajectory needs at least 4 samples, got {n}", n=t.size))
     spline = CubicSpline(t, p)
     t0 = t - t[0]
     return Trajectory(name, t0, p.copy(), spline(t, 1), spline(t, 2))
@@ -151,5 +156,5 @@ def trajectory_from_samples(t, p, name: str = "custom") -> Trajectory:
 def parse_trajectory_csv(text: str, name: str = "custom", max_rows: int = MAX_CSV_ROWS) -> Trajectory:
     """A trajectory from CSV text with columns ``t,p1,p2`` (s, m, m unless the header gives units, ``t [ms]``);
     the dialects and limits of :mod:`tpm_viz.csvio` (``docs/csv.md``); one-line errors."""
-    cols = parse_columns(text, ["t", "p1", "p2"], source="the trajectory CSV", max_rows=max_rows)
+    cols = parse_columns(text, ["t", "p1", "p2"], source=T("the trajectory CSV"), max_rows=max_rows)
     return trajectory_from_samples(cols["t"], np.stack([cols["p1"], cols["p2"]], -1), name)

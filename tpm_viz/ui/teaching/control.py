@@ -21,6 +21,7 @@ import viser
 
 from tpm_viz import meshes
 from tpm_viz.app.palette import hex_colour
+from tpm_viz.app.readouts import reason
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.multibody.control import ControlRun, ControlSetup
 from tpm_viz.paper.control import ControllerKind, axis_masses, model_with_errors
@@ -36,12 +37,21 @@ from tpm_viz.ui.teaching.control_run import (
     timed,
     upload_label,
 )
-from tpm_viz.ui.teaching.control_text import LABELS, comparison_html, gains_html, lesson_html, run_html
+from tpm_viz.ui.teaching.control_text import (
+    LABELS,
+    comparison_html,
+    gains_html,
+    label_of,
+    lesson_html,
+    run_html,
+    setup_phrase,
+)
 from tpm_viz.ui.teaching.motion import MotionPlayer, TimeChart
 from tpm_viz.ui.teaching.player import SPEEDS
 from tpm_viz.ui.teaching.playing import RunHub
 from tpm_viz.ui.teaching.trace import TRACE_Z, segments
 from tpm_viz.ui.worker import Worker
+from tpm_viz.words import Phrase, T, say
 
 __all__ = ["CONTROLLERS", "MAGNIFY", "ControlView"]
 
@@ -53,8 +63,15 @@ REF_COLOUR, ACTUAL_COLOUR = (34, 197, 94), (220, 38, 38)
 CHART_HZ = 4.0
 
 
+def _failure(exc: BaseException) -> Phrase:
+    """What to tell about a failed simulation: the refusal's words, or that a bug was logged."""
+    if isinstance(exc, TpmVizError):
+        return reason(exc)
+    return Phrase("internal error ({kind}), logged on the server", kind=type(exc).__name__)
+
+
 def _internal_error(owner, exc: Exception) -> None:
-    owner.view.refuse(f"internal error ({type(exc).__name__}), logged on the server", resync=False)
+    owner.view.refuse(_failure(exc), resync=False)
 
 
 class ControlView:
@@ -67,8 +84,10 @@ class ControlView:
         self.player = MotionPlayer(view, "control", on_stop=self._refresh_status)
         self.run: ControlRun | None = None
         self.seconds: float | None = None
-        self.busy = ""
-        self.status = ""
+        self.busy: str | Phrase = ""
+        self.status: str | Phrase = ""
+        self._lesson: tuple[float, float] | None = None
+        """The payload [kg] and mass error of the last lesson run (to word it again in another language)."""
         self.table: dict[ControllerKind, ControlRun] = {}
         self._table_key: tuple | None = None
         self._ghost: viser.BoxHandle | None = None
@@ -136,7 +155,7 @@ class ControlView:
     # -- reading the widgets -------------------------------------------------------------------------------
     def _kind(self) -> ControllerKind:
         if self.controller.value not in CONTROLLERS:
-            raise InputError(f"unknown controller {self.controller.value!r}")
+            raise InputError(Phrase("unknown controller {name}", name=repr(self.controller.value)))
         return CONTROLLERS[self.controller.value]
 
     def _setup(self, kind: ControllerKind | None = None) -> ControlSetup:
@@ -152,7 +171,7 @@ class ControlView:
             fn(*args)
         except TpmVizError as exc:
             with self.view.hub.lock:
-                self.view.refuse(str(exc), resync=False)
+                self.view.refuse(exc, resync=False)
 
     def _show_gains(self) -> None:
         try:
@@ -160,7 +179,7 @@ class ControlView:
             masses = axis_masses(model_with_errors(self.view.session.state.params, *setup.mass_error))
         except (TpmVizError, AttributeError):
             return
-        self.gains.content = gains_html(setup.controller, setup.gains, masses)
+        self.gains.content = gains_html(setup.controller, setup.gains, masses, self.view.lang)
 
     def attach(self) -> None:
         """The tab joined its session: show the gains for its mechanism."""
@@ -195,7 +214,11 @@ class ControlView:
             reference = lab_reference(self.reference.value, self.runs.of(self.view.session).uploaded)
             self._request += 1
             request = self._request
-            self.busy = "Simulating all three controllers…" if lesson else f"Simulating {LABELS[setup.controller]}…"
+            self.busy = (
+                T("Simulating all three controllers…")
+                if lesson
+                else Phrase("Simulating {controller}…", controller=label_of(setup.controller))
+            )
             self._refresh_status()
         if lesson:
             job = lambda: all_three(params, reference, setup)  # noqa: E731
@@ -211,9 +234,9 @@ class ControlView:
                 return
             self.busy = ""
             if error is not None:
-                self.status = f"Simulation refused: {error}"
+                self.status = Phrase("Simulation refused: {why}", why=_failure(error))
                 self._refresh_status()
-                self.view.refuse(str(error), resync=False)
+                self.view.refuse(_failure(error), resync=False)
                 return
             self.status = ""
             key = (
@@ -227,22 +250,28 @@ class ControlView:
                 self.table[kind] = run
             run, seconds = result.get(setup.controller, next(iter(result.values())))
             self._load(params, run, seconds)
-            self.table_html.content = comparison_html(self.table, self._setup_text(run))
             if lesson:
-                self.lesson_text.content = lesson_html(self.table, setup.payload, setup.mass_error[0])
+                self._lesson = (setup.payload, setup.mass_error[0])
+            self._write_tables()
             try:
                 self.player.seek(0.0)
             except TpmVizError as exc:
-                self.view.refuse(str(exc), resync=False)
+                self.view.refuse(exc, resync=False)
             self._refresh_status()
 
-    def _setup_text(self, run: ControlRun) -> str:
-        s = run.setup
-        limit = "no force limit" if s.force_limit is None else f"limit {s.force_limit:g} N"
-        return (
-            f"{run.name}, ω_n {s.gains.wn:g} Hz, ζ {s.gains.zeta:g}, payload {s.payload:g} kg, mass error "
-            f"{s.mass_error[0] * 100:+g} %, {limit}, {s.rate:g} Hz, noise {s.noise * 1e6:g} µm"
-        )
+    def _write_tables(self) -> None:
+        """The comparison table and the lesson's words, in the tab's language (under the lock)."""
+        lang = self.view.lang
+        if self.run is not None:
+            self.table_html.content = comparison_html(self.table, setup_phrase(self.run), lang)
+        if self._lesson is not None:
+            self.lesson_text.content = lesson_html(self.table, *self._lesson, lang)
+
+    def retell(self) -> None:
+        """The tab's language changed: the gains, the run, the table and the lesson again, in it (under the lock)."""
+        self._show_gains()
+        self._write_tables()
+        self._refresh_status()
 
     def _load(self, params: Params, run: ControlRun, seconds: float) -> None:
         """Make ``run`` the one played and charted (under the lock)."""
@@ -326,8 +355,11 @@ class ControlView:
     def _refresh_status(self) -> None:
         if self.view.closed:
             return
-        self.summary.content = run_html(self.run, self.seconds, self.busy, self.status) + (
-            "<div style='font-size:0.85em;color:#334155'>playing…</div>" if self.player.playing else ""
+        lang = self.view.lang
+        self.summary.content = run_html(self.run, self.seconds, self.busy, self.status, lang) + (
+            f"<div style='font-size:0.85em;color:#334155'>{say(lang, T('playing…'))}</div>"
+            if self.player.playing
+            else ""
         )
         self.view.client.flush()
 

@@ -15,6 +15,7 @@ from tpm_viz.multibody.control import ControlRun, ControlSetup, simulate
 from tpm_viz.paper.control import ControllerKind, Gains
 from tpm_viz.paper.trajectories import trajectory_from_samples
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase
 
 __all__ = ["PAPER", "ControlMotion", "all_three", "lab_reference", "lab_setup", "timed", "upload_label"]
 
@@ -43,7 +44,7 @@ def lab_reference(label: str, uploaded: Source | None):
     if uploaded is not None and uploaded.knots is not None and label == upload_label(uploaded):
         t, p = uploaded.knots
         return trajectory_from_samples(t, p, name=uploaded.label.split(", T =")[0])
-    raise InputError(f"unknown reference {label!r}: upload a CSV in the Player first")
+    raise InputError(Phrase("unknown reference {label}: upload a CSV in the Player first", label=repr(label)))
 
 
 def upload_label(source: Source) -> str:

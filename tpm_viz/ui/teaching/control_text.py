@@ -1,6 +1,7 @@
 """Text of the *Control* tab (HTML): gains, a run's summary, the comparison table and the lesson "why computed
-torque". Formatting only: every number comes from the runs (through :func:`.text.num`, a dash for NaN or infinity),
-none is typed in; every name is escaped."""
+torque", in a tab's language (``lang``; the words are :class:`~tpm_viz.words.Phrase` s rendered with ``say``).
+Formatting only: every number comes from the runs (through :func:`.text.num`, a dash for NaN or infinity), none is
+typed in; every name is escaped."""
 
 from __future__ import annotations
 
@@ -9,72 +10,117 @@ import html
 from tpm_viz.multibody.control import ControlRun
 from tpm_viz.paper.control import ControllerKind, Gains
 from tpm_viz.ui.text import num
+from tpm_viz.words import Lang, Phrase, T, say
 
-__all__ = ["LABELS", "comparison_html", "gains_html", "lesson_html", "run_html"]
+__all__ = ["LABELS", "comparison_html", "gains_html", "label_of", "lesson_html", "run_html", "setup_phrase"]
 
 LABELS = {ControllerKind.PD: "PD", ControllerKind.PDFF: "PD + feedforward", ControllerKind.CTC: "Computed torque"}
+"""The controllers' names: the options of the *Controller* dropdown (fixed texts, in the catalogue)."""
 _STYLE = "font-size:0.85em;color:#334155;line-height:1.45"
 
 
-def gains_html(kind: ControllerKind, gains: Gains, masses: tuple[float, float]) -> str:
+def label_of(kind: ControllerKind) -> Phrase:
+    """The name of a controller as a phrase (rendered from the catalogue, as the dropdown shows it)."""
+    return Phrase(LABELS[kind])
+
+
+def _q(name: str, text: str) -> str:
+    """A number in a ``data-q`` span (for the browser tests)."""
+    return f"<span data-q='{name}'>{text}</span>"
+
+
+def gains_html(kind: ControllerKind, gains: Gains, masses: tuple[float, float], lang: Lang = Lang.EN) -> str:
     """The gains of the chosen law: ``K_p = ω²``, ``K_d = 2ζω`` and, for the actuator-space loops, the stiffness."""
     text = (
         f"ω = 2π ω_n = {num(gains.omega, '.1f')} rad/s, "
-        f"K_p = ω² = <span data-q='kp'>{num(gains.kp, '.0f')}</span> 1/s², "
-        f"K_d = 2ζω = <span data-q='kd'>{num(gains.kd, '.1f')}</span> 1/s"
+        f"K_p = ω² = {_q('kp', num(gains.kp, '.0f'))} 1/s², "
+        f"K_d = 2ζω = {_q('kd', num(gains.kd, '.1f'))} 1/s"
     )
     if kind is ControllerKind.CTC:
-        text += "<br>computed torque: τ = ID(p, ṗ, p̈_ref + K_d ė + K_p e), the closed form at the measured state"
+        more = T("computed torque: τ = ID(p, ṗ, p̈_ref + K_d ė + K_p e), the closed form at the measured state")
+        text += "<br>" + html.escape(say(lang, more))
     else:
         m1, m2 = masses
-        text += (
-            f"<br>per actuator: m_i = {num(m1, '.3f')}, {num(m2, '.3f')} kg (model at p = 0), stiffness m_i K_p = "
-            f"{num(m1 * gains.kp, '.1f', 1e-3)}, {num(m2 * gains.kp, '.1f', 1e-3)} N/mm"
+        stiffness = Phrase(
+            "per actuator: m_i = {m1}, {m2} kg (model at p = 0), stiffness m_i K_p = {k1}, {k2} N/mm",
+            m1=num(m1, ".3f"),
+            m2=num(m2, ".3f"),
+            k1=num(m1 * gains.kp, ".1f", 1e-3),
+            k2=num(m2 * gains.kp, ".1f", 1e-3),
         )
+        text += "<br>" + html.escape(say(lang, stiffness))
         if kind is ControllerKind.PDFF:
-            text += "<br>plus the closed-form τ along the reference (eqs. 29-31) as feedforward"
+            feedforward = T("plus the closed-form τ along the reference (eqs. 29-31) as feedforward")
+            text += "<br>" + html.escape(say(lang, feedforward))
     return f'<div data-q="gains" style="{_STYLE}">{text}</div>'
 
 
-def _saturation(run: ControlRun) -> str:
-    return f"{num(run.time_in_saturation, '.1f', 1e3)} ms"
+def setup_phrase(run: ControlRun) -> Phrase:
+    """The setup of a run in one line (reference, gains, mismatch, limits, noise), for the comparison table."""
+    s = run.setup
+    limit = T("no force limit") if s.force_limit is None else Phrase("limit {limit:g} N", limit=s.force_limit)
+    return Phrase(
+        "{name}, ω_n {wn:g} Hz, ζ {zeta:g}, payload {payload:g} kg, mass error {error} %, {limit}, {rate:g} Hz, "
+        "noise {noise:g} µm",
+        name=run.name,
+        wn=s.gains.wn,
+        zeta=s.gains.zeta,
+        payload=s.payload,
+        error=num(s.mass_error[0], "+g", 100),
+        limit=limit,
+        rate=s.rate,
+        noise=s.noise * 1e6,
+    )
 
 
-def run_html(run: ControlRun | None, seconds: float | None, busy: str = "", status: str = "") -> str:
+def run_html(
+    run: ControlRun | None,
+    seconds: float | None,
+    busy: str | Phrase = "",
+    status: str | Phrase = "",
+    lang: Lang = Lang.EN,
+) -> str:
     """The run being played: its figures, how long it took to simulate, what is computing, why it stopped."""
     esc = html.escape
     lines = []
     if busy:
-        lines.append(f"<i>{esc(busy)}</i>")
+        lines.append(f"<i>{esc(say(lang, busy))}</i>")
     if status:
-        lines.append(f'<span style="color:#991b1b">{esc(status)}</span>')
+        lines.append(f'<span style="color:#991b1b">{esc(say(lang, status))}</span>')
     if run is None:
         if not lines:
-            lines.append("No run yet: choose a controller and a reference, then press <b>Simulate</b>.")
+            lines.append(say(lang, T("No run yet: choose a controller and a reference, then press <b>Simulate</b>.")))
     else:
         s = run.setup
-        lines.append(
-            f"<b>{esc(LABELS[s.controller])}</b> on {esc(run.name)}, "
-            f"{num(run.t[-1], '.3f')} s at {num(s.rate, '.0f')} Hz"
-            + (f" (simulated in <span data-q='sim-ms'>{num(seconds, '.0f', 1e3)}</span> ms)" if seconds else "")
+        head = Phrase(
+            "<b>{controller}</b> on {name}, {t} s at {rate} Hz",
+            controller=esc(say(lang, label_of(s.controller))),
+            name=esc(run.name),
+            t=num(run.t[-1], ".3f"),
+            rate=num(s.rate, ".0f"),
         )
-        lines.append(
-            f"RMS error <span data-q='run-rms'>{num(run.rms_error, '.2f', 1e6)}</span> µm, max "
-            f"{num(run.max_error, '.2f', 1e6)} µm, peak |τ| {num(run.peak_force, '.1f')} N, "
-            f"saturated {_saturation(run)}"
+        took = Phrase(" (simulated in {ms} ms)", ms=_q("sim-ms", num(seconds, ".0f", 1e3))) if seconds else ""
+        lines.append(say(lang, head) + say(lang, took))
+        figures = Phrase(
+            "RMS error {rms} µm, max {max} µm, peak |τ| {peak} N, saturated {saturated} ms",
+            rms=_q("run-rms", num(run.rms_error, ".2f", 1e6)),
+            max=num(run.max_error, ".2f", 1e6),
+            peak=num(run.peak_force, ".1f"),
+            saturated=num(run.time_in_saturation, ".1f", 1e3),
         )
+        lines.append(say(lang, figures))
     return f'<div data-q="control-run" style="{_STYLE}">' + "<br>".join(lines) + "</div>"
 
 
-def comparison_html(runs: dict[ControllerKind, ControlRun], setup_text: str) -> str:
+_HEADS = (T("controller"), T("RMS error (µm)"), T("max error (µm)"), T("peak |τ| (N)"), T("saturated (ms)"))
+
+
+def comparison_html(runs: dict[ControllerKind, ControlRun], setup: str | Phrase, lang: Lang = Lang.EN) -> str:
     """The controllers on the same run (same reference, mechanism, mismatch, limits and noise)."""
     if not runs:
         return ""
     cell = "padding:2px 6px;text-align:right;font-variant-numeric:tabular-nums"
-    head = "".join(
-        f'<th style="{cell}">{h}</th>'
-        for h in ("controller", "RMS error (µm)", "max error (µm)", "peak |τ| (N)", "saturated (ms)")
-    )
+    head = "".join(f'<th style="{cell}">{html.escape(say(lang, h))}</th>' for h in _HEADS)
     body = []
     for kind in ControllerKind:
         run = runs.get(kind)
@@ -82,53 +128,74 @@ def comparison_html(runs: dict[ControllerKind, ControlRun], setup_text: str) -> 
             continue
         v = kind.value
         body.append(
-            f'<tr><td style="padding:2px 6px">{html.escape(LABELS[kind])}</td>'
+            f'<tr><td style="padding:2px 6px">{html.escape(say(lang, label_of(kind)))}</td>'
             f'<td style="{cell}" data-q="rms-{v}">{num(run.rms_error, ".2f", 1e6)}</td>'
             f'<td style="{cell}" data-q="max-{v}">{num(run.max_error, ".2f", 1e6)}</td>'
             f'<td style="{cell}" data-q="peak-{v}">{num(run.peak_force, ".1f")}</td>'
             f'<td style="{cell}" data-q="sat-{v}">{num(run.time_in_saturation, ".1f", 1e3)}</td></tr>'
         )
+    title = html.escape(say(lang, T("Same run, each controller")))
     return (
-        f'<div data-q="control-table" style="{_STYLE}"><b>Same run, each controller</b> '
-        f'<span style="color:#64748b">({html.escape(setup_text)})</span>'
+        f'<div data-q="control-table" style="{_STYLE}"><b>{title}</b> '
+        f'<span style="color:#64748b">({html.escape(say(lang, setup))})</span>'
         f'<table style="border-collapse:collapse;margin-top:4px"><tr>{head}</tr>{"".join(body)}</table></div>'
     )
 
 
-def _ratio(a: float, b: float) -> str:
+def _ratio(a: float, b: float) -> Phrase | str:
     """``a / b`` as "3.2× smaller" / "1.4× larger" (by the numbers)."""
     if not (a > 0 and b > 0):
         return "—"
-    return f"{num(a / b, '.2g')}× smaller" if a > b else f"{num(b / a, '.2g')}× larger"
+    if a > b:
+        return Phrase("{ratio}× smaller", ratio=num(a / b, ".2g"))
+    return Phrase("{ratio}× larger", ratio=num(b / a, ".2g"))
 
 
-def lesson_html(runs: dict[ControllerKind, ControlRun], payload: float, mass_error: float) -> str:
+def lesson_html(runs: dict[ControllerKind, ControlRun], payload: float, mass_error: float, lang: Lang = Lang.EN) -> str:
     """The lesson "why computed torque", its claims worded from the three runs' numbers."""
     pd, ff, ctc = (runs.get(k) for k in (ControllerKind.PD, ControllerKind.PDFF, ControllerKind.CTC))
     if pd is None or ff is None or ctc is None:
         return ""
     e = {k: r.rms_error for k, r in runs.items()}
     best = min(e, key=lambda k: e[k])
-    parts = [f"a payload of {num(payload, '.2f')} kg the controllers do not know"] if payload > 0 else []
-    if mass_error:
-        parts.append(f"masses {num(mass_error, '+.0f', 100)} % off in their model")
-    mismatch = " and ".join(parts) if parts else "an exact model (add a payload to see the difference)"
+    payload_words = Phrase("a payload of {mass} kg the controllers do not know", mass=num(payload, ".2f"))
+    error_words = Phrase("masses {error} % off in their model", error=num(mass_error, "+.0f", 100))
+    if payload > 0 and mass_error:
+        mismatch: Phrase = Phrase("{first} and {second}", first=payload_words, second=error_words)
+    elif payload > 0:
+        mismatch = payload_words
+    elif mass_error:
+        mismatch = error_words
+    else:
+        mismatch = T("an exact model (add a payload to see the difference)")
     paras = [
-        f"Same reference, same gains, {mismatch}.",
-        f"<b>PD</b> makes force only from the error, so it must lag to push: RMS error "
-        f"{num(e[ControllerKind.PD], '.1f', 1e6)} µm, peak |τ| {num(pd.peak_force, '.1f')} N.",
-        f"<b>PD + feedforward</b> adds the closed-form force along the reference; the feedback is left with what the "
-        f"model misses: RMS {num(e[ControllerKind.PDFF], '.1f', 1e6)} µm, "
-        f"{_ratio(e[ControllerKind.PD], e[ControllerKind.PDFF])} than PD.",
-        f"<b>Computed torque</b> evaluates the model at the <i>measured</i> state and turns the feedback into an "
-        f"acceleration, so the error obeys ë + K_d ė + K_p e ≈ 0 whatever the pose: RMS "
-        f"{num(e[ControllerKind.CTC], '.1f', 1e6)} µm, {_ratio(e[ControllerKind.PDFF], e[ControllerKind.CTC])} than "
-        f"PD + feedforward.",
-        f"Smallest error here: <b>{html.escape(LABELS[best])}</b>. The paper derived its closed form "
-        "“for the real-time computed torque control” (Sections 1, 3, 5): these are the figures behind that.",
+        Phrase("Same reference, same gains, {mismatch}.", mismatch=mismatch),
+        Phrase(
+            "<b>PD</b> makes force only from the error, so it must lag to push: RMS error {rms} µm, peak |τ| {peak} N.",
+            rms=num(e[ControllerKind.PD], ".1f", 1e6),
+            peak=num(pd.peak_force, ".1f"),
+        ),
+        Phrase(
+            "<b>PD + feedforward</b> adds the closed-form force along the reference; the feedback is left with what "
+            "the model misses: RMS {rms} µm, {ratio} than PD.",
+            rms=num(e[ControllerKind.PDFF], ".1f", 1e6),
+            ratio=_ratio(e[ControllerKind.PD], e[ControllerKind.PDFF]),
+        ),
+        Phrase(
+            "<b>Computed torque</b> evaluates the model at the <i>measured</i> state and turns the feedback into an "
+            "acceleration, so the error obeys ë + K_d ė + K_p e ≈ 0 whatever the pose: RMS {rms} µm, {ratio} than "
+            "PD + feedforward.",
+            rms=num(e[ControllerKind.CTC], ".1f", 1e6),
+            ratio=_ratio(e[ControllerKind.PDFF], e[ControllerKind.CTC]),
+        ),
+        Phrase(
+            "Smallest error here: <b>{best}</b>. The paper derived its closed form “for the real-time computed "
+            "torque control” (Sections 1, 3, 5): these are the figures behind that.",
+            best=html.escape(say(lang, label_of(best))),
+        ),
     ]
     return (
         f'<div data-q="lesson" style="{_STYLE}">'
-        + "".join(f"<p style='margin:0 0 4px 0'>{p}</p>" for p in paras)
+        + "".join(f"<p style='margin:0 0 4px 0'>{say(lang, p)}</p>" for p in paras)
         + "</div>"
     )

@@ -23,12 +23,14 @@ import numpy as np
 import viser
 
 from tpm_viz import meshes
-from tpm_viz.app.overlays import MAP_KINDS, cached_map, colour_scale, ellipse_polylines, map_rgba
+from tpm_viz.app.overlays import COND_MAX, MAP_KINDS, cached_map, colour_scale, ellipse_polylines, map_rgba
+from tpm_viz.app.readouts import reason
 from tpm_viz.params import Params
 from tpm_viz.ui.guard import guarded
 from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.text import num
 from tpm_viz.ui.worker import Worker
+from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["ELLIPSE_COLOURS", "ELLIPSE_SCALE", "ExplorerView", "MapService"]
 
@@ -39,6 +41,19 @@ ELLIPSE_SCALE = 0.12
 ELLIPSE_CAP = 3.0
 ELLIPSE_Z = meshes.PLATFORM_Z[1] + 0.004
 ELLIPSE_COLOURS = {"velocity": (30, 58, 138), "force": (234, 88, 12)}  # dark blue (not the leg circles' blue)
+_LEGEND = {
+    str(t): t
+    for t in (
+        T("det J_x = cos(θ1+θ2) (dimensionless)"),
+        T("white band: direct singularity"),
+        T("condition number of J (log scale)"),
+        T("workspace (working mode, eq. 4)"),
+        T("in stroke"),
+        T("reachable, out of stroke"),
+        T("transparent: unreachable (|p_j| ≥ l_a)"),
+    )
+}
+"""The words of the maps' legends (:func:`~tpm_viz.app.overlays.colour_scale`, English) as phrases."""
 
 
 class MapService:
@@ -49,7 +64,7 @@ class MapService:
         self._lock = threading.Lock()
         self._maps: OrderedDict[Params, dict[str, np.ndarray]] = OrderedDict()
         self._pending: set[Params] = set()
-        self._failed: dict[Params, str] = {}  # why a map could not be computed (not retried)
+        self._failed: dict[Params, Phrase] = {}  # why a map could not be computed (not retried)
         self.subscribers: weakref.WeakSet = weakref.WeakSet()
         self.last_seconds = float("nan")
         """Wall time of the last map computation [s] (for the benchmark)."""
@@ -68,7 +83,7 @@ class MapService:
                 )
             return None
 
-    def failure(self, params: Params) -> str | None:
+    def failure(self, params: Params) -> Phrase | None:
         """Why the map of ``params`` could not be computed, or None."""
         with self._lock:
             return self._failed.get(params)
@@ -84,7 +99,7 @@ class MapService:
         with self._lock:
             self._pending.discard(params)
             if images is None:
-                self._failed[params] = str(error) if error is not None else "no map"
+                self._failed[params] = reason(error) if error is not None else T("no map")
             else:
                 self._maps[params] = images
                 while len(self._maps) > 8:
@@ -93,12 +108,23 @@ class MapService:
             view.map_ready(params)
 
 
-def colour_bar_html(kind: str) -> str:
-    """The legend of a map kind: a gradient (or swatches) with labelled stops."""
+def _legend(lang: Lang, text: str) -> str:
+    """A word of a legend in ``lang`` (escaped)."""
+    if text.startswith("1 = isotropic"):
+        return html.escape(say(lang, Phrase("1 = isotropic; ≥ {most:g} saturates", most=COND_MAX)))
+    return html.escape(say(lang, _LEGEND.get(text, text)))
+
+
+def colour_bar_html(kind: str, lang: Lang = Lang.EN) -> str:
+    """The legend of a map kind: a gradient (or swatches) with labelled stops, in ``lang``."""
     scale = colour_scale(kind)
     if not scale.stops:
-        return '<div style="font-size:0.8em;color:#64748b">No map: the floor shows the in-stroke workspace.</div>'
-    esc = html.escape
+        words = html.escape(say(lang, T("No map: the floor shows the in-stroke workspace.")))
+        return f'<div style="font-size:0.8em;color:#64748b">{words}</div>'
+
+    def esc(text: str) -> str:
+        return _legend(lang, text)
+
     if kind == "workspace":
         body = "".join(
             f'<span style="display:inline-flex;align-items:center;gap:4px;margin-right:10px">'
@@ -142,7 +168,7 @@ class ExplorerView:
             "The loci stay on top: red arcs cos(θ1+θ2) = 0 (eq. 12), amber square |p_j| = l_a (eq. 11)."
         )
         self.map_kind = gui.add_dropdown("Floor map", tuple(MAP_KINDS.values()), initial_value=MAP_KINDS["off"])
-        self.legend = gui.add_html(colour_bar_html("off"))
+        self.legend = gui.add_html(colour_bar_html("off", self.view.lang))
         self.status = gui.add_markdown("")
         self.ellipses = gui.add_checkbox(
             "Manipulability ellipses", False, hint="Velocity (dark blue) and force (orange) ellipses at the platform"
@@ -201,7 +227,7 @@ class ExplorerView:
         kind = self.kind
         if self._map_drawn == (params, kind):
             return
-        self.legend.content = colour_bar_html(kind)
+        self.legend.content = colour_bar_html(kind, self.view.lang)
         self.view.scene.set_region_hidden(kind != "off")  # the workspace floor would cover the map
         if kind == "off":
             self._map_drawn = (params, kind)
@@ -212,8 +238,10 @@ class ExplorerView:
         images = self.maps.get(params)
         if images is None:
             failure = self.maps.failure(params)
-            computing = "*Computing the map for these parameters…*"
-            self.status.content = f"Map unavailable: {html.escape(failure)}" if failure else computing
+            lang = self.view.lang
+            computing = "*" + say(lang, T("Computing the map for these parameters…")) + "*"
+            unavailable = Phrase("Map unavailable: {why}", why=failure) if failure else None
+            self.status.content = html.escape(say(lang, unavailable)) if unavailable else computing
             if self._image is not None:
                 self._image.visible = False
             return
@@ -270,21 +298,45 @@ class ExplorerView:
     def _readout_html(self, frame: Snapshot, drawing) -> str:
         if not self.ellipses_on:
             return ""
-        r = frame.readout
-        head = f"det J_x = {num(r.det_jx, '.3f')}, condition number of J = {num(r.cond, '.2f')}"
+        r, lang = frame.readout, self.view.lang
+        head = say(
+            lang,
+            Phrase(
+                "det J_x = {det}, condition number of J = {cond}", det=num(r.det_jx, ".3f"), cond=num(r.cond, ".2f")
+            ),
+        )
         if drawing is None:
-            body = "Ellipses hidden: J is singular (or nearly) at this pose."
+            body = say(lang, T("Ellipses hidden: J is singular (or nearly) at this pose."))
         else:
             v, f = drawing.velocity_radii, drawing.force_radii
-            body = (
-                f"<span style='color:#1e3a8a'>velocity ellipse</span> semi-axes {num(v.min(), '.3f')} × "
-                f"{num(v.max(), '.3f')} (m/s per m/s of actuator speed)<br>"
-                f"<span style='color:#ea580c'>force ellipse</span> semi-axes {num(f.min(), '.3f')} × "
-                f"{num(f.max(), '.3f')} (N per N of actuator force)<br>"
-                f"drawn at {ELLIPSE_SCALE * 1e3:.0f} mm per unit"
-                + (f", radii clipped at {ELLIPSE_CAP:g}" if drawing.clipped else "")
+            velocity = Phrase(
+                "<span style='color:#1e3a8a'>velocity ellipse</span> semi-axes {low} × {high} (m/s per m/s of actuator "
+                "speed)",
+                low=num(v.min(), ".3f"),
+                high=num(v.max(), ".3f"),
             )
+            force = Phrase(
+                "<span style='color:#ea580c'>force ellipse</span> semi-axes {low} × {high} (N per N of actuator force)",
+                low=num(f.min(), ".3f"),
+                high=num(f.max(), ".3f"),
+            )
+            scale = (
+                Phrase(
+                    "drawn at {mm:.0f} mm per unit, radii clipped at {cap:g}", mm=ELLIPSE_SCALE * 1e3, cap=ELLIPSE_CAP
+                )
+                if drawing.clipped
+                else Phrase("drawn at {mm:.0f} mm per unit", mm=ELLIPSE_SCALE * 1e3)
+            )
+            body = "<br>".join(say(lang, x) for x in (velocity, force, scale))
         return f'<div data-q="ellipses" style="font-size:0.8em;color:#334155;line-height:1.4">{head}<br>{body}</div>'
+
+    def retell(self) -> None:
+        """The tab's language changed: the legend and the map's status again, in it (under the hub's lock)."""
+        self._map_drawn = None
+        if self._frame is not None:
+            self._draw_map(self._frame.state.params)
+        else:
+            self.legend.content = colour_bar_html(self.kind, self.view.lang)
 
     def close(self) -> None:
         """The tab went away."""

@@ -57,8 +57,9 @@ def _internal_error(owner, exc: Exception) -> None:
 
 
 def problems_html(problems: Sequence[str], lang: Lang = Lang.EN) -> str:
-    """The lesson files that were refused, one line each (``file:line: what is wrong``)."""
-    lines = "".join(f"<li>{html.escape(p)}</li>" for p in problems)
+    """The lesson files that were refused, one line each (``file:line: what is wrong``), in ``lang`` (a
+    :class:`~tpm_viz.app.lesson_toml.Problem` keeps its phrase; any other line is shown as it is)."""
+    lines = "".join(f"<li>{html.escape(say(lang, getattr(p, 'phrase', p)))}</li>" for p in problems)
     head = say(lang, "{count} lesson file(s) refused:", count=len(problems))
     return (
         f'<div data-q="demo-problems" style="font-size:0.8em;color:#b91c1c"><b>{html.escape(head)}'
@@ -145,7 +146,7 @@ class DemosView:
 
     def _refuse(self, exc: Exception) -> None:
         with self.view.hub.lock:
-            self.view.refuse(exc.args[0] if exc.args and isinstance(exc.args[0], Phrase) else str(exc))
+            self.view.refuse(exc)
 
     def _user(self, event) -> bool:
         return getattr(event, "client", None) is not None and not getattr(self.view, "closed", False)
@@ -207,7 +208,7 @@ class DemosView:
                 session.play_token += 1
                 view.hub.commit(session, new, origin=view)
             except TpmVizError as exc:
-                view.refuse(exc.args[0] if exc.args and isinstance(exc.args[0], Phrase) else str(exc))
+                view.refuse(exc)
                 return
             position, look_at = beside_panel(*camera)
             view.client.camera.position = position

@@ -26,6 +26,7 @@ from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.params import Params
 from tpm_viz.ui.guard import report
 from tpm_viz.ui.teaching.charts import marker
+from tpm_viz.words import Phrase
 
 __all__ = ["FPS", "Motion", "MotionPlayer", "TimeChart"]
 
@@ -80,9 +81,9 @@ class MotionPlayer:
     def _usable(self) -> Motion:
         motion = self.motion
         if motion is None:
-            raise InputError("nothing to play yet: compute it first")
+            raise InputError(Phrase("nothing to play yet: compute it first"))
         if motion.params != self.view.session.state.params:
-            raise InputError("the mechanism changed since this was computed: compute it again")
+            raise InputError(Phrase("the mechanism changed since this was computed: compute it again"))
         return motion
 
     def seek(self, t: float) -> None:

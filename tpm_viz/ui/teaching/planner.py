@@ -19,6 +19,7 @@ import viser
 from tpm_viz import meshes
 from tpm_viz.app.palette import hex_colour
 from tpm_viz.app.planning import PATH_KINDS, PlanResult, solve
+from tpm_viz.app.readouts import reason
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.params import Params
 from tpm_viz.ui.guard import guarded
@@ -28,6 +29,7 @@ from tpm_viz.ui.teaching.planner_text import industry_html, result_html, sizing_
 from tpm_viz.ui.teaching.player import SPEEDS
 from tpm_viz.ui.teaching.trace import TRACE_Z, segments
 from tpm_viz.ui.worker import Worker
+from tpm_viz.words import Phrase, T
 
 __all__ = ["BAR_HEIGHT", "PlanMotion", "PlannerView", "bar_segments", "floor_point"]
 
@@ -40,7 +42,7 @@ CHART_HZ = 4.0
 
 
 def _internal_error(owner, exc: Exception) -> None:
-    owner.view.refuse(f"internal error ({type(exc).__name__}), logged on the server", resync=False)
+    owner.view.refuse(Phrase("internal error ({kind}), logged on the server", kind=type(exc).__name__), resync=False)
 
 
 def bar_segments(params: Params, d, tau, limit: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -102,7 +104,7 @@ class PlannerView:
         self.worker = worker
         self.player = MotionPlayer(view, "plan", on_stop=self._flush)
         self.result: PlanResult | None = None
-        self.error = ""
+        self.error: str | Phrase = ""
         self._request = 0
         self._shown = 0
         self._planned_for: Params | None = None
@@ -127,7 +129,7 @@ class PlannerView:
         self.clear = gui.add_button("Clear waypoints", color="gray", visible=False)
         self.force = gui.add_slider("Force limit F_max (N)", 20.0, 1000.0, 5.0, 200.0)
         self.speed = gui.add_slider("Speed limit (m/s, 0 = none)", 0.0, 5.0, 0.05, 0.0)
-        self.result_html = gui.add_html(result_html(None, 200.0, None, False))
+        self.result_html = gui.add_html(result_html(None, 200.0, None, False, lang=self.view.lang))
         self.controls = gui.add_button_group("Playback", ("Play", "Pause", "To start"))
         self.play_speed = gui.add_dropdown("Speed", tuple(SPEEDS), initial_value="0.1×")
         self.loop = gui.add_checkbox("Loop", True)
@@ -158,7 +160,7 @@ class PlannerView:
             fn(*args)
         except TpmVizError as exc:
             with self.view.hub.lock:
-                self.view.refuse(str(exc), resync=False)
+                self.view.refuse(exc, resync=False)
 
     @guarded(on_error=_internal_error)
     def _on_limits(self, event) -> None:
@@ -187,13 +189,17 @@ class PlannerView:
             self._shown = request
             latest = request == self._request
             if error is not None:
-                self.error = f"No plan: {error}" if isinstance(error, TpmVizError) else "No plan: internal error"
-                self.result_html.content = result_html(None, 0.0, None, not latest, self.error)
+                self.error = (
+                    Phrase("No plan: {why}", why=reason(error))
+                    if isinstance(error, TpmVizError)
+                    else T("No plan: internal error")
+                )
+                self.result_html.content = result_html(None, 0.0, None, not latest, self.error, self.view.lang)
                 self.view.client.flush()
                 return
             self.error = ""
             self.result = result
-            self.result_html.content = result_html(result, 0.0, None, not latest)
+            self.result_html.content = result_html(result, 0.0, None, not latest, lang=self.view.lang)
             if latest:
                 self._load(params, result)
             self.view.client.flush()
@@ -205,7 +211,7 @@ class PlannerView:
         s, limit = result.samples, result.plan.limits.force
         ones = np.ones_like(s.t)
         self.chart.show(s.t, (s.tau[:, 0], s.tau[:, 1], limit * ones, -limit * ones))
-        self.sizing.content = sizing_html(result)
+        self.sizing.content = sizing_html(result, self.view.lang)
         self._path = self.view.client.scene.add_line_segments(
             "/planner/path", segments(s.p, TRACE_Z, 400), PATH_COLOUR, thickness=2.5, thickness_units="screen"
         )
@@ -231,7 +237,7 @@ class PlannerView:
         self._user(event, self._set_waypoints, f"{text}; {item}" if text else item)
 
     def _refuse_click(self) -> None:
-        raise InputError("Shift+click on the floor to add a waypoint")
+        raise InputError(Phrase("Shift+click on the floor to add a waypoint"))
 
     def _set_waypoints(self, text: str) -> None:
         with self.view.hub.lock:
@@ -256,6 +262,16 @@ class PlannerView:
         self.view.client.flush()
 
     # -- drawing -------------------------------------------------------------------------------------------
+    def retell(self) -> None:
+        """The tab's language changed: the result line and the sizing table again, in it (under the hub's lock)."""
+        busy, lang = self._shown < self._request, self.view.lang
+        if self.error:
+            self.result_html.content = result_html(None, 0.0, None, busy, self.error, lang)
+        else:
+            self.result_html.content = result_html(self.result, 0.0, None, busy, lang=lang)
+        if self.result is not None:
+            self.sizing.content = sizing_html(self.result, lang)
+
     def attach(self) -> None:
         """The tab joined its session: plan the default path for its mechanism."""
         self.request()

@@ -104,6 +104,9 @@ class Teaching:
         """The tab's language changed: the texts the tabs wrote themselves, again in it (under the hub's lock)."""
         self.player.refresh()
         self.demos.retell()
+        self.control.retell()
+        self.planner.retell()
+        self.explorer.retell()
 
     def close(self) -> None:
         """The tab went away."""
