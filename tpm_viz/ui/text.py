@@ -15,7 +15,7 @@ import numpy as np
 from tpm_viz.app.palette import hex_colour
 from tpm_viz.app.readouts import Readout
 from tpm_viz.app.state import AppState
-from tpm_viz.words import Lang, say
+from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["COLORS_CSS", "banner_level", "dashboard_html", "force_scale", "legend_html", "num"]
 
@@ -74,7 +74,7 @@ def _banner(state: AppState, readout: Readout, lang: Lang) -> str:
     level = banner_level(readout)
     bg, fg, border = COLORS_CSS[level]
     lines = [html.escape(say(lang, a.text)) for a in readout.alerts] or [
-        "Regular pose: clear of singularities and stroke ends"
+        html.escape(say(lang, T("Regular pose: clear of singularities and stroke ends")))
     ]
     note = (
         f'<div style="margin-top:3px;font-style:italic">{html.escape(say(lang, state.note))}</div>'
@@ -96,19 +96,30 @@ def _row(label: str, values: str, unit: str) -> str:
     )
 
 
-def _kinematics(readout: Readout) -> str:
+def _kinematics(readout: Readout, lang: Lang) -> str:
     p, d, th = readout.p, readout.d, np.degrees(readout.theta)
     mode = "+ (det J_x > 0)" if readout.mode > 0 else "− (det J_x < 0)"
+    labels = [html.escape(say(lang, label)) for label in ROW_LABELS]
     rows = [
-        _row("platform p", f"({_q('p1', num(p[0], '.1f', 1e3))}, {_q('p2', num(p[1], '.1f', 1e3))})", "mm"),
-        _row("actuators d₁, d₂", f"{_q('d1', num(d[0], '.1f', 1e3))}, {_q('d2', num(d[1], '.1f', 1e3))}", "mm"),
-        _row("leg angles θ₁, θ₂", f"{_q('theta1', num(th[0], '.2f'))}, {_q('theta2', num(th[1], '.2f'))}", "deg"),
+        _row(labels[0], f"({_q('p1', num(p[0], '.1f', 1e3))}, {_q('p2', num(p[1], '.1f', 1e3))})", "mm"),
+        _row(labels[1], f"{_q('d1', num(d[0], '.1f', 1e3))}, {_q('d2', num(d[1], '.1f', 1e3))}", "mm"),
+        _row(labels[2], f"{_q('theta1', num(th[0], '.2f'))}, {_q('theta2', num(th[1], '.2f'))}", "deg"),
         _row("det J_x = cos(θ₁+θ₂)", _q("det_jx", num(readout.det_jx, ".4f")), "eq. 12"),
         _row("det J_q = cos θ₁ cos θ₂", _q("det_jq", num(readout.det_jq, ".4f")), "eq. 11"),
-        _row("condition number of J", _q("cond", num(readout.cond, ".2f")), "eq. 10"),
-        _row("assembly mode", _q("mode", mode), ""),
+        _row(labels[3], _q("cond", num(readout.cond, ".2f")), "eq. 10"),
+        _row(labels[4], _q("mode", mode), ""),
     ]
     return f'<table style="font-size:0.85em;border-collapse:collapse;margin-top:6px">{"".join(rows)}</table>'
+
+
+ROW_LABELS = (
+    T("platform p"),
+    T("actuators d₁, d₂"),
+    T("leg angles θ₁, θ₂"),
+    T("condition number of J"),
+    T("assembly mode"),
+)
+"""The dashboard's row labels (the others are formulas, the same in every language)."""
 
 
 def _bar(value, scale: float) -> str:
@@ -129,14 +140,26 @@ def _forces(state: AppState, readout: Readout, lang: Lang) -> str:
     f = readout.forces
     load = state.load
     if load.mode == "static":
-        head = (
-            f"Static: external load on platform f_ext = ({num(load.f_ext[0], '.1f')}, {num(load.f_ext[1], '.1f')}) N; "
-            f"{html.escape(f.equation)}"
+        head = say(
+            lang,
+            Phrase(
+                "Static: external load on platform f_ext = ({fx}, {fy}) N; {equation}",
+                fx=num(load.f_ext[0], ".1f"),
+                fy=num(load.f_ext[1], ".1f"),
+                equation=html.escape(say(lang, f.equation)),
+            ),
         )
     else:
-        head = (
-            f"Dynamic: ṗ = ({num(load.dp[0], '.3f')}, {num(load.dp[1], '.3f')}) m/s, "
-            f"p̈ = ({num(load.ddp[0], '.2f')}, {num(load.ddp[1], '.2f')}) m/s²; {html.escape(f.equation)}"
+        head = say(
+            lang,
+            Phrase(
+                "Dynamic: ṗ = ({v1}, {v2}) m/s, p̈ = ({a1}, {a2}) m/s²; {equation}",
+                v1=num(load.dp[0], ".3f"),
+                v2=num(load.dp[1], ".3f"),
+                a1=num(load.ddp[0], ".2f"),
+                a2=num(load.ddp[1], ".2f"),
+                equation=html.escape(say(lang, f.equation)),
+            ),
         )
     tau = [None, None] if f.tau is None else list(f.tau)
     ref = [None, None] if f.tau_ref is None else list(f.tau_ref)
@@ -148,14 +171,23 @@ def _forces(state: AppState, readout: Readout, lang: Lang) -> str:
             f'<div style="display:grid;grid-template-columns:1.6em 1fr 4.6em;gap:4px;align-items:center">'
             f"<b>τ{'₁₂'[i]}</b>{_bar(tau[i], scale)}"
             f'<span style="text-align:right">{_q(f"tau{i + 1}", num(tau[i], ".2f"))} N</span></div>'
-            f'<div style="font-size:0.9em;color:#475569;margin:0 0 3px 1.9em">Pinocchio '
-            f"{_q(f'tau{i + 1}_ref', num(ref[i], '.2f'))} N, difference "
-            f"{_q(f'tau{i + 1}_diff', num(diff[i], '.1e'))} N</div>"
+            f'<div style="font-size:0.9em;color:#475569;margin:0 0 3px 1.9em">'
+            + say(
+                lang,
+                Phrase(
+                    "Pinocchio {ref} N, difference {diff} N",
+                    ref=_q(f"tau{i + 1}_ref", num(ref[i], ".2f")),
+                    diff=_q(f"tau{i + 1}_diff", num(diff[i], ".1e")),
+                ),
+            )
+            + "</div>"
         )
     note = f'<div style="color:#92400e">{html.escape(say(lang, f.note))}</div>' if f.note else ""
     return (
         f'<div style="font-size:0.85em;margin-top:6px"><div style="color:#334155;margin-bottom:3px">'
-        f"<b>Actuator forces</b> (paper's closed form; bars full scale ±{num(scale, '.0f')} N)<br>{head}</div>"
+        f"<b>{html.escape(say(lang, T('Actuator forces')))}</b> "
+        + html.escape(say(lang, Phrase("(paper's closed form; bars full scale ±{scale} N)", scale=num(scale, ".0f"))))
+        + f"<br>{head}</div>"
         f"{''.join(rows)}{note}</div>"
     )
 
@@ -185,4 +217,4 @@ def dashboard_html(state: AppState, readout: Readout, lang: Lang = Lang.EN) -> s
     """The always-visible top of the panel: banner, kinematic readouts, force bars. Its messages (the alerts, the
     note of the last move, the force note) in ``lang``; its fixed words are shown in the tab's language by the
     tab's connection (:mod:`tpm_viz.ui.language`)."""
-    return f"<div>{_banner(state, readout, lang)}{_kinematics(readout)}{_forces(state, readout, lang)}</div>"
+    return f"<div>{_banner(state, readout, lang)}{_kinematics(readout, lang)}{_forces(state, readout, lang)}</div>"

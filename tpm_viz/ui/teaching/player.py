@@ -294,7 +294,8 @@ class PlayerView:
             if t is not None:
                 self._put(self.time, float(np.clip(round(t, 4), 0.0, self.time.max)))
         if due or new_run or force:
-            self.summary.content = summary_html(ps, run, self._shown_t if self._shown_t is not _UNSET else t)
+            shown_t = self._shown_t if self._shown_t is not _UNSET else t
+            self.summary.content = summary_html(ps, run, shown_t, self.view.lang)
             self.duration.notes = () if run is None else (duration_note(run.duration), force_note(run.peak))
             self.duration.draw(self.view.lang)
             self.note.draw(self.view.lang)

@@ -1,47 +1,61 @@
 """Text of the player's summary line (HTML): formatting only, every number through :func:`.text.num` (a dash
-for NaN or infinity), every name escaped."""
+for NaN or infinity), every name escaped, every word a :class:`~tpm_viz.words.Phrase` rendered in the tab's
+language. Forces are per actuator: the peak is ``max_i |τ_i|`` over the run, written ``|τ_i|`` (never a norm)."""
 
 from __future__ import annotations
 
 import html
 
 from tpm_viz.ui.text import num
+from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["summary_html"]
 
+_WHERE = {
+    "playing": T("playing"),
+    "off": T("not on the path (moved by hand): press Play or move the time slider"),
+    "paused": T("paused"),
+}
 
-def summary_html(ps, run, t) -> str:
+
+def summary_html(ps, run, t, lang: Lang = Lang.EN) -> str:
     """The player's summary: what is loaded or computing, its peak force and Pinocchio difference, the
     previous run's peak, and where the playback is (``t`` [s], None when the platform left the path)."""
     esc = html.escape
     lines = []
     if ps.loading is not None:
-        lines.append(f"<i>Computing {esc(ps.loading.label)} (closed form and Pinocchio)…</i>")
+        computing = Phrase("Computing {name} (closed form and Pinocchio)…", name=ps.loading.label)
+        lines.append(f"<i>{esc(say(lang, computing))}</i>")
     if ps.status:
-        lines.append(f'<span style="color:#991b1b">{esc(ps.status)}</span>')
+        lines.append(f'<span style="color:#991b1b">{esc(say(lang, ps.status))}</span>')
     if run is None:
         if not lines:
-            lines.append("No trajectory loaded: choose one above or upload a CSV.")
+            lines.append(esc(say(lang, T("No trajectory loaded: choose one above or upload a CSV."))))
     else:
         diff = run.max_diff
-        lines.append(
-            f"<b>{esc(run.source.label)}</b>: peak |τ| = <span data-q='run-peak'>{num(run.peak, '.1f')}</span> N "
-            "(closed form)"
-        )
-        lines.append(
-            "Pinocchio − paper: max |Δτ| = "
-            + (f"<span data-q='run-diff'>{num(diff, '.1e')}</span> N" if diff is not None else esc(run.ref_note))
-        )
+        peak = f"<span data-q='run-peak'>{num(run.peak, '.1f')}</span>"
+        name = f"<b>{esc(run.source.label)}</b>"
+        lines.append(say(lang, Phrase("{name}: peak |τ_i| = {peak} N (closed form)", name=name, peak=peak)))
+        gap = f"<span data-q='run-diff'>{num(diff, '.1e')}</span> N" if diff is not None else esc(run.ref_note)
+        lines.append(say(lang, Phrase("Pinocchio − paper: max |Δτ_i| = {gap}", gap=gap)))
         if ps.previous is not None:
-            label, peak = ps.previous
-            ratio = f" (this / previous = {num(run.peak / peak, '.3f')})" if peak > 0 else ""
-            lines.append(f"Previous run: {esc(label)}, peak {num(peak, '.1f')} N{ratio}")
-        if ps.playing:
-            where = "playing"
-        elif t is None:
-            where = "not on the path (moved by hand): press Play or move the time slider"
-        else:
-            where = "paused"
-        t_text = num(t, ".3f") if t is not None else "—"
-        lines.append(f"t = <span data-q='player-t'>{t_text}</span> s of {num(run.duration, '.3f')} s, {where}")
+            label, before = ps.previous
+            previous = Phrase("Previous run: {name}, peak {peak} N", name=esc(label), peak=num(before, ".1f"))
+            text = say(lang, previous)
+            if before > 0:
+                text += say(lang, Phrase(" (this / previous = {ratio})", ratio=num(run.peak / before, ".3f")))
+            lines.append(text)
+        where = "playing" if ps.playing else "off" if t is None else "paused"
+        t_text = f"<span data-q='player-t'>{num(t, '.3f') if t is not None else '—'}</span>"
+        lines.append(
+            say(
+                lang,
+                Phrase(
+                    "t = {t} s of {duration} s, {where}",
+                    t=t_text,
+                    duration=num(run.duration, ".3f"),
+                    where=say(lang, _WHERE[where]),
+                ),
+            )
+        )
     return '<div style="font-size:0.85em;color:#334155;line-height:1.45">' + "<br>".join(lines) + "</div>"
