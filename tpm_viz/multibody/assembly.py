@@ -16,7 +16,9 @@ import numpy as np
 
 from tpm_viz.errors import InputError, SingularConfigurationError, UnreachablePoseError
 from tpm_viz.multibody.locking import locked
+from tpm_viz.numbers import fixed
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase
 
 __all__ = ["DOF", "NEWTON_FLOOR", "NEWTON_MAX_ITER", "NEWTON_TOL", "ClosedLoopAssembly"]
 
@@ -127,8 +129,12 @@ class ClosedLoopAssembly:
         la, (p1, p2) = self.params.l_a, p.tolist()
         if max(abs(p1), abs(p2)) >= la:
             raise UnreachablePoseError(
-                f"platform position ({p1 * 1e3:.1f}, {p2 * 1e3:.1f}) mm is unreachable: "
-                f"each |p_j| must be below l_a = {la * 1e3:.1f} mm"
+                Phrase(
+                    "platform position ({x}, {y}) mm is unreachable: each |p_j| must be below l_a = {l_a:.1f} mm",
+                    x=fixed(p1, ".1f", 1e3),
+                    y=fixed(p2, ".1f", 1e3),
+                    l_a=la * 1e3,
+                )
             )
         starts = [lambda: self._guess_from_platform(p, d)]
         if d is None and self._last is not None:  # fallback: continuation from the last pose, tangent predictor
@@ -143,8 +149,11 @@ class ClosedLoopAssembly:
                     self._last = (p.copy(), q, None)
                 return q, jc, jp
         raise SingularConfigurationError(
-            f"no closed-loop configuration found at ({p1 * 1e3:.1f}, {p2 * 1e3:.1f}) mm "
-            "(too close to cos θ_i = 0, eq. 11)"
+            Phrase(
+                "no closed-loop configuration found at ({x}, {y}) mm (too close to cos θ_i = 0, eq. 11)",
+                x=fixed(p1, ".1f", 1e3),
+                y=fixed(p2, ".1f", 1e3),
+            )
         )
 
     @locked
@@ -159,7 +168,7 @@ class ClosedLoopAssembly:
         gap = math.hypot(float(d[0] - k), float(d[1] - k))  # |C_2 - C_1|, no overflow for huge d
         if not gap < 2 * la or gap == 0:
             raise UnreachablePoseError(
-                "actuator positions cannot be assembled: the leg circles are more than 2 l_a apart"
+                Phrase("actuator positions cannot be assembled: the leg circles are more than 2 l_a apart")
             )
         normal = np.array([c1[1] - c2[1], c2[0] - c1[0]]) / gap
         found = []
@@ -171,4 +180,6 @@ class ClosedLoopAssembly:
         for q in found:
             if np.sign(np.cos(np.subtract(*self._link_angles(q)))) == mode:  # det J_x = cos(θ1 + θ2), eq. 12
                 return q
-        raise SingularConfigurationError(f"assembly mode {mode:+d} not found: d is at or near the direct singularity")
+        raise SingularConfigurationError(
+            Phrase("assembly mode {mode} not found: d is at or near the direct singularity", mode=f"{mode:+d}")
+        )

@@ -58,6 +58,7 @@ from tpm_viz.multibody.locking import locked
 from tpm_viz.multibody.rank import ranked_svd
 from tpm_viz.paper.kinematics import as_xy
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase
 
 __all__ = ["PART_NAMES", "MultibodyModel", "inverse_dynamics", "model_for"]
 
@@ -196,8 +197,12 @@ class MultibodyModel(ClosedLoopAssembly):
         svd = ranked_svd(jc)
         if self.model.nv - svd.rank != DOF:
             raise SingularConfigurationError(
-                f"singular configuration: the closure Jacobian has rank {svd.rank}, not {self.model.nv - DOF} "
-                "(a parallelogram is folded, cos θ_i = 0, eq. 11)"
+                Phrase(
+                    "singular configuration: the closure Jacobian has rank {rank}, not {full} (a parallelogram is "
+                    "folded, cos θ_i = 0, eq. 11)",
+                    rank=svd.rank,
+                    full=self.model.nv - DOF,
+                )
             )
         return svd
 
