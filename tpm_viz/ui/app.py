@@ -166,7 +166,7 @@ class TpmApp:
         try:
             ok = self.access.login(view, attempt, source=self.room.source(view))
         except TpmVizError as exc:
-            view.refuse(str(exc), resync=False)
+            view.refuse(exc, resync=False)
             return
         if not ok:
             log_fault(view.client.client_id, "login", "wrong presenter token")  # rate-limited

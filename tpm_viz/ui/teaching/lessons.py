@@ -36,18 +36,6 @@ from tpm_viz.words import Lang, Phrase, T, say
 __all__ = ["DemosView"]
 
 NONE = "(no lessons)"
-PANEL_SHIFT = 0.25
-"""Sideways shift of a demo's camera per metre of viewing distance: the control panel covers the right of the
-canvas, so the camera looks a little right of the subject (as :func:`.scene.camera_pose` does)."""
-
-
-def beside_panel(position, look_at) -> tuple[np.ndarray, np.ndarray]:
-    """``position`` and ``look_at`` [m] shifted along +x by :data:`PANEL_SHIFT` x their distance."""
-    position, look_at = np.asarray(position, dtype=float), np.asarray(look_at, dtype=float)
-    shift = np.array([PANEL_SHIFT * float(np.linalg.norm(position - look_at)), 0.0, 0.0])
-    return position + shift, look_at + shift
-
-
 PRESS_SHOW = T("Press 'Show this one' to set up the scene.")
 
 
@@ -210,7 +198,7 @@ class DemosView:
             except TpmVizError as exc:
                 view.refuse(exc)
                 return
-            position, look_at = beside_panel(*camera)
+            position, look_at = (np.asarray(v, dtype=float) for v in camera)  # the canvas is free (docked panel)
             view.client.camera.position = position
             view.client.camera.look_at = look_at
             self.explorer.set(kind=demo.map_kind, ellipses=demo.ellipses)

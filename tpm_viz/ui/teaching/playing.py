@@ -113,7 +113,7 @@ class RunHub:
                         if on_refused is not None:
                             on_refused(error)
                         else:
-                            origin.refuse(str(error))
+                            origin.refuse(error)
                     self._refresh(session)
                     return
                 if session.state.params != params:  # the mechanism changed meanwhile: again, for the new one
