@@ -255,9 +255,15 @@ class ProtocolClient:
                 continue
             except Exception:  # connection closed
                 return
+            now = time.perf_counter()
             for m in decode_batch(raw):
-                if "owner" in m and "name" in m:  # a scene-node message (viser 1.1.1: stamped with its scope)
-                    self._record(m)
+                self.take(m, now)
+
+    def take(self, m: dict, now: float) -> None:
+        """One decoded message, received at ``now`` (``time.perf_counter``), on the reader thread: subclasses
+        record more (call this one for the scene nodes)."""
+        if "owner" in m and "name" in m:  # a scene-node message (viser 1.1.1: stamped with its scope)
+            self._record(m)
 
     def _record(self, m: dict) -> None:
         key = (m["name"], m["owner"])

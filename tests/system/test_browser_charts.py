@@ -17,14 +17,11 @@ Not measured: how the glyphs look (the canvas pixels); the screenshots were look
 
 from __future__ import annotations
 
-import os
 import re
-import tempfile
 import time
 
 import pytest
 
-from tests.support.browser import CHROMIUM, CHROMIUM_ARGS
 from tests.support.protocol import wait_for
 from tpm_viz.app.runs import Source
 from tpm_viz.ui.teaching.charts import FORCES, KINEMATICS
@@ -105,41 +102,28 @@ def _check_chart(handle, page, y_label, where: str) -> None:
     assert m["title"] is None or m["title"]["scroll"] <= m["title"]["client"] + 1, where
 
 
-def test_chart_axes_are_whole_on_a_laptop_and_on_a_phone(app):
-    if not os.path.exists(CHROMIUM):
-        pytest.skip(f"{CHROMIUM} is not installed")
-    sync_api = pytest.importorskip("playwright.sync_api")
+def test_chart_axes_are_whole_on_a_laptop_and_on_a_phone(app, browser):
     y_labels = [FORCES[1], *(label for _attr, _title, label, _scale in KINEMATICS)]
-    with tempfile.TemporaryDirectory() as profile, sync_api.sync_playwright() as pw:
-        context = pw.chromium.launch_persistent_context(
-            profile,
-            executable_path=CHROMIUM,
-            args=CHROMIUM_ARGS,
-            headless=True,
-            viewport={"width": 1024, "height": 768},
-        )
-        try:
-            page = context.new_page()
-            errors: list[str] = []
-            page.on("pageerror", lambda exc: errors.append(str(exc)))
-            page.goto(f"http://127.0.0.1:{app.port}/")
-            page.wait_for_selector("[data-q=p1]", timeout=30_000)
-            view = wait_for(lambda: next(iter(app.views.values()), None), what="the tab's view")
-            player = view.teaching.player
-            page.get_by_role("tab", name="Player").click()
-            page.locator(f'[id="{player.choice._impl.uuid}"]').click()  # the real UI for the first run
-            page.get_by_role("option", name="circle (Fig. 5)", exact=True).click()
-            time.sleep(PAUSE)
-            wait_for(lambda: player.charts.forces.visible and player.charts.forces.data[0][-1] == 0.5, what="the run")
-            runs = app.services.runs
-            for size in ({"width": 1024, "height": 768}, {"width": 390, "height": 844}, {"width": 320, "height": 568}):
-                page.set_viewport_size(size)
-                page.get_by_role("tab", name="Player").click()
-                for duration in (0.5, 0.01, 0.0137, 100.0):
-                    runs.load(view.session, Source.paper("circle", duration), origin=view)
-                    wait_for(lambda d=duration: player.charts.forces.data[0][-1] == d, what=f"the run of {duration} s")
-                    for k, (handle, y_label) in enumerate(zip(player.charts.handles, y_labels, strict=True)):
-                        _check_chart(handle, page, y_label, f"{size['width']} px, T = {duration} s, chart {k}")
-            assert not errors
-        finally:
-            context.close()
+    page = browser.new_page()
+    page.set_viewport_size({"width": 1024, "height": 768})
+    errors: list[str] = []
+    page.on("pageerror", lambda exc: errors.append(str(exc)))
+    page.goto(f"http://127.0.0.1:{app.port}/")
+    page.wait_for_selector("[data-q=p1]", timeout=30_000)
+    view = wait_for(lambda: next(iter(app.views.values()), None), what="the tab's view")
+    player = view.teaching.player
+    page.get_by_role("tab", name="Player").click()
+    page.locator(f'[id="{player.choice._impl.uuid}"]').click()  # the real UI for the first run
+    page.get_by_role("option", name="circle (Fig. 5)", exact=True).click()
+    time.sleep(PAUSE)
+    wait_for(lambda: player.charts.forces.visible and player.charts.forces.data[0][-1] == 0.5, what="the run")
+    runs = app.services.runs
+    for size in ({"width": 1024, "height": 768}, {"width": 390, "height": 844}, {"width": 320, "height": 568}):
+        page.set_viewport_size(size)
+        page.get_by_role("tab", name="Player").click()
+        for duration in (0.5, 0.01, 0.0137, 100.0):
+            runs.load(view.session, Source.paper("circle", duration), origin=view)
+            wait_for(lambda d=duration: player.charts.forces.data[0][-1] == d, what=f"the run of {duration} s")
+            for k, (handle, y_label) in enumerate(zip(player.charts.handles, y_labels, strict=True)):
+                _check_chart(handle, page, y_label, f"{size['width']} px, T = {duration} s, chart {k}")
+    assert not errors

@@ -11,7 +11,7 @@ import time
 import numpy as np
 import pytest
 
-from tests.support.protocol import ProtocolClient, decode_batch, wait_for
+from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz import Params
 from tpm_viz.app.paths import path_for
 from tpm_viz.app.planner import Limits, plan_cycle, plan_path
@@ -28,23 +28,12 @@ class TimedClient(ProtocolClient):
         self.lock = threading.Lock()
         super().__init__(port)
 
-    def _drain(self) -> None:
-        while not self._stop.is_set():
-            try:
-                raw = self.ws.recv(timeout=0.2)
-            except TimeoutError:
-                continue
-            except Exception:  # connection closed
-                return
-            now = time.perf_counter()
-            if not isinstance(raw, bytes):  # viser sends binary frames only
-                continue
-            for m in decode_batch(raw):
-                if m.get("type") == "GuiUpdateMessage":
-                    with self.lock:
-                        self.updates.append((now, m["uuid"], m["updates"]))
-                elif "owner" in m and "name" in m:
-                    self._record(m)
+    def take(self, m: dict, now: float) -> None:
+        if m.get("type") == "GuiUpdateMessage":
+            with self.lock:
+                self.updates.append((now, m["uuid"], m["updates"]))
+        else:
+            super().take(m, now)
 
     def contents_after(self, uuid: str, since: float) -> list[tuple[float, str]]:
         with self.lock:

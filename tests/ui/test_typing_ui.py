@@ -14,7 +14,7 @@ import uuid
 import numpy as np
 import pytest
 
-from tests.support.protocol import ProtocolClient, decode_batch, wait_for
+from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz import Params
 from tpm_viz.app.typed import QUIET
 
@@ -173,18 +173,11 @@ class Recorder(ProtocolClient):
         self.lock = threading.Lock()
         super().__init__(port)
 
-    def _drain(self) -> None:
-        while not self._stop.is_set():
-            try:
-                raw = self.ws.recv(timeout=0.2)
-            except TimeoutError:
-                continue
-            except Exception:
-                return
-            for m in decode_batch(raw):
-                if m["type"] in ("FileTransferPartAck", "RemoveNotificationMessage", "NotificationShowMessage"):
-                    with self.lock:
-                        self.seen.append(m)
+    def take(self, m: dict, now: float) -> None:
+        if m["type"] in ("FileTransferPartAck", "RemoveNotificationMessage", "NotificationShowMessage"):
+            with self.lock:
+                self.seen.append(m)
+        super().take(m, now)
 
 
 def _upload(client, button, name: str, content: bytes, declared: int | None = None) -> str:
