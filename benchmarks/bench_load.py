@@ -29,6 +29,8 @@ import argparse
 import asyncio
 import math
 import random
+import shutil
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -41,6 +43,7 @@ from tests.support.protocol import ServerProcess, Tab, machine_busy_seconds
 
 TOKEN = "bench-presenter-token"
 _HALL_OWN = [30]  # --own (set by main)
+_PROFILE: list[Path] = []  # --profile FILE (set by main)
 
 
 async def _drag_loop(tab: Tab, seconds: float, rate: float, index: int, rng: random.Random) -> int:
@@ -86,8 +89,11 @@ async def _scenario(server: ServerProcess, n: int, mode: str, seconds: float, ra
     for tab in tabs:
         tab.latencies.clear()
     rng = random.Random(0)
+    profiler = _start_profile(server.pid, seconds)
     cpu0, t0, own0, all0 = server.cpu_seconds(), time.perf_counter(), time.process_time(), machine_busy_seconds()
     sends = await asyncio.gather(*(_drag_loop(t, seconds, rate, k, rng) for k, t in enumerate(draggers)))
+    if profiler is not None:
+        await asyncio.to_thread(profiler.wait, 30)
     await asyncio.sleep(0.5)  # the last updates arrive
     wall, cpu, own_cpu = time.perf_counter() - t0, server.cpu_seconds() - cpu0, time.process_time() - own0
     others = max(0.0, machine_busy_seconds() - all0 - cpu - own_cpu)
@@ -111,6 +117,18 @@ async def _scenario(server: ServerProcess, n: int, mode: str, seconds: float, ra
         "rss": server.rss_mb(),
         "per_tab": per_tab,
     }
+
+
+def _start_profile(pid: int, seconds: float) -> subprocess.Popen | None:
+    """``py-spy record`` of the server over the drag window only (``--profile FILE``, raw collapsed stacks)."""
+    if not _PROFILE:
+        return None
+    if shutil.which("py-spy") is None:
+        print("--profile needs py-spy (pip install py-spy); measuring without it")
+        return None
+    cmd = ["py-spy", "record", "--pid", str(pid), "--duration", str(max(1, int(seconds))), "--format", "raw"]
+    cmd += ["--nonblocking", "--threads", "-o", str(_PROFILE[0])]
+    return subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
 
 def _line(r: dict, mode: str) -> str:
@@ -143,7 +161,10 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=10.0, help="drag time per N (max 120)")
     parser.add_argument("--rate", type=float, default=20.0, help="drag updates per second per tab")
     parser.add_argument("--quick", action="store_true", help="4 s per N")
+    parser.add_argument("--profile", type=Path, help="write py-spy's collapsed stacks of the drag window here")
     args = parser.parse_args()
+    if args.profile is not None:
+        _PROFILE.append(args.profile)
     seconds = min(4.0 if args.quick else args.seconds, 120.0)
     print(f"Load, mode {args.mode}: N tabs dragging at {args.rate:g} Hz for {seconds:g} s (server in a child process)")
     problems = 0

@@ -2,7 +2,7 @@
 
 1. Computing: a floor map for a new parameter set (workspace_map 200 x 200 + three colourings, in the
    background worker), a trajectory run (401 samples, closed form + Pinocchio, once per load).
-2. Dragging is not stalled by a map: tab A drags the shared mechanism at 20 Hz (``ClientView._drain_drags``, lock
+2. Dragging is not stalled by a map: tab A drags the shared mechanism at 20 Hz (``Dragging.drain``, lock
    wait included) while tab B, on its own copy with a map shown, applies a new link length every 0.3 s. Four
    cases: B idle; the worker computing maps back to back (nobody else holding the lock); B applying parameters
    with its maps computed in the background worker (the app); the same with the maps computed inside the hub's
@@ -35,6 +35,7 @@ from tpm_viz.app.runs import Source, build_run
 from tpm_viz.app.transitions import apply_params
 from tpm_viz.multibody.model import inverse_dynamics as pinocchio
 from tpm_viz.ui.app import TpmApp, build_server
+from tpm_viz.ui.drags import PendingDrag
 from tpm_viz.ui.teaching import explorer as explorer_module
 
 P = Params.paper()
@@ -151,9 +152,10 @@ def _drag_during_param_changes(samples: int, mode: str) -> list[float]:
     times = []
     for k in range(samples):
         angle = 2 * np.pi * k / 40
-        a._pending_drags.append(("update", np.array([0.08 * np.cos(angle), 0.08 * np.sin(angle), 0.09])))
+        target = np.array([0.08 * np.cos(angle), 0.08 * np.sin(angle), 0.09])
+        a.session.drags.push(a, PendingDrag("update", target, next(a.hub.arrivals)))
         t0 = time.perf_counter()
-        a._drain_drags()
+        a.drags.drain()
         times.append(time.perf_counter() - t0)
         time.sleep(max(0.0, 0.05 - (time.perf_counter() - t0)))
     stop.set()

@@ -1,7 +1,7 @@
 """Speed of the browser app (benchmarks, not tests): prints medians and 95th percentiles.
 
 1. Server side, one drag update: clamped inverse kinematics, both dynamic models (closed form and Pinocchio),
-   the scene and panel push and the flush, exactly as a gizmo event runs it (``ClientView._drain_drags``),
+   the scene and panel push and the flush, exactly as a gizmo event runs it (``Dragging.drain``),
    with 1, 10 and 30 tabs on the shared mechanism (protocol-level clients).
 2. End to end in headless Chromium: from a browser input to the scene update arriving in the page (decoded by
    viser's websocket worker), for a gizmo drag with the real mouse and for a typed actuator position.
@@ -30,6 +30,8 @@ sys.path.insert(0, str(ROOT))  # the repository root: tests.support
 from tests.support.browser import CHROMIUM, CHROMIUM_ARGS, WORKER_LOG_JS
 from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz.ui.app import TpmApp, build_server
+from tpm_viz.ui.dragging import Dragging
+from tpm_viz.ui.drags import PendingDrag
 
 
 def _stats(name: str, seconds) -> None:
@@ -57,9 +59,9 @@ def bench_server(samples: int) -> None:
         for k in range(samples):
             angle = 2 * np.pi * k / samples
             target = np.array([0.09 * np.cos(angle), 0.09 * np.sin(angle), 0.09])
-            view._pending_drags.append(("update", target))
+            view.session.drags.push(view, PendingDrag("update", target, next(app.hub.arrivals)))
             t0 = time.perf_counter()
-            view._drain_drags()
+            view.drags.drain()
             times.append(time.perf_counter() - t0)
         _stats(f"{tabs} tab(s) on the shared mechanism", times)
         for c in clients:
@@ -94,11 +96,9 @@ def bench_browser(samples: int) -> None:
     import viser.transforms as tf
     from playwright.sync_api import sync_playwright
 
-    from tpm_viz.ui import client as client_module
-
     received: list[float] = []
     flushed: list[float] = []
-    original_on_drag, original_drain = client_module.ClientView._on_drag, client_module.ClientView._drain_drags
+    original_on_drag, original_drain = Dragging.on_drag, Dragging.drain
 
     async def on_drag(self, event):  # timestamp each gizmo message as the server receives it
         received.append(time.perf_counter())
@@ -109,7 +109,7 @@ def bench_browser(samples: int) -> None:
         original_drain(self)
         flushed.append(time.perf_counter() - start)
 
-    client_module.ClientView._on_drag, client_module.ClientView._drain_drags = on_drag, drain
+    Dragging.on_drag, Dragging.drain = on_drag, drain
     app = TpmApp(build_server("127.0.0.1", 0))
     with tempfile.TemporaryDirectory() as profile, sync_playwright() as pw:
         ctx = pw.chromium.launch_persistent_context(
@@ -170,7 +170,7 @@ def bench_browser(samples: int) -> None:
         _stats("typed d1: update sent -> slider moved", [(b - a) / 1e3 for a, b in pairs])
         ctx.close()
     app.stop()
-    client_module.ClientView._on_drag, client_module.ClientView._drain_drags = original_on_drag, original_drain
+    Dragging.on_drag, Dragging.drain = original_on_drag, original_drain
 
 
 def bench_startup(runs: int) -> None:

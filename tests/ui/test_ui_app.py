@@ -354,9 +354,9 @@ def test_a_class_pulling_the_shared_platform_at_once_is_paced_and_the_latest_dra
     """More tabs than INLINE_DRAG_VIEWS on the shared mechanism: drag commits are at least SHARED_DRAG_INTERVAL
     apart (latest value wins in between), the mechanism is drawn once per commit in the broadcast scope whatever
     the number of tabs, every tab shows the same state, and no drag is left stranded."""
-    from tpm_viz.ui import client as client_module
+    from tpm_viz.ui import dragging
 
-    tabs = [connect() for _ in range(client_module.INLINE_DRAG_VIEWS + 3)]
+    tabs = [connect() for _ in range(dragging.INLINE_DRAG_VIEWS + 3)]
     hub = app.hub
     commits: list[tuple[float, bool]] = []
     original_commit = hub.commit
@@ -385,7 +385,7 @@ def test_a_class_pulling_the_shared_platform_at_once_is_paced_and_the_latest_dra
     sends = 25 * len(tabs)
     assert 2 <= len(commits) < sends  # merged: latest value wins
     times = [t for t, _ in commits]
-    assert min(np.diff(times)) >= 0.9 * client_module.SHARED_DRAG_INTERVAL
+    assert min(np.diff(times)) >= 0.9 * dragging.SHARED_DRAG_INTERVAL
     assert len({id(f) for f in drawn}) == len(drawn) <= len(commits)  # one broadcast drawing per commit
     assert not hub.shared.drags.scheduled
 

@@ -11,7 +11,6 @@ transitions themselves are the pure functions of :mod:`.transitions`; every call
 
 from __future__ import annotations
 
-import asyncio
 import functools
 import time
 from typing import cast
@@ -23,10 +22,9 @@ from tpm_viz import meshes
 from tpm_viz.app import transitions
 from tpm_viz.app.poses import DEMO_KINDS
 from tpm_viz.app.state import AppState
-from tpm_viz.errors import TpmVizError
 from tpm_viz.params import Params
 from tpm_viz.ui._viser import widget_value
-from tpm_viz.ui.drags import PendingDrag
+from tpm_viz.ui.dragging import Dragging
 from tpm_viz.ui.fields import Place, Typing, control
 from tpm_viz.ui.guard import guarded
 from tpm_viz.ui.language import TabWords
@@ -51,12 +49,6 @@ def _size(params: Params) -> float:
     return hi - lo
 
 
-INLINE_DRAG_VIEWS = 4
-"""A drag of a session shown by at most this many tabs is applied on the event loop itself (bench_load.py)."""
-SHARED_DRAG_INTERVAL = 0.025
-"""Drags of a session shown by more than :data:`INLINE_DRAG_VIEWS` tabs are committed at most once per this many
-seconds (40 Hz; latest value wins in between), however many students pull the shared platform at once: one
-dragger at the browser's 20 Hz is never delayed, thirty keep the server responsive (bench_load.py --mode shared)."""
 WATCH_INTERVAL = 0.05
 """While another tab drags (or a trajectory plays), this tab's own part of a frame (gizmo, panel, teaching layer)
 is drawn at most once per this many seconds (20 Hz); the mechanism itself is drawn at every commit, once for all
@@ -93,6 +85,8 @@ class ClientView:
         self._drawn_at = -1.0  # time.monotonic() of this tab's last render
         self.typing = Typing(self)
         """The typed number fields of this tab (Enter, Apply, the quiet time: :mod:`.fields`)."""
+        self.drags = Dragging(self)
+        """The gizmo drags of this tab (:mod:`.dragging`)."""
         with hub.lock:
             state = hub.shared.state
             self.words = TabWords(self)  # the Language selector, first in the panel; sets self.lang (ui/language.py)
@@ -209,7 +203,7 @@ class ClientView:
     # -- wiring --------------------------------------------------------------------------------------------
     def _wire(self) -> None:
         panel, scene = self.panel, self.scene
-        scene.gizmo.on_update(self._on_drag)
+        scene.gizmo.on_update(self.drags.on_drag)
         self.typing.add(panel.p, self._apply_p)
         for name in ("f_ext", "dp", "ddp"):
             self.typing.add(panel.boxes()[name], functools.partial(self._apply_load, name))
@@ -228,78 +222,9 @@ class ClientView:
             handle.on_update(lambda event, what=what: self._on_show(event, what))
         panel.frame_camera.on_click(self._on_frame)
 
-    @guarded
-    async def _on_drag(self, event) -> None:
-        """Gizmo events, in arrival order on the event loop: keep a snapshot, then apply the latest one, here if
-        the hub is free and few tabs show this session (a private copy: no thread hop), else in the pool, at most
-        every :data:`SHARED_DRAG_INTERVAL` for a session shown by many tabs."""
-        drag = PendingDrag(event.phase, np.array(event.target.position, dtype=float), next(self.hub.arrivals))
-        session = getattr(self, "session", None)  # None while this tab is still being built (under the lock)
-        if session is None:
-            self.hub.drag_pool.submit(self._drag_after_build, drag)  # waits for the lock the build holds
-            return
-        session.drags.push(self, drag)
-        if len(session.views) <= INLINE_DRAG_VIEWS:
-            if self.hub.lock.acquire(blocking=False):
-                try:
-                    self._drain_drags()  # ~1 ms, never blocks (the lock is ours, pushes and flushes are queued)
-                finally:
-                    self.hub.lock.release()
-                return
-        elif self.hub.access.may_change(self, session):
-            if session.drags.scheduled:
-                return  # the scheduled drain takes this drag (latest value wins)
-            session.drags.scheduled = True
-            delay = session.drags.next_at - time.monotonic()
-            if delay > 0:
-                asyncio.get_running_loop().call_later(delay, self._submit_drain)
-                return
-        self._submit_drain()
-
-    def _submit_drain(self) -> None:
-        try:
-            self.hub.drag_pool.submit(self._drain_drags)  # guarded: its errors are logged, never lost in a future
-        except RuntimeError:  # the interpreter is shutting down
-            return
-
-    @guarded(on_error=_internal_error)
-    def _drain_drags(self) -> None:
-        """Apply the latest pending gizmo position (latest value wins); ``end`` writes the gizmo back.
-
-        Latest value wins across the session: the pending drags of every other tab that may change this
-        mechanism are merged into the one commit (30 students pulling the shared platform at once make one
-        commit per round, not 30)."""
-        with self.hub.lock:
-            session = self.session
-            queue = session.drags
-            queue.scheduled = False  # first: a drag that arrives from now on schedules the next drain,
-            queue.next_at = time.monotonic() + SHARED_DRAG_INTERVAL  # not before this
-            take = None if self.closed else queue.take(self, lambda view: self.hub.access.may_change(view, session))
-            if take is None:
-                if self.closed:
-                    queue.drop(self)
-                for other in queue.waiting():  # this tab left (or was merged) with the session's drain: hand it on
-                    if not other.closed:
-                        other.drain_drags()
-                        break
-                return
-            for view in take.ended:
-                view.drag_ended()  # its drag ended: its gizmo is written back by this commit
-            mover, latest = take.mover, take.latest
-            try:
-                mover.commit_drag(latest.phase, latest.position)
-            except TpmVizError as exc:  # the gizmo goes back to the last good pose when the drag ends
-                mover.refuse(exc, resync=latest.phase == "end")
-
-    @guarded(on_error=_internal_error)
-    def _drag_after_build(self, drag: PendingDrag) -> None:
-        with self.hub.lock:
-            self.session.drags.push(self, drag)
-            self._drain_drags()
-
     def drain_drags(self) -> None:
         """Commit the session's pending drags (called by a tab that leaves with the session's drain)."""
-        self._drain_drags()
+        self.drags.drain()
 
     def commit_drag(self, phase: str, position: np.ndarray) -> None:
         """Commit this tab's drag to ``position`` [m] (under the hub's lock)."""
