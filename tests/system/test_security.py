@@ -343,8 +343,8 @@ def test_presenter_mode_students_are_refused_on_the_shared_mechanism_only(pconne
     presenter.set_value(pv.panel.d[0], 210.0)
     wait_for(lambda: abs(_state(wv).pose.d[0] - 0.21) < 1e-9, what="the presenter's change reaching the watcher")
     assert _state(sv) is _state(pv)
-    assert "Presenter mode: you are allowed" in pv.panel.class_info.content
-    assert "only the presenter is allowed" in sv.panel.class_info.content
+    wait_for(lambda: "Presenter mode: you are allowed" in pv.panel.class_info.content, what="the presenter's line")
+    wait_for(lambda: "only the presenter is allowed" in sv.panel.class_info.content, what="a student's line")
 
     student.set_value(sv.panel.own_copy, True)  # a student's own copy is theirs to change
     wait_for(lambda: not sv.session.shared, what="the student's own copy")

@@ -14,7 +14,9 @@ tpm-viz needs these things viser's public API does not offer:
   (``_client_state_from_id``), the raw connections (``_live_connections``, to refuse or drop a tab) and the
   websockets module viser serves with (:data:`ws_server`; :mod:`.limits` replaces the ``ServerProtocol`` it builds per
   connection: viser accepts 50 MiB frames and answers an over-long URL segment with HTTP 500), and viser's decoding of
-  incoming messages (:func:`quiet_decoding`); a tab's GUI texts and the values it sends (:func:`reword`).
+  incoming messages (:func:`quiet_decoding`); a tab's GUI texts and the values it sends (:func:`reword`);
+- the serialisation of outgoing messages (``Message.as_serializable_dict``), done once per message instead of once
+  per tab it goes to (:func:`share_serialization`).
 
 :func:`check_viser` runs when the server is built: the installed viser must be the tested minor version
 (:data:`TESTED`, pinned in ``pyproject.toml``) and every internal above must exist, else the app stops at start with
@@ -31,7 +33,7 @@ import dataclasses
 import inspect
 import threading
 import uuid
-from collections.abc import Awaitable, Callable, Iterator
+from collections.abc import Callable, Iterator
 from typing import Any, cast
 
 import viser
@@ -39,6 +41,7 @@ from viser import _messages
 from viser.infra import _infra
 
 from tpm_viz.errors import TpmVizError
+from tpm_viz.ui.wire import GuiUpdate, Handshake, Malformed, Upload, Wrapper, message_bytes, renumbered
 
 ws_server = _infra.websockets.asyncio.server
 """websockets' asyncio server, as viser imported it (tpm-viz does not depend on websockets directly)."""
@@ -56,6 +59,7 @@ __all__ = [
     "hook_handshakes",
     "quiet_decoding",
     "reword",
+    "share_serialization",
     "thread_pool",
     "widget_uuid",
     "widget_value",
@@ -134,10 +138,6 @@ def drop_gizmo_echo(gizmo: Any) -> None:
         aux.sync_cb = None
 
 
-GuiUpdate = Callable[[Any, Any], Awaitable[None]]
-Upload = Callable[[Any, Any], None]
-
-
 class ClientDoor:
     """A tab's message handling, for :mod:`.transport`: look up widgets and uploads, replace three handlers."""
 
@@ -177,10 +177,6 @@ class ClientDoor:
         for message_type, old, new in pairs:
             self._conn.unregister_handler(message_type, old)
             self._conn.register_handler(message_type, new)
-
-
-Incoming = Callable[[int, Any], Awaitable[None]]
-Wrapper = Callable[[Incoming], Incoming]
 
 
 class ServerDoor:
@@ -237,7 +233,7 @@ class ServerDoor:
             return len(messages), -1
         transport = connection.transport  # the frame being written (up to one window of 128 messages)
         written = transport.get_write_buffer_size() if transport is not None else 0
-        return len(messages), written + sum(map(_message_bytes, messages))
+        return len(messages), written + sum(map(message_bytes, messages))
 
     def notify(self, client_id: int, title: str, body: str) -> None:
         """Show a red notification in that tab (a connection not yet registered as a viser client included)."""
@@ -263,26 +259,8 @@ class ServerDoor:
             loop.call_soon_threadsafe(connection.transport.abort)
 
 
-def _message_bytes(message: Any) -> int:
-    """Rough size of a queued message [bytes]: its bytes, text and array payloads plus a fixed overhead."""
-    size = 64
-    for value in vars(message).values():
-        if isinstance(value, (bytes, bytearray, str)):
-            size += len(value)
-        else:
-            size += int(getattr(value, "nbytes", 0) or 0)
-    return size
-
-
-class Malformed:
-    """Stands for a message of a known type whose fields viser could not decode (wrong types, missing fields):
-    dispatched like a message, handled by nobody, dropped with a log line by :mod:`.limits`."""
-
-    def __init__(self, problem: str) -> None:
-        self.problem = problem
-
-
 _DESERIALIZE = _messages.Message.deserialize.__func__  # type: ignore[attr-defined]
+_SERIALIZE = _messages.Message.as_serializable_dict
 _BIG_MESSAGE = 64 << 10
 """Incoming messages larger than this [bytes] must be upload parts (nothing else a browser sends is that big): a
 big map or list in any other message would hold the event loop while it is decoded."""
@@ -327,10 +305,32 @@ def quiet_decoding(on_garbage: Callable[[str], object]) -> None:
     _messages.Message._tpm_viz_quiet = True  # type: ignore[attr-defined]
 
 
+def share_serialization() -> None:
+    """Make each outgoing message's wire dict once, not once per tab (process-wide): a broadcast update reaching 150
+    tabs was serialised 150 times (a fifth of the server's time, ``bench_load.py --mode hall --profile``). Queued
+    messages are not changed (viser fills them first; :func:`reword` changes copies, which a copied entry does not
+    match: it holds its message's id); array buffers are shared, their placeholders renumbered per window."""
+    if getattr(_messages.Message, "_tpm_viz_shared", False):
+        return
+
+    def as_serializable_dict(self: Any, binary_buffers: list | None = None) -> dict[str, Any]:
+        cached = self.__dict__.get("_tpm_viz_wire")
+        if binary_buffers is None or cached is None or cached[0] != id(self):
+            start = 0 if binary_buffers is None else len(binary_buffers)
+            out = _SERIALIZE(self, binary_buffers)
+            if binary_buffers is not None:
+                self.__dict__["_tpm_viz_wire"] = (id(self), out, start, tuple(binary_buffers[start:]))
+            return out
+        _, out, start, buffers = cached
+        shift = len(binary_buffers) - start
+        binary_buffers.extend(buffers)
+        return renumbered(out, shift) if buffers and shift else out
+
+    _messages.Message.as_serializable_dict = as_serializable_dict  # type: ignore[method-assign]
+    _messages.Message._tpm_viz_shared = True  # type: ignore[attr-defined]
+
+
 # -- handshakes (ui/classroom.py: same-origin check, the browser's identity cookie) ----------------------------------
-Handshake = Callable[[Any, Any, Callable[[], Any]], Any]
-"""``hook(connection, request, viser_response)``: return a websockets ``Response`` (e.g. ``viser_response()``, with
-headers added, or ``connection.respond(403, ...)`` to refuse) or None (go on with the websocket handshake)."""
 _HANDSHAKE_LOCK = threading.Lock()
 
 

@@ -36,7 +36,7 @@ from tpm_viz.app.readouts import Reference
 from tpm_viz.app.state import AppState
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.params import Params
-from tpm_viz.ui._viser import check_viser, disable_share_url, hook_handshakes, thread_pool
+from tpm_viz.ui._viser import check_viser, disable_share_url, hook_handshakes, share_serialization, thread_pool
 from tpm_viz.ui.classroom import Classroom, Handshakes, local_addresses, qr_text, student_urls
 from tpm_viz.ui.client import ClientView
 from tpm_viz.ui.continuity import Store
@@ -49,10 +49,14 @@ from tpm_viz.ui.scene import MechanismScene, camera_pose
 from tpm_viz.ui.session import Hub
 from tpm_viz.ui.teaching.tabs import Services
 from tpm_viz.ui.transport import harden
+from tpm_viz.words import Lang, Phrase, say
 
 __all__ = ["TpmApp", "build_server", "main"]
 
 BRAND = (13, 148, 136)
+CLASS_INFO_DELAY = 0.3
+"""A change of the class (tabs joining, leaving, switching) is shown in every tab's classroom line after this many
+seconds, once for all the changes meanwhile [s]."""
 
 
 def is_loopback(host: str) -> bool:
@@ -77,6 +81,7 @@ def build_server(host: str = "127.0.0.1", port: int = 8080) -> viser.ViserServer
     ):  # same-origin check; viser prints its own banner even with verbose=False
         server = viser.ViserServer(host=host, port=port, label="tpm-viz", verbose=False)
     disable_share_url(server)
+    share_serialization()  # a broadcast message is serialised once, not once per tab (ui/_viser.py)
     guard_executor(thread_pool(server))  # every callback's exception is logged
     harden_server(server)  # one tab cannot freeze or fill the server (ui/limits.py)
     server.gui.configure_theme(
@@ -118,6 +123,7 @@ class TpmApp:
         """The worker, floor maps and trajectory runs every tab of this app shares."""
         self.views: dict[int, ClientView] = {}
         self._views_lock = threading.Lock()
+        self._class_info_timer: threading.Timer | None = None
         position, look_at = camera_pose(self.hub.shared.state.params)
         server.initial_camera.position = position
         server.initial_camera.look_at = look_at
@@ -135,7 +141,7 @@ class TpmApp:
 
     @guarded
     def _connect(self, client: viser.ClientHandle) -> None:
-        harden(client)  # malformed GUI updates and oversized uploads are dropped before viser sees them
+        harden(client, lang=lambda: self._lang_of(client.client_id))  # malformed updates and big uploads dropped
         who = self.room.identify(client)  # before the view moves the camera
         view = ClientView(client, self.hub, self.services)
         if self.access.enabled:
@@ -144,6 +150,12 @@ class TpmApp:
             self.views[client.client_id] = view
         self.room.connected(view, who)  # presenter or not; what it had before a drop
         self._class_info()
+
+    def _lang_of(self, client_id: int) -> Lang:
+        """The language of a tab (English until its view is built)."""
+        with self._views_lock:
+            view = self.views.get(client_id)
+        return Lang.EN if view is None else view.lang
 
     @guarded
     def _disconnect(self, client: viser.ClientHandle) -> None:
@@ -178,21 +190,45 @@ class TpmApp:
         self._class_info()
 
     def _class_info(self) -> None:
+        """Tabs joined, left, switched or logged in: redraw every tab's classroom line, at most once per
+        :data:`CLASS_INFO_DELAY` (150 tabs arriving or leaving at once redraw 150 lines once, not 150 x 150 times)."""
+        with self._views_lock:
+            if self._class_info_timer is not None:
+                return
+            self._class_info_timer = timer = threading.Timer(CLASS_INFO_DELAY, self._write_class_info)
+        timer.daemon = True
+        timer.start()
+
+    @guarded
+    def _write_class_info(self) -> None:
+        with self._views_lock:
+            self._class_info_timer = None
         connected = set(self.server.get_clients())
         with self._views_lock:
             views = [v for cid, v in self.views.items() if not v.closed and cid in connected]
-        shared = self.hub.shared_viewers()
+        count = Phrase(
+            "{tabs} tab(s) connected, {shared} on the shared mechanism.",
+            tabs=len(views),
+            shared=self.hub.shared_viewers(),
+        )
         for view in views:
-            where = "your own copy" if not view.session.shared else "the shared mechanism"
-            text = f"{len(views)} tab(s) connected, {shared} on the shared mechanism. You see {where}."
-            if self.access.enabled:
-                who = "you are" if self.access.is_presenter_tab(view) else "only the presenter is"
-                who = "the presenter handed it to the class: everybody is" if self.access.open_to_class else who
-                text += f" Presenter mode: {who} allowed to change the shared mechanism."
-            view.set_class_info(text)
+            if not view.session.shared:
+                parts = [count, Phrase("You see your own copy.")]
+            else:
+                parts = [count, Phrase("You see the shared mechanism.")]
+            if self.access.enabled and self.access.open_to_class:
+                parts.append(Phrase("Presenter mode: the presenter handed the shared mechanism to the class."))
+            elif self.access.enabled and self.access.is_presenter_tab(view):
+                parts.append(Phrase("Presenter mode: you are allowed to change the shared mechanism."))
+            elif self.access.enabled:
+                parts.append(Phrase("Presenter mode: only the presenter is allowed to change the shared mechanism."))
+            view.set_class_info(" ".join(say(view.lang, part) for part in parts))
 
     def stop(self) -> None:
         """Stop the server (the port is free again at once) and the app's drag threads; save the session."""
+        with self._views_lock:
+            if self._class_info_timer is not None:
+                self._class_info_timer.cancel()
         self.room.stop()
         self.server.stop()
         self.hub.drag_pool.shutdown(wait=False, cancel_futures=True)

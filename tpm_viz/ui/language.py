@@ -152,4 +152,5 @@ class TabWords:
         frame = view.session.frame
         if frame is not None:
             view.render(frame)
+        view.hub.membership_changed()  # the classroom line, written by the app (coalesced for all tabs)
         view.teaching.words_changed()

@@ -278,7 +278,11 @@ class MechanismScene:
         last = self._sent.get(key)
         if last is not None and np.array_equal(np.asarray(last), np.asarray(value)):
             return
-        setattr(handle, attr, value)
+        try:
+            setattr(handle, attr, value)
+        except RuntimeError as exc:  # viser 1.1.1 wakes its sender with asyncio.Event.set() from this thread, which
+            if "mutated during iteration" not in str(exc):  # races the event loop; the message is queued already
+                raise
         self._sent[key] = value
 
     def forget(self) -> None:

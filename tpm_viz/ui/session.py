@@ -27,6 +27,7 @@ import numpy as np
 
 from tpm_viz.app.access import Access
 from tpm_viz.app.inputs import read_number, read_vec2
+from tpm_viz.app.pacing import Pacer
 from tpm_viz.app.readouts import Readout, Reference, evaluate
 from tpm_viz.app.state import AppState
 from tpm_viz.errors import InputError
@@ -121,6 +122,9 @@ class Hub:
         self.on_membership: Callable[[], None] | None = None
         self.arrivals = itertools.count()
         """Numbers gizmo events in arrival order (they arrive on the event loop, one at a time)."""
+        self.pacer = Pacer()
+        """How often a dragged own copy may be redrawn (:mod:`tpm_viz.app.pacing`): every drag commit if the server
+        keeps up, less often when thirty students drag their own copies at once."""
         self.drag_pool = ThreadPoolExecutor(max_workers=2, thread_name_prefix="tpm-viz-drag")
         """Where drags of a session shown by many tabs are committed: two threads (they serialise on the lock); a
         plain executor, not ``loop.run_in_executor``, so that finishing a drag does not wake the event loop."""

@@ -81,9 +81,8 @@ class TabScene:
         self._set_shadows(set(), style=False)
         if self._cover is None:
             self._cover = self._api.add_frame(self.shared.root, show_axes=False, visible=False)
-        if self.private is None:
-            sink = None
-            self.private = MechanismScene(self._api, params, root=PRIVATE_ROOT, sink=sink, flush=False)
+        if self.private is None:  # each update one atomic window of this tab (flushed by the tab's render)
+            self.private = MechanismScene(self._api, params, root=PRIVATE_ROOT, sink=self._client, flush=False)
             self.private.set_style(self.presentation)
             for what in FAMILIES:
                 self.private.set_visible(what, self.show[what])

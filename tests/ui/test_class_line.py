@@ -1,0 +1,43 @@
+"""The classroom line of *Class & view*: right counts, in the tab's language, and redrawn once per burst of
+arrivals and departures (150 tabs leaving at once must not redraw 150 lines 150 times: issue 11)."""
+
+from __future__ import annotations
+
+import re
+import time
+
+from tests.support.fixtures import open_tab
+from tests.support.protocol import ProtocolClient, wait_for
+from tpm_viz.ui import app as app_module
+from tpm_viz.words import Lang
+
+HANGUL = re.compile("[\uac00-\ud7a3]")
+
+
+def test_the_class_line_counts_tabs_and_is_redrawn_once_per_burst(app, connect, monkeypatch):
+    leaving: list[ProtocolClient] = []
+    tabs = [connect() for _ in range(3)] + [open_tab(app, leaving) for _ in range(3)]
+    first = tabs[0][1]
+    wait_for(lambda: "6 tab(s) connected, 6 on the shared mechanism" in first.panel.class_info.content, what="6 tabs")
+    writes: list[str] = []
+    original = type(first).set_class_info
+    monkeypatch.setattr(type(first), "set_class_info", lambda self, text: writes.append(text) or original(self, text))
+
+    tabs[1][0].set_value(tabs[1][1].panel.own_copy, True)
+    for client in leaving:  # three tabs leave at once, one switches to its own copy
+        client.close()
+    wait_for(lambda: len(app.views) == 3, what="three tabs gone")
+    wait_for(lambda: "3 tab(s) connected, 2 on the shared mechanism" in first.panel.class_info.content, what="3")
+    time.sleep(3 * app_module.CLASS_INFO_DELAY)
+    assert len(writes) <= 2 * 3  # each remaining tab written once or twice, not once per change (4 changes)
+    assert "You see your own copy." in tabs[1][1].panel.class_info.content
+    assert "You see the shared mechanism." in first.panel.class_info.content
+
+
+def test_the_class_line_follows_the_tab_language(connect):
+    (_c1, v1), (_c2, v2) = connect(), connect()
+    wait_for(lambda: "2 tab(s) connected" in v1.panel.class_info.content, what="the line")
+    v1.words.set(Lang.KO)
+    wait_for(lambda: HANGUL.search(v1.panel.class_info.content), what="the Korean line")
+    assert "2" in v1.panel.class_info.content  # the same count
+    assert not HANGUL.search(v2.panel.class_info.content)  # the other tab stays in English

@@ -1,0 +1,80 @@
+"""How often the students' own copies may be redrawn while they are dragged, so that a busy server stays responsive.
+
+The server runs on one core's worth of Python (the GIL). A drag commit of an own copy costs a few milliseconds (the
+inverse kinematics, both dynamic models, the tab's scene and panel), so thirty students dragging their own copies at
+the browser's 20 Hz ask for more than the whole core, and everything, the presenter's broadcast included, queues up.
+
+A :class:`Pacer` keeps the time spent on those commits near a budget: a fraction of the wall time, since the commits
+hold the hub's lock one after the other however the GIL is shared (a commit that waits for the GIL makes the others
+wait too: what queues is wall time, not CPU time). It measures that time over windows of :attr:`Pacer.window`
+seconds and sets the shortest interval between two commits of one own copy: zero while the budget is kept; when it
+is exceeded, the interval grows with the overload (``load / budget``) and shrinks again when the load falls. A
+commit always takes the latest position of the gizmo (latest value wins), so a longer interval makes a dragged copy
+move in fewer, larger steps, not later: the position drawn is the newest one the tab sent, at most one
+browser event old when it is drawn (``benchmarks/bench_load.py --mode hall``).
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from dataclasses import dataclass, field
+
+__all__ = ["Pacer"]
+
+
+@dataclass
+class Pacer:
+    """The interval between two drag commits of one own copy [s], from the time those commits took."""
+
+    budget: float = 0.4
+    """Fraction of the wall time the commits of own copies may take (the rest: the presenter, sending, reading)."""
+    window: float = 0.5
+    """Length of a measuring window [s]."""
+    start: float = 0.05
+    """The first interval [s] when the budget is first exceeded (the browser's 20 Hz)."""
+    ceiling: float = 0.5
+    """The longest interval [s]: a dragged copy moves at least twice a second."""
+    floor: float = 0.02
+    """An interval below this [s] is dropped to zero (no pacing)."""
+    _interval: float = 0.0
+    _spent: float = 0.0
+    _since: float | None = None
+    _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
+
+    def spent(self, seconds: float, now: float) -> None:
+        """A commit of an own copy took ``seconds`` [s] (wall time), ending at ``now`` (``time.monotonic()``)."""
+        with self._lock:
+            self._roll(now)
+            self._spent += max(0.0, float(seconds))
+
+    def interval(self, now: float) -> float:
+        """The shortest interval between two commits of one own copy now [s]."""
+        with self._lock:
+            self._roll(now)
+            return self._interval
+
+    def load(self, now: float) -> float:
+        """Fraction of the wall time spent on commits in the current window so far."""
+        with self._lock:
+            self._roll(now)
+            elapsed = now - self._since if self._since is not None else 0.0
+            return self._spent / elapsed if elapsed > 0 else 0.0
+
+    def _roll(self, now: float) -> None:
+        if self._since is None:
+            self._since = now
+            return
+        elapsed = now - self._since
+        if elapsed < self.window:
+            return
+        load = self._spent / elapsed
+        self._since, self._spent = now, 0.0
+        ratio = load / self.budget
+        if self._interval == 0.0:
+            if ratio > 1.0:
+                self._interval = min(self.ceiling, self.start * ratio)
+            return
+        self._interval = min(self.ceiling, self._interval * math.sqrt(ratio))  # damped: no oscillation
+        if self._interval < self.floor:
+            self._interval = 0.0
