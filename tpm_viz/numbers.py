@@ -31,7 +31,7 @@ import math
 import re
 
 from tpm_viz.errors import InputError
-from tpm_viz.words import Phrase
+from tpm_viz.words import Phrase, T
 
 __all__ = [
     "DASH",
@@ -72,6 +72,17 @@ UNITS: dict[str, tuple[str, float, float]] = {
 """Units people write (e.g. in a CSV header) -> (quantity, multiplier, divisor): SI value = value * mul / div.
 Case is ignored, ``µm``/``μm`` is ``um``, ``s²``/``s2`` is ``s^2``."""
 _SI = {"length": "m", "time": "s", "velocity": "m/s", "acceleration": "m/s^2", "force": "N", "angle": "rad"}
+_QUANTITY = {
+    "length": T("length"),
+    "time": T("time"),
+    "velocity": T("velocity"),
+    "acceleration": T("acceleration"),
+    "force": T("force"),
+    "angle": T("angle"),
+}
+"""The quantities of :data:`UNITS` as words (messages)."""
+_ALT = {"m": "mm", "s": "ms", "m/s": "mm/s", "m/s^2": "mm/s^2", "N": "kN", "rad": "deg"}
+"""A second unit a refusal suggests besides the SI one, by SI unit."""
 _MINUS = str.maketrans({"\u2212": "-", "\uff0d": "-", "\ufe63": "-"})
 _SPACES = "\u0020\u00a0\u202f\u2009\u2007"
 _GROUPED = re.compile(rf"[+-]?\d{{1,3}}(?:[{_SPACES}]\d{{3}})+(?:[.,]\d*)?(?:[eE][+-]?\d+)?")
@@ -109,16 +120,19 @@ def shorten(text, limit: int = QUOTE) -> str:
     return repr(text[: max(limit - 3, 1)]) + "..."
 
 
-def _label(name: str, unit: str) -> str:
-    name = str(name)[:QUOTE]
-    return f"{name} [{unit}]" if unit else name
+def _label(name: str | Phrase, unit: str) -> str | Phrase:
+    """A field's name and unit in a message: a phrase stays a phrase (shown in a tab's language), a plain name is
+    cut to :data:`QUOTE` characters."""
+    named: str | Phrase = name if isinstance(name, Phrase) else str(name)[:QUOTE]
+    return Phrase("{name} [{unit}]", name=named, unit=unit) if unit else named
 
 
-def parse_number(text, name: str = "value", unit: str = "") -> float:
+def parse_number(text, name: str | Phrase = "value", unit: str = "") -> float:
     """The finite float that ``text`` spells (rules in the module docstring), else a one-line InputError.
 
-    ``name`` names the field in messages, ``unit`` is the field's unit (quoted in messages, and accepted after
-    the number). Real numbers (not ``bool``) are accepted as they are if finite.
+    ``name`` names the field in messages (a plain name, or a phrase such as ``T("duration")``, shown in a tab's
+    language), ``unit`` is the field's unit (quoted in messages, and accepted after the number). Real numbers (not
+    ``bool``) are accepted as they are if finite.
     """
     label = _label(name, unit)
     if isinstance(text, bool):
@@ -215,11 +229,11 @@ def plausibility_note(
     return None if note is None else str(note)
 
 
-def unit_factor(unit: str, quantity: str | None, label: str, name: str) -> tuple[float, float]:
+def unit_factor(unit: str, quantity: str | None, label: str | Phrase, name: str) -> tuple[float, float]:
     """``(multiplier, divisor)`` from ``unit`` to SI for a ``quantity`` (``"length"``, ...; None: takes no unit).
 
     ``""`` is SI. An unknown unit, or one of another quantity, is a one-line InputError starting with ``label``
-    and naming the quantity of ``name`` (``p1 is a length in m``).
+    (text, or a phrase shown in a tab's language) and naming the quantity of ``name`` (``p1 is a length in m``).
     """
     if not unit:
         return 1.0, 1.0
@@ -227,9 +241,39 @@ def unit_factor(unit: str, quantity: str | None, label: str, name: str) -> tuple
     entry = UNITS.get(key[:-1] + "^2" if key.endswith("/s2") else key)
     si = _SI.get(quantity or "", "")
     if entry is None:
-        hint = f" (use {si} or {'mm' if si == 'm' else 'ms' if si == 's' else si})" if si else ""
-        raise InputError(f"{label} has an unknown unit {shorten(unit)}{hint}")
+        if not si:
+            raise InputError(Phrase("{label} has an unknown unit {unit}", label=label, unit=shorten(unit)))
+        alt = _ALT.get(si, si)
+        raise InputError(
+            Phrase(
+                "{label} has an unknown unit {unit} (use {si} or {alt})",
+                label=label,
+                unit=shorten(unit),
+                si=si,
+                alt=alt,
+            )
+        )
     if quantity != entry[0]:
-        what = f"{name} is a {quantity} in {si}" if quantity else f"{name} takes no unit"
-        raise InputError(f"{label}: {shorten(unit)} is a {entry[0]} unit, but {what}")
+        kind = _QUANTITY[entry[0]]
+        if not quantity:
+            raise InputError(
+                Phrase(
+                    "{label}: {unit} is a {kind} unit, but {name} takes no unit",
+                    label=label,
+                    unit=shorten(unit),
+                    kind=kind,
+                    name=name,
+                )
+            )
+        raise InputError(
+            Phrase(
+                "{label}: {unit} is a {kind} unit, but {name} is a {quantity} in {si}",
+                label=label,
+                unit=shorten(unit),
+                kind=kind,
+                name=name,
+                quantity=_QUANTITY.get(quantity, quantity),
+                si=si,
+            )
+        )
     return entry[1], entry[2]

@@ -15,27 +15,32 @@ import numpy as np
 import pytest
 
 from tpm_viz import Params
-from tpm_viz.app import sessions
+from tpm_viz.app import sessions, transitions
 from tpm_viz.app.access import Access
+from tpm_viz.app.inputs import MAX_UPLOAD_BYTES, read_upload
 from tpm_viz.app.moves import Pose
 from tpm_viz.app.planner import Limits
 from tpm_viz.app.planning import parse_waypoints
 from tpm_viz.app.readouts import evaluate
 from tpm_viz.app.runs import Source, build_run
+from tpm_viz.app.state import AppState
 from tpm_viz.errors import TpmVizError
+from tpm_viz.numbers import unit_factor
 from tpm_viz.paper.kinematics import forward_kinematics
 from tpm_viz.paper.trajectories import parse_trajectory_csv
-from tpm_viz.words import Lang, say
+from tpm_viz.words import Lang, T, say
 
 P = Params.paper()
 HANGUL = re.compile("[\uac00-\ud7a3]")
-ALLOWED = {"csv", "mib", "utf", "json", "tpm", "viz", "rms", "nan", "inf", "sqrt", "pinocchio"}
-"""Latin words a Korean line may keep: file formats, names, units and symbols (``l_a``, ``p_j`` are 1-letter)."""
+ALLOWED = {"csv", "mib", "utf", "json", "tpm", "viz", "rms", "nan", "inf", "sqrt", "pinocchio", "ext"}
+"""Latin words a Korean line may keep: file formats, names, units and symbols (``l_a``, ``p_j`` are 1-letter;
+``f_ext``)."""
 
 
 def english_words(text: str) -> list[str]:
-    """Words of three or more Latin letters that are not in :data:`ALLOWED`."""
-    return [w for w in re.findall(r"[A-Za-z]{3,}", text) if w.lower() not in ALLOWED]
+    """Words of three or more Latin letters that are not in :data:`ALLOWED`, outside quoted inputs (what the user
+    typed or sent is quoted as it is)."""
+    return [w for w in re.findall(r"[A-Za-z]{3,}", re.sub(r"'[^']*'", "", text)) if w.lower() not in ALLOWED]
 
 
 def tokens(text: str) -> list[str]:
@@ -93,6 +98,30 @@ CASES = {
         _lockout,
         "too many wrong presenter tokens from this address; try again in 60 s",
     ),
+    "an upload that is too large": (
+        lambda: read_upload(b"t,p1,p2\n" + b"0" * MAX_UPLOAD_BYTES),
+        "the file is too large (1048584 bytes; at most 1048576 bytes)",
+    ),
+    "a text where an actuator position is due": (
+        lambda: transitions.drive(AppState.initial(), 0, "1;2"),
+        "d1 must be a number, got '1;2'",
+    ),
+    "a list where the external force is due": (
+        lambda: transitions.set_load(AppState.initial(), "static", [1, 2, 3], (0, 0), (0, 0)),
+        "f_ext must be two numbers, got [1, 2, 3]",
+    ),
+    "an unknown unit": (
+        lambda: unit_factor("furlong", "length", T("the trajectory CSV"), "p1"),
+        "the trajectory CSV has an unknown unit 'furlong' (use m or mm)",
+    ),
+    "a time unit for a length": (
+        lambda: unit_factor("ms", "length", T("the trajectory CSV"), "p1"),
+        "the trajectory CSV: 'ms' is a time unit, but p1 is a length in m",
+    ),
+    "a position in millimetres": (
+        lambda: read_upload(b"t,p1,p2\n0,0,0\n1,50,0\n2,100,0\n3,150,0\n"),
+        "a position in the file is beyond 10 m (the file is in metres)",
+    ),
 }
 
 
@@ -126,3 +155,18 @@ def test_the_banner_warnings_of_a_pose_are_korean_in_a_korean_tab():
     english, korean = str(alerts[0].text), say(Lang.KO, alerts[0].text)
     assert english.startswith("Slider 1 is against its end-stop (d1 = 0.0 mm)")
     assert HANGUL.search(korean) and "d1 = 0.0 mm" in korean and not english_words(korean)
+
+
+def test_a_csv_header_with_an_unknown_unit_is_refused_in_korean_with_the_same_quotes():
+    """Through the CSV reader: the unit's words are Korean; the column's label is written by the reader."""
+    header = "t,p1 [furlong],p2\n0,0,0\n1,0,0\n2,0,0\n3,0,0\n"
+    exc = refusal(lambda: parse_trajectory_csv(header))
+    english = str(exc)
+    assert english == "the trajectory CSV: column 'p1 [furlong]' has an unknown unit 'furlong' (use m or mm)"
+    korean = say(Lang.KO, exc)
+    assert HANGUL.search(korean) and "'furlong'" in korean and "'p1 [furlong]'" in korean, korean
+    assert sorted(tokens(korean)) == sorted(tokens(english))
+    label = set(
+        english_words("the trajectory CSV: column")
+    )  # the label csvio builds (English text until it is a phrase)
+    assert set(english_words(korean)) <= label, korean

@@ -9,7 +9,12 @@ end); values that are not numbers at all (NaN, inf, text, wrong length) are refu
 The CSV trajectory upload goes through :func:`read_upload` only (size, encoding, row count, finiteness, timing),
 whichever widget receives it. :func:`value_problem` is the first, kind-level check of any widget value, applied to
 every GUI message before a callback runs (``ui/transport.py``): a number for a number, a boolean for a checkbox,
-text of at most :data:`MAX_TEXT` characters, a tuple of the widget's length.
+text of at most :data:`MAX_TEXT` characters, a tuple of the widget's length (its answer is a log line, in English:
+a browser never sends such a value, so no user reads it).
+
+Every refusal carries a :class:`~tpm_viz.words.Phrase` (``str(exc)``: the English line; ``say(lang, exc)``: the line
+in a tab's language). A widget's ``name`` in a message may be a phrase (``T("time t")``), shown in the tab's
+language, or a plain name (``"d1"``, ``"f_ext"``), shown as it is.
 """
 
 from __future__ import annotations
@@ -19,14 +24,17 @@ from collections.abc import Iterable, Mapping
 
 import numpy as np
 
+from tpm_viz.app.readouts import reason
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.paper.trajectories import Trajectory, parse_trajectory_csv
 from tpm_viz.params import PARAM_INFO, Params
+from tpm_viz.words import Phrase, T
 
 __all__ = [
     "MAX_TEXT",
     "MAX_UPLOAD_BYTES",
     "MAX_UPLOAD_ROWS",
+    "TOO_LARGE",
     "read_choice",
     "read_flag",
     "read_number",
@@ -47,6 +55,9 @@ MAX_UPLOAD_POSITION = 10.0
 _MAX_NAME = 80
 MAX_TEXT = 1000
 """Longest text a text input accepts [characters] (the presenter token is far shorter)."""
+TOO_LARGE = T("the file is too large ({size} bytes; at most {most} bytes)")
+"""The refusal of an upload beyond the size limit (raise ``Phrase(TOO_LARGE.template, size=..., most=...)``; also
+the transport's, ``tpm_viz.ui.transport``, which refuses it before any byte is buffered)."""
 
 
 def value_problem(current, value, max_text: int = MAX_TEXT) -> str | None:
@@ -77,50 +88,55 @@ def value_problem(current, value, max_text: int = MAX_TEXT) -> str | None:
     return f"a value of the wrong type for this widget ({type(value).__name__})"
 
 
-def read_number(value, name: str, scale: float = 1.0, lo: float = -math.inf, hi: float = math.inf) -> float:
+def read_number(value, name: str | Phrase, scale: float = 1.0, lo: float = -math.inf, hi: float = math.inf) -> float:
     """A finite number from a widget, times ``scale`` (UI unit -> SI), clipped to ``[lo, hi]`` (SI)."""
     if isinstance(value, bool):
-        raise InputError(f"{name} must be a number, got {_show(value)}")
+        raise InputError(Phrase("{name} must be a number, got {got}", name=name, got=_show(value)))
     try:
         x = float(value)
     except (TypeError, ValueError, OverflowError):
-        raise InputError(f"{name} must be a number, got {_show(value)}") from None
+        raise InputError(Phrase("{name} must be a number, got {got}", name=name, got=_show(value))) from None
     if not math.isfinite(x):
-        raise InputError(f"{name} must be finite, got {_show(value)}")
+        raise InputError(Phrase("{name} must be finite, got {got}", name=name, got=_show(value)))
     scaled = x * scale
     if not math.isfinite(scaled):  # e.g. 1e308 mm -> m is fine, but 1e308 * 1e3 is not
-        raise InputError(f"{name} is too large, got {_show(value)}")
+        raise InputError(Phrase("{name} is too large, got {got}", name=name, got=_show(value)))
     return float(np.clip(scaled, lo, hi))
 
 
-def read_vec2(value, name: str, scale: float = 1.0, bound: float = math.inf) -> np.ndarray:
+def read_vec2(value, name: str | Phrase, scale: float = 1.0, bound: float = math.inf) -> np.ndarray:
     """Two finite numbers from a widget, times ``scale`` (UI unit -> SI), each clipped to ``[-bound, bound]``."""
+    two = Phrase("{name} must be two numbers, got {got}", name=name, got=_show(value))
     if isinstance(value, (str, bytes, Mapping)):
-        raise InputError(f"{name} must be two numbers, got {_show(value)}")
+        raise InputError(two)
     try:
         items = list(value)
     except TypeError:
-        raise InputError(f"{name} must be two numbers, got {_show(value)}") from None
+        raise InputError(two) from None
     if len(items) != 2:
-        raise InputError(f"{name} must be two numbers, got {_show(value)}")
+        raise InputError(two)
     return np.array([read_number(v, name, scale, -bound, bound) for v in items])
 
 
-def read_choice(value, name: str, choices: Iterable[str]) -> str:
+def read_choice(value, name: str | Phrase, choices: Iterable[str]) -> str:
     """One of ``choices`` (a dropdown value), else :class:`~tpm_viz.InputError`."""
     choices = tuple(choices)
     if not isinstance(value, str) or value not in choices:
-        raise InputError(f"{name} must be one of {', '.join(choices)}, got {_show(value)}")
+        raise InputError(
+            Phrase(
+                "{name} must be one of {choices}, got {got}", name=name, choices=", ".join(choices), got=_show(value)
+            )
+        )
     return value
 
 
-def read_flag(value, name: str) -> bool:
+def read_flag(value, name: str | Phrase) -> bool:
     """A checkbox value: a real boolean (``0``/``1`` accepted), else :class:`~tpm_viz.InputError`."""
     if isinstance(value, bool):
         return value
     if isinstance(value, (int, float)) and value in (0, 1):
         return bool(value)
-    raise InputError(f"{name} must be on or off, got {_show(value)}")
+    raise InputError(Phrase("{name} must be on or off, got {got}", name=name, got=_show(value)))
 
 
 def read_params(params: Params, raw: Mapping[str, object]) -> Params:
@@ -128,7 +144,7 @@ def read_params(params: Params, raw: Mapping[str, object]) -> Params:
     changes = {}
     for name, value in raw.items():
         if name not in PARAM_INFO:
-            raise InputError(f"unknown parameter {_show(name)}")
+            raise InputError(Phrase("unknown parameter {name}", name=_show(name)))
         changes[name] = read_number(value, name, scale=1.0 / PARAM_INFO[name]["ui_scale"])
     return params.replace(**changes)
 
@@ -143,16 +159,16 @@ def read_upload(content, filename: str = "upload.csv", max_bytes: int = MAX_UPLO
     (samples too close in time). Reachability for the current parameters is the player's check.
     """
     if not isinstance(content, (bytes, bytearray, memoryview)):
-        raise InputError("the upload is not a file")
+        raise InputError(T("the upload is not a file"))
     content = bytes(content)
     if len(content) > max_bytes:
-        raise InputError(f"the file is too large ({len(content)} bytes; at most {max_bytes} bytes)")
+        raise InputError(Phrase(TOO_LARGE.template, size=len(content), most=max_bytes))
     if b"\x00" in content:
-        raise InputError("the file is not a text CSV file (binary content)")
+        raise InputError(T("the file is not a text CSV file (binary content)"))
     try:
         text = content.decode("utf-8-sig")
     except UnicodeDecodeError:
-        raise InputError("the file is not UTF-8 text") from None
+        raise InputError(T("the file is not UTF-8 text")) from None
     name = _clean_name(filename)
     try:
         with np.errstate(all="ignore"):
@@ -160,13 +176,21 @@ def read_upload(content, filename: str = "upload.csv", max_bytes: int = MAX_UPLO
     except TpmVizError:
         raise
     except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:  # defensive: a parser gap
-        raise InputError(f"the trajectory CSV could not be read: {exc}") from None
+        raise InputError(Phrase("the trajectory CSV could not be read: {why}", why=reason(exc))) from None
     if np.max(np.abs(traj.p)) > MAX_UPLOAD_POSITION:
-        raise InputError(f"a position in the file is beyond {MAX_UPLOAD_POSITION:g} m (the file is in metres)")
+        raise InputError(
+            Phrase("a position in the file is beyond {most:g} m (the file is in metres)", most=MAX_UPLOAD_POSITION)
+        )
     if not float(traj.t[-1]) <= MAX_UPLOAD_SECONDS:
-        raise InputError(f"the trajectory lasts {float(traj.t[-1]):g} s (at most {MAX_UPLOAD_SECONDS:g} s)")
+        raise InputError(
+            Phrase(
+                "the trajectory lasts {duration:g} s (at most {most:g} s)",
+                duration=float(traj.t[-1]),
+                most=MAX_UPLOAD_SECONDS,
+            )
+        )
     if not (np.all(np.isfinite(traj.dp)) and np.all(np.isfinite(traj.ddp))):
-        raise InputError("samples too close in time: the velocities or accelerations are not finite")
+        raise InputError(T("samples too close in time: the velocities or accelerations are not finite"))
     return traj
 
 

@@ -6,7 +6,8 @@
   diverging scale, or the condition number of ``J`` (eq. 10) on a log scale. Cells where the quantity does not
   exist (unreachable: NaN in the map) are fully transparent, so no NaN ever leaves this module; reachable cells
   outside the stroke are drawn faint.
-- :func:`colour_scale`: the legend of each kind (colour stops with their values and units).
+- :func:`colour_scale`: the legend of each kind (colour stops with their values and units; its words are
+  :class:`~tpm_viz.words.Phrase` s, rendered in a tab's language where the legend is shown).
 - :func:`ellipse_polylines`: the velocity and force manipulability ellipses (:mod:`tpm_viz.paper.ellipses`) at a
   platform position, scaled for drawing, or None at a singular pose.
 - :func:`arrow_length`, :func:`arrow_vector`: how long the force arrows of the 3D view are drawn. Near a
@@ -27,6 +28,7 @@ from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.paper.ellipses import ellipse_outline, manipulability_ellipses
 from tpm_viz.paper.workspace import WorkspaceMap, workspace_map
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase, T
 
 __all__ = [
     "ARROW_FORCE",
@@ -75,11 +77,12 @@ _OUT_OF_STROKE = (148, 163, 184)
 
 
 class ColourScale(NamedTuple):
-    """Legend of a map: title, unit, colour stops ``(label, "#rrggbb")`` from low to high, and a note."""
+    """Legend of a map: title (with its unit), colour stops ``(label, "#rrggbb")`` from low to high (a label is a
+    number as text, or words), and a note (None: none)."""
 
-    title: str
-    stops: tuple[tuple[str, str], ...]
-    note: str
+    title: Phrase
+    stops: tuple[tuple[str | Phrase, str], ...]
+    note: Phrase | None
 
 
 def _hex(rgb) -> str:
@@ -89,19 +92,25 @@ def _hex(rgb) -> str:
 def colour_scale(kind: str) -> ColourScale:
     """The legend of map ``kind`` (see :data:`MAP_KINDS`)."""
     if kind == "det_jx":
-        stops = tuple((f"{v:+.1f}" if v else "0", _hex(c)) for v, c in _DIVERGING)
-        return ColourScale("det J_x = cos(θ1+θ2) (dimensionless)", stops, "white band: direct singularity")
+        diverging: tuple[tuple[str | Phrase, str], ...] = tuple(
+            (f"{v:+.1f}" if v else "0", _hex(c)) for v, c in _DIVERGING
+        )
+        return ColourScale(T("det J_x = cos(θ1+θ2) (dimensionless)"), diverging, T("white band: direct singularity"))
     if kind == "cond":
-        stops = tuple((f"{10**v:.3g}", _hex(c)) for v, c in _SEQUENTIAL)
-        return ColourScale("condition number of J (log scale)", stops, f"1 = isotropic; ≥ {COND_MAX:g} saturates")
+        sequential: tuple[tuple[str | Phrase, str], ...] = tuple((f"{10**v:.3g}", _hex(c)) for v, c in _SEQUENTIAL)
+        return ColourScale(
+            T("condition number of J (log scale)"),
+            sequential,
+            Phrase("1 = isotropic; ≥ {most:g} saturates", most=COND_MAX),
+        )
     if kind == "workspace":
         return ColourScale(
-            "workspace (working mode, eq. 4)",
-            (("in stroke", _hex(_IN_STROKE)), ("reachable, out of stroke", _hex(_OUT_OF_STROKE))),
-            "transparent: unreachable (|p_j| ≥ l_a)",
+            T("workspace (working mode, eq. 4)"),
+            ((T("in stroke"), _hex(_IN_STROKE)), (T("reachable, out of stroke"), _hex(_OUT_OF_STROKE))),
+            T("transparent: unreachable (|p_j| ≥ l_a)"),
         )
     if kind == "off":
-        return ColourScale("no map", (), "")
+        return ColourScale(T("no map"), (), None)
     raise InputError(f"map kind must be one of {', '.join(MAP_KINDS)}, got {kind!r}")
 
 

@@ -158,7 +158,7 @@ class Run:
     ddd: np.ndarray  # (c) eq. (14)
     tau: np.ndarray  # (e) eq. (31), closed form
     tau_ref: np.ndarray | None  # reference model (Pinocchio), None if unavailable
-    ref_note: str = ""  # why tau_ref is missing
+    ref_note: Phrase | None = None  # why tau_ref is missing (None when it is there)
 
     @property
     def duration(self) -> float:
@@ -220,13 +220,14 @@ def build_run(params: Params, source: Source, reference: Reference | None = None
         res = inverse_dynamics_detail(params, p, dp, ddp)
     except TpmVizError as exc:
         raise InputError(Phrase("{what}: {why}", what=what, why=reason(exc))) from None
-    tau_ref, note = None, "no reference model"
+    note: Phrase | None = T("no reference model")
+    tau_ref = None
     if reference is not None:
         try:
             tau_ref = np.asarray(reference(params, p, dp, ddp), dtype=float).reshape(p.shape)
-            note = ""
+            note = None
         except (TpmVizError, ArithmeticError, np.linalg.LinAlgError) as exc:
-            tau_ref, note = None, f"reference model: {exc}"
+            tau_ref, note = None, Phrase("reference model: {why}", why=reason(exc))
         if tau_ref is not None and not np.all(np.isfinite(tau_ref)):
-            tau_ref, note = None, "reference model: non-finite forces"
+            tau_ref, note = None, Phrase("reference model: {why}", why=T("non-finite forces"))
     return Run(source, params, t, p, dp, ddp, res.d, res.dd, res.ddd, res.tau, tau_ref, note)

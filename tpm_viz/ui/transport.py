@@ -26,6 +26,10 @@ viser's page shows its own toast for every upload, "File uploaded successfully" 
 whatever the app then makes of the file. That toast is hidden before the last acknowledgement goes out (and the
 button freed when an upload is refused before its end): whether a file was taken is the app's to say, next to the
 upload button (:mod:`.teaching.player`), so that a refused file never gets a success toast.
+
+A refused upload is the one drop a user sees (a red notification, at most one a second): its words are phrases
+shown in the tab's language (``harden(client, lang=...)``: how to read the tab's language when it happens); the log
+lines and the reasons of the other drops (a browser never sends those) stay English.
 """
 
 from __future__ import annotations
@@ -37,13 +41,15 @@ import math
 import time
 import types
 import typing
+from collections.abc import Callable
 from typing import Any
 
 import viser
 
-from tpm_viz.app.inputs import MAX_TEXT, MAX_UPLOAD_BYTES, value_problem
+from tpm_viz.app.inputs import MAX_TEXT, MAX_UPLOAD_BYTES, TOO_LARGE, value_problem
 from tpm_viz.ui._viser import ClientDoor, Malformed, widget_value
 from tpm_viz.ui.guard import log_fault
+from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["MAX_UPLOADS", "UPLOAD_TIMEOUT", "harden", "message_problem", "update_problem"]
 
@@ -71,8 +77,11 @@ def update_problem(current, updates, handle=None, max_text: int = MAX_TEXT) -> s
     return value_problem(current, value, max_text)
 
 
-def harden(client: viser.ClientHandle, max_upload_bytes: int = MAX_UPLOAD_BYTES) -> None:
-    """Install the filters of the module docstring on ``client``'s connection (call once, on connect)."""
+def harden(
+    client: viser.ClientHandle, max_upload_bytes: int = MAX_UPLOAD_BYTES, lang: Callable[[], Lang] | None = None
+) -> None:
+    """Install the filters of the module docstring on ``client``'s connection (call once, on connect). ``lang``
+    returns the tab's language at the time of a refusal (None: English), e.g. ``lambda: view.lang``."""
     door = ClientDoor(client)
     cid = client.client_id
     in_flight: dict[str, tuple[float, str, int]] = {}  # transfer uuid -> (start time, button, size): unfinished
@@ -86,17 +95,22 @@ def harden(client: viser.ClientHandle, max_upload_bytes: int = MAX_UPLOAD_BYTES)
                 return
         await door.gui_update(client_id, message)
 
-    def refuse_upload(text: str, button: str | None, transfer: str, size: int) -> None:
+    def refuse_upload(why: Phrase, button: str | None, transfer: str, size: int) -> None:
         door.end_upload(str(button), transfer, max(0, size))  # no spinner left, the button free again
-        if log_fault(cid, "upload", f"upload refused: {text}"):  # at most one notification per second as well
+        if log_fault(cid, "upload", f"upload refused: {why}"):  # at most one notification per second as well
+            tab = Lang.EN
+            with contextlib.suppress(Exception):  # a getter that fails: English
+                tab = Lang.EN if lang is None else Lang(lang())
             with contextlib.suppress(Exception):
-                client.add_notification("Upload refused", text, color="red", auto_close_seconds=8.0)
+                title, text = say(tab, T("Upload refused")), say(tab, why)
+                client.add_notification(title, text, color="red", auto_close_seconds=8.0)
 
     def expire(transfer: str) -> None:
         entry = in_flight.pop(transfer, None)
         if entry is not None and door.upload_state(transfer) is not None:
             door.drop_upload(transfer)
-            refuse_upload(f"the upload did not finish within {UPLOAD_TIMEOUT:g} s", entry[1], transfer, entry[2])
+            late = Phrase("the upload did not finish within {seconds:g} s", seconds=UPLOAD_TIMEOUT)
+            refuse_upload(late, entry[1], transfer, entry[2])
 
     def upload_start(client_id, message) -> None:
         size, parts = message.size_bytes, message.part_count
@@ -107,12 +121,10 @@ def harden(client: viser.ClientHandle, max_upload_bytes: int = MAX_UPLOAD_BYTES)
             return
         button, transfer = message.source_component_uuid, message.transfer_uuid
         if not (0 <= size <= max_upload_bytes and 0 <= parts <= max(1, size)):
-            refuse_upload(
-                f"the file is too large ({size} bytes; at most {max_upload_bytes} bytes)", button, transfer, size
-            )
+            refuse_upload(Phrase(TOO_LARGE.template, size=size, most=max_upload_bytes), button, transfer, size)
             return
         if len(in_flight) >= MAX_UPLOADS or transfer in in_flight:
-            refuse_upload(f"at most {MAX_UPLOADS} uploads at a time", button, transfer, size)
+            refuse_upload(Phrase("at most {count} uploads at a time", count=MAX_UPLOADS), button, transfer, size)
             return
         in_flight[transfer] = (time.monotonic(), str(button), size)
         with contextlib.suppress(RuntimeError):  # called on the server's event loop
@@ -129,7 +141,7 @@ def harden(client: viser.ClientHandle, max_upload_bytes: int = MAX_UPLOAD_BYTES)
             door.drop_upload(message.transfer_uuid)
             in_flight.pop(message.transfer_uuid, None)
             refuse_upload(
-                "the file sent more bytes than it announced",
+                T("the file sent more bytes than it announced"),
                 message.source_component_uuid,
                 message.transfer_uuid,
                 state["total_bytes"],

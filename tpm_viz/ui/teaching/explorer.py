@@ -23,7 +23,7 @@ import numpy as np
 import viser
 
 from tpm_viz import meshes
-from tpm_viz.app.overlays import COND_MAX, MAP_KINDS, cached_map, colour_scale, ellipse_polylines, map_rgba
+from tpm_viz.app.overlays import MAP_KINDS, cached_map, colour_scale, ellipse_polylines, map_rgba
 from tpm_viz.app.readouts import reason
 from tpm_viz.params import Params
 from tpm_viz.ui.guard import guarded
@@ -41,19 +41,6 @@ ELLIPSE_SCALE = 0.12
 ELLIPSE_CAP = 3.0
 ELLIPSE_Z = meshes.PLATFORM_Z[1] + 0.004
 ELLIPSE_COLOURS = {"velocity": (30, 58, 138), "force": (234, 88, 12)}  # dark blue (not the leg circles' blue)
-_LEGEND = {
-    str(t): t
-    for t in (
-        T("det J_x = cos(θ1+θ2) (dimensionless)"),
-        T("white band: direct singularity"),
-        T("condition number of J (log scale)"),
-        T("workspace (working mode, eq. 4)"),
-        T("in stroke"),
-        T("reachable, out of stroke"),
-        T("transparent: unreachable (|p_j| ≥ l_a)"),
-    )
-}
-"""The words of the maps' legends (:func:`~tpm_viz.app.overlays.colour_scale`, English) as phrases."""
 
 
 class MapService:
@@ -108,11 +95,10 @@ class MapService:
             view.map_ready(params)
 
 
-def _legend(lang: Lang, text: str) -> str:
-    """A word of a legend in ``lang`` (escaped)."""
-    if text.startswith("1 = isotropic"):
-        return html.escape(say(lang, Phrase("1 = isotropic; ≥ {most:g} saturates", most=COND_MAX)))
-    return html.escape(say(lang, _LEGEND.get(text, text)))
+def _legend(lang: Lang, text: str | Phrase | None) -> str:
+    """A text of a legend (:func:`~tpm_viz.app.overlays.colour_scale`: words, or a number as text) in ``lang``,
+    escaped."""
+    return html.escape(text.render(lang) if isinstance(text, Phrase) else str(text or ""))
 
 
 def colour_bar_html(kind: str, lang: Lang = Lang.EN) -> str:
@@ -122,7 +108,7 @@ def colour_bar_html(kind: str, lang: Lang = Lang.EN) -> str:
         words = html.escape(say(lang, T("No map: the floor shows the in-stroke workspace.")))
         return f'<div style="font-size:0.8em;color:#64748b">{words}</div>'
 
-    def esc(text: str) -> str:
+    def esc(text: str | Phrase | None) -> str:
         return _legend(lang, text)
 
     if kind == "workspace":

@@ -32,7 +32,7 @@ from tpm_viz.ui.teaching.charts import Charts
 from tpm_viz.ui.teaching.player_text import summary_html
 from tpm_viz.ui.teaching.playing import RunHub, following
 from tpm_viz.ui.teaching.trace import PathTrace
-from tpm_viz.words import Phrase
+from tpm_viz.words import Phrase, T
 
 __all__ = ["CHART_HZ", "SPEEDS", "PlayerView"]
 
@@ -46,7 +46,7 @@ _UNSET = object()
 
 def _internal_error(owner, exc: Exception) -> None:
     """The guard's report to the tab whose callback failed (the traceback is in the server log)."""
-    owner.view.refuse(f"internal error ({type(exc).__name__}), logged on the server", resync=False)
+    owner.view.refuse(Phrase("internal error ({kind}), logged on the server", kind=type(exc).__name__), resync=False)
 
 
 def _option(source: Source) -> str:
@@ -179,7 +179,7 @@ class PlayerView:
             label = self.choice.value
             sources = self._sources()
             if label not in sources:
-                raise InputError(f"unknown trajectory {label!r}")
+                raise InputError(Phrase("unknown trajectory {name}", name=repr(label)))
             source = sources[label]
             run = self.runs.of(self.session).run
             if label == NONE:
@@ -221,7 +221,7 @@ class PlayerView:
         with self.view.hub.lock:
             if self._is_echo(self.time):
                 return
-            t = read_number(self.time.value, "time t", lo=0.0, hi=1e4)
+            t = read_number(self.time.value, T("time t"), lo=0.0, hi=1e4)
             self.runs.seek(self.session, t, origin=self.view)
 
     def _download(self, name: str, data: bytes) -> None:
@@ -230,7 +230,7 @@ class PlayerView:
     def _run_or_refuse(self):
         run = self.runs.of(self.session).run
         if run is None:
-            raise InputError("load a trajectory first")
+            raise InputError(T("load a trajectory first"))
         return run
 
     @guarded(on_error=_internal_error)

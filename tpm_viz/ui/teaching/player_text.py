@@ -36,7 +36,9 @@ def summary_html(ps, run, t, lang: Lang = Lang.EN) -> str:
         peak = f"<span data-q='run-peak'>{num(run.peak, '.1f')}</span>"
         name = f"<b>{esc(run.source.label)}</b>"
         lines.append(say(lang, Phrase("{name}: peak |τ_i| = {peak} N (closed form)", name=name, peak=peak)))
-        gap = f"<span data-q='run-diff'>{num(diff, '.1e')}</span> N" if diff is not None else esc(run.ref_note)
+        gap = (
+            f"<span data-q='run-diff'>{num(diff, '.1e')}</span> N" if diff is not None else esc(say(lang, run.ref_note))
+        )
         lines.append(say(lang, Phrase("Pinocchio − paper: max |Δτ_i| = {gap}", gap=gap)))
         if ps.previous is not None:
             label, before = ps.previous

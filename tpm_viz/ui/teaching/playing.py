@@ -21,12 +21,13 @@ import weakref
 from dataclasses import dataclass
 
 from tpm_viz.app.moves import place
-from tpm_viz.app.readouts import Load
+from tpm_viz.app.readouts import Load, reason
 from tpm_viz.app.runs import Run, Source, build_run
 from tpm_viz.app.state import AppState, TrajectorySample
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.ui.session import Hub, Session
 from tpm_viz.ui.worker import Worker
+from tpm_viz.words import Phrase, T
 
 __all__ = ["FPS", "PlayerSession", "RunHub", "following", "sampled"]
 
@@ -65,7 +66,7 @@ class PlayerSession:
     previous: tuple[str, float] | None = None  # label and peak force [N] of the run before
     playing: bool = False
     token: int = -1  # session.play_token of the playing thread
-    status: str = ""  # why the run was dropped, or empty
+    status: Phrase | str = ""  # why the run was dropped (rendered in each tab's language), or empty
 
 
 class RunHub:
@@ -148,7 +149,7 @@ class RunHub:
                     return
                 ps.loading = None
                 if error is not None:
-                    ps.run, ps.status = None, f"Trajectory unloaded: {error}"
+                    ps.run, ps.status = None, Phrase("Trajectory unloaded: {why}", why=reason(error))
                 elif session.state.params != params:
                     ps.run = new
                     self.follow_params(session)
@@ -176,9 +177,9 @@ class RunHub:
     def _usable(self, session: Session) -> Run:
         run = self.of(session).run
         if run is None:
-            raise InputError("load a trajectory first (line, circle or your CSV)")
+            raise InputError(T("load a trajectory first (line, circle or your CSV)"))
         if run.params != session.state.params:
-            raise InputError("the trajectory is being recomputed for the new parameters; try again in a moment")
+            raise InputError(T("the trajectory is being recomputed for the new parameters; try again in a moment"))
         return run
 
     def play(self, session: Session, speed: float, loop: bool = False, origin=None) -> None:
