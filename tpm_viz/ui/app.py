@@ -299,14 +299,12 @@ def main(
     gc.collect()
     gc.freeze()  # the start-up heap (numpy, trimesh, Pinocchio, viser) is never scanned again: full collections
     # with 30 tabs take ~7 ms instead of ~90 ms (a pause every tab would feel in the middle of a drag)
-    shown = "127.0.0.1" if host in ("0.0.0.0", "::") else host
-    print(f"tpm-viz serving at http://{shown}:{app.port}", flush=True)
-    if room is not None:
-        _announce(app, room, bound=host)
     if not block:
+        _serving(app, host, room)
         return app
-    signal.signal(signal.SIGTERM, _interrupt)  # a stop by the system saves the session too
+    signal.signal(signal.SIGTERM, _interrupt)  # before the URL is printed: a stop right after it saves too
     try:
+        _serving(app, host, room)
         while True:
             time.sleep(3600)
     except KeyboardInterrupt:
@@ -314,6 +312,14 @@ def main(
     finally:
         app.stop()
     return app
+
+
+def _serving(app: TpmApp, host: str, room: Classroom | None) -> None:
+    """The one line with the URL (and in classroom mode the students' URLs, QR code and token)."""
+    shown = "127.0.0.1" if host in ("0.0.0.0", "::") else host
+    print(f"tpm-viz serving at http://{shown}:{app.port}", flush=True)
+    if room is not None:
+        _announce(app, room, bound=host)
 
 
 def _interrupt(signum, frame) -> None:
