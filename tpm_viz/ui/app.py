@@ -305,8 +305,8 @@ def main(
     signal.signal(signal.SIGTERM, _interrupt)  # before the URL is printed: a stop right after it saves too
     try:
         _serving(app, host, room)
-        while True:
-            time.sleep(3600)
+        while True:  # short sleeps: a signal delivered to another thread does not cut the main thread's sleep,
+            time.sleep(0.5)  # and Python runs the handler only when the main thread runs again
     except KeyboardInterrupt:
         pass
     finally:
