@@ -126,13 +126,16 @@ def _finite_range(lo: float, hi: float) -> tuple[float, float]:
     return max(lo, -_SPAN_MAX), min(hi, _SPAN_MAX)
 
 
-def time_ticks(t0: float, t1: float, most: int = 6, room: float | None = None, gap: float = 12.0) -> Ticks:
+def time_ticks(
+    t0: float, t1: float, most: int = 6, room: float | None = None, gap: float = 12.0, px: float = 12.0
+) -> Ticks:
     """Ticks of a time axis spanning exactly ``[t0, t1]`` [s], on multiples of a 1-2-5 step: between 3
     (``t0 = 0``; 2 for another start) and ``most`` of them (``most >= 6``, raised to 6 if smaller).
 
     The smallest such step is taken, unless ``room`` is given: the width [CSS px] of the narrowest plot the axis
-    may be drawn on. Then the step is also large enough that neighbouring labels (12 px, :func:`text_width`)
-    leave ``gap`` px between them, if any step with enough ticks allows it (else the one with the fewest)."""
+    may be drawn on. Then the step is also large enough that neighbouring labels (``px`` CSS px,
+    :func:`text_width`) leave ``gap`` px between them, if any step with enough ticks allows it (else the one with
+    the fewest)."""
     t0, t1 = float(t0), float(t1)
     if not (math.isfinite(t0) and math.isfinite(t1)):
         t0, t1 = 0.0, 1.0
@@ -151,7 +154,7 @@ def time_ticks(t0: float, t1: float, most: int = 6, room: float | None = None, g
             return best  # no larger step has room for more: the fewest labels that still make an axis
         if fewest <= count <= most:
             best = _build(m, k, first, last, t0, t1)
-            widest = max(text_width(label) for label in best.labels)
+            widest = max(text_width(label, px) for label in best.labels)
             if room is None or room * _step_of(m, k) / span >= widest + gap:
                 return best
         if count < fewest:  # pragma: no cover (the step after one with > most ticks has >= fewest, see tests)

@@ -13,7 +13,8 @@ when the viewer orbits or zooms.
 
 **Presentation mode** (a checkbox of the *Class & view* tab, per tab): large type (the readouts
 :data:`READOUT_PX` CSS pixels, every label darker and larger), a wider panel (:data:`PRESENTATION_WIDTH`), thicker
-lines and larger labels in 3D (:mod:`.tabscene`), and a box of the banner and the two forces that floats over the
+lines and larger labels in 3D (:mod:`.tabscene`), the player's charts with 18 px dark axes
+(:data:`~.teaching.charts.LARGE`), and a box of the banner and the two forces that floats over the
 bottom of the canvas whenever the panel is collapsed to its rail (a separate viser panel, shown by the style sheet
 only then; the framing keeps its band free). All of it is this tab's own: the style sheet is an HTML element of
 the tab's GUI, and every tab's GUI is its own.
@@ -115,6 +116,9 @@ div:has(> [data-q="banner"]) [style*="grid-template-columns"] {{ grid-template-c
 div:has(> [data-q="banner"]) [style*="grid-template-columns"] > span {{ white-space: nowrap; }}
 .mantine-Paper-root label, .mantine-Button-label, .mantine-Tabs-tab, .mantine-Checkbox-label,
 .mantine-Paper-root .mantine-Text-root {{ font-size: 15px !important; color: #0f172a; letter-spacing: 0 !important; }}
+.uplot .u-title {{ font-size: 17px !important; color: #0f172a; }}
+.uplot .u-legend {{ font-size: 15px !important; }}
+.uplot .u-legend .u-label {{ color: #0f172a; }}
 [data-floating-window]:has([data-live]) {{ visibility: hidden; pointer-events: none; }}
 body:has([data-dock-rail-root]) [data-floating-window]:has([data-live]) {{ visibility: visible; pointer-events: auto; }}
 [data-live] {{ max-height: calc({round(LIVE_BAND * 100)}vh - {LIVE_CHROME}px); overflow-y: auto; }}
@@ -123,7 +127,9 @@ body:has([data-dock-rail-root]) [data-floating-window]:has([data-live]) {{ visib
 [data-live] table, [data-live] > div > div:last-child > div:first-child {{ display: none; }}
 @media {_PHONE} {{ div:has(> div > [data-live]) {{ display: none !important; }} }}
 </style>"""
-"""Presentation mode: large, dark type; the box of banner and forces shown only while the panel is collapsed."""
+"""Presentation mode: large, dark type (the charts' titles and legends too; their axes are drawn on a canvas, sized by
+:meth:`~.teaching.charts.Charts.set_presentation`); the box of banner and forces shown only while the panel is
+collapsed."""
 
 
 def mechanism_box(params: Params) -> tuple[np.ndarray, np.ndarray]:
@@ -232,6 +238,9 @@ class Look:
         if self.live is not None:
             self.live.visible = on
         self.view.scene.set_presentation(on)
+        teaching = getattr(self.view, "teaching", None)  # None only while the tab is being built
+        if teaching is not None:
+            teaching.player.charts.set_presentation(on)
         self.show()
         self.view.frame_camera(self.view.session.state.params)
 

@@ -13,6 +13,10 @@ the wire, so:
   stay apart on the narrowest chart (:data:`NARROWEST_PX`, a small phone): fewer time ticks on a wide screen, never
   touching labels on a narrow one. A chart is tall enough for its rotated y label in every language
   (:func:`chart_height`). Drag-to-zoom is off (the ticks are fixed to the run's range).
+- the axes are drawn in one of two :class:`AxisLook` s: :data:`NORMAL` (uPlot's 12 px in viser's grey) or
+  :data:`LARGE` for presentation mode (:meth:`Charts.set_presentation`, from :mod:`tpm_viz.ui.look`: 18 px in
+  near-black, thicker ticks); every size above (axis heights and widths, label room, padding, tick spacing)
+  follows the font size, so the larger labels and titles are not cut either.
 
 No NaN is ever sent. Charts are built once per tab; a new run replaces their axes and data; the marker moves by
 re-sending the (decimated, <= :data:`CHART_POINTS` points) data, which the caller throttles during playback.
@@ -23,6 +27,7 @@ connection shows the English texts in the tab's language, :mod:`tpm_viz.ui.langu
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -33,14 +38,60 @@ from tpm_viz.app.palette import hex_colour
 from tpm_viz.app.runs import Run
 from tpm_viz.words import Lang, Phrase, T, say
 
-__all__ = ["CHART_POINTS", "Charts", "axes_for", "chart_height", "marker", "plot_room", "y_axis"]
+__all__ = ["CHART_POINTS", "LARGE", "NORMAL", "AxisLook", "Charts", "axes_for", "chart_height", "marker"]
+__all__ += ["plot_room", "y_axis"]
 
 CHART_POINTS = 151
 FONT_PX = 12  # uPlot's axis font: 12 px (bold for the axis labels)
 TICK_PX, GAP_PX = 10, 5  # uPlot's tick length and the gap between tick and label [px]
-X_AXIS_PX = 34  # height of the time axis: tick, gap, one line of labels, descenders
-LABEL_PX = 24  # room of an axis label (one line of bold 12 px text and its gap)
-PADDING = (12, 24, 0, 0)  # top: half a y label above the top tick; right: half a time label past the end
+FONTS = '"Segoe UI", Roboto, "Helvetica Neue", Arial, "Noto Sans", "NanumGothic", sans-serif'
+"""The font families of the large axes (uPlot's own default list, with a Korean font before the generic one)."""
+
+
+@dataclass(frozen=True)
+class AxisLook:
+    """How the axes of a chart are drawn: the font size of tick labels and axis titles [CSS px] (titles bold) and
+    the colour of text and ticks (None: uPlot's font and viser's theme grey, nothing sent). Every size of an axis
+    follows the font size (:attr:`x_axis`, :attr:`label`, :attr:`padding`)."""
+
+    px: int = FONT_PX
+    colour: str | None = None
+    tick_width: float = 1.0  # [px]
+
+    @property
+    def x_axis(self) -> int:
+        """Height of the time axis [px]: tick, gap, one line of labels and their descenders (34 at 12 px)."""
+        return TICK_PX + GAP_PX + math.ceil(self.px * 19 / 12)
+
+    @property
+    def label(self) -> int:
+        """Room of an axis title [px]: one line of bold text and its gap (24 at 12 px)."""
+        return 2 * self.px
+
+    @property
+    def padding(self) -> tuple[int, int, int, int]:
+        """uPlot's padding [px]: top, half a y label above the top tick; right, half a time label past the end."""
+        return (self.px, 2 * self.px, 0, 0)
+
+    def style(self) -> dict[str, Any]:
+        """The uPlot axis options of this look (none for the normal look: uPlot's and viser's defaults)."""
+        if self.colour is None:
+            return {}
+        return {
+            "font": f"{self.px}px {FONTS}",
+            "labelFont": f"bold {self.px}px {FONTS}",
+            "stroke": self.colour,
+        }
+
+
+NORMAL = AxisLook()
+"""The charts' axes as uPlot and viser draw them: 12 px, grey."""
+LARGE = AxisLook(18, "#0f172a", 2.0)
+"""The charts' axes in presentation mode: 18 px (>= 16 px, read on a 1024 x 768 projector), near-black (the colour of
+the presentation mode's labels), ticks 2 px wide."""
+X_AXIS_PX = NORMAL.x_axis  # height of the time axis: tick, gap, one line of labels, descenders
+LABEL_PX = NORMAL.label  # room of an axis label (one line of bold 12 px text and its gap)
+PADDING = NORMAL.padding  # top: half a y label above the top tick; right: half a time label past the end
 NARROWEST_PX = 303
 """[CSS px] The narrowest chart the time labels must fit: the full-width phone sheet (:mod:`tpm_viz.ui.look`) of a
 320 px wide phone, measured in Chromium (390 px: 373; the docked panel: 365). A wider chart has room to spare."""
@@ -66,50 +117,56 @@ def marker(n: int, k: int | None) -> np.ndarray:
     return out
 
 
-def chart_height(y_label: Phrase, least: int) -> int:
+def chart_height(y_label: Phrase, least: int, look: AxisLook = NORMAL) -> int:
     """Height [px] of a chart whose plot area is at least as tall as ``y_label`` (bold, rotated along the y axis)
     in every language, and at least ``least``."""
-    longest = max(text_width(say(lang, y_label), FONT_PX, bold=True) for lang in Lang)
-    return max(int(least), math.ceil(PADDING[0] + X_AXIS_PX + LABEL_PX + longest + 12))
+    longest = max(text_width(say(lang, y_label), look.px, bold=True) for lang in Lang)
+    return max(int(least), math.ceil(look.padding[0] + look.x_axis + look.label + longest + look.px))
 
 
-def _axis(ticks: Ticks, label: str, size: float) -> dict[str, Any]:
+def _axis(ticks: Ticks, label: str, size: float, look: AxisLook) -> dict[str, Any]:
+    tick: dict[str, Any] = {"size": TICK_PX}
+    if look.colour is not None:
+        tick.update(stroke=look.colour, width=look.tick_width)
     return {
         "label": label,
         "size": math.ceil(size),
-        "labelSize": LABEL_PX,
+        "labelSize": look.label,
         "splits": ticks.values,
         "values": ticks.labels,
         "gap": GAP_PX,
-        "ticks": {"size": TICK_PX},
+        "ticks": tick,
+        **look.style(),
     }
 
 
-def y_axis(values) -> tuple[Ticks, int]:
+def y_axis(values, look: AxisLook = NORMAL) -> tuple[Ticks, int]:
     """The ticks of a value axis around ``values`` (display units, any shape) and its width [px]: tick, gap and
-    the widest label (:func:`~tpm_viz.app.chart_axes.text_width`, an upper bound) with 4 px to spare."""
+    the widest label (:func:`~tpm_viz.app.chart_axes.text_width`, an upper bound) with a third of an em to spare."""
     y = value_ticks(values, most=5, resolution=RESOLUTION)
-    return y, math.ceil(TICK_PX + GAP_PX + max(text_width(s, FONT_PX) for s in y.labels) + 4)
+    widest = max(text_width(s, look.px) for s in y.labels)
+    return y, math.ceil(TICK_PX + GAP_PX + widest + look.px / 3)
 
 
-def plot_room(y_size: float) -> float:
+def plot_room(y_size: float, look: AxisLook = NORMAL) -> float:
     """Width [px] of the plot area of a chart whose y axis is ``y_size`` px wide, on the narrowest chart."""
-    return NARROWEST_PX - PADDING[1] - LABEL_PX - y_size
+    return NARROWEST_PX - look.padding[1] - look.label - y_size
 
 
 def axes_for(
-    t, values, y_label: str, x_label: str, room: float | None = None
+    t, values, y_label: str, x_label: str, room: float | None = None, look: AxisLook = NORMAL
 ) -> tuple[dict[str, Any], tuple[dict[str, Any], ...]]:
-    """uPlot ``scales`` and ``axes`` for series ``values`` (display units, any shape) against ``t`` [s]: the time
-    axis spans ``[t[0], t[-1]]``, the y axis the ticks around the values; every tick labelled, no label wider
-    than its axis, time labels apart on a plot ``room`` px wide (default: this chart's on the narrowest chart,
-    :func:`plot_room`)."""
+    """uPlot ``scales`` and ``axes`` for series ``values`` (display units, any shape) against ``t`` [s], drawn in
+    ``look``: the time axis spans ``[t[0], t[-1]]``, the y axis the ticks around the values; every tick labelled,
+    no label wider than its axis, time labels apart on a plot ``room`` px wide (default: this chart's on the
+    narrowest chart, :func:`plot_room`)."""
     t = np.asarray(t, dtype=float)
-    y, y_size = y_axis(values)
-    room = plot_room(y_size) if room is None else room
-    x = time_ticks(t[0], t[-1], room=room) if len(t) else time_ticks(0.0, 1.0, room=room)
+    y, y_size = y_axis(values, look)
+    room = plot_room(y_size, look) if room is None else room
+    t0, t1 = (t[0], t[-1]) if len(t) else (0.0, 1.0)
+    x = time_ticks(t0, t1, room=room, gap=look.px, px=look.px)
     scales = {"x": {"time": False, "range": (x.lo, x.hi)}, "y": {"range": (y.lo, y.hi)}, "c": {"range": (0.0, 1.0)}}
-    return scales, (_axis(x, x_label, X_AXIS_PX), _axis(y, y_label, y_size))
+    return scales, (_axis(x, x_label, look.x_axis, look), _axis(y, y_label, y_size, look))
 
 
 def _series(label: str, colour: str, width: float = 2.0, dash=None) -> Any:
@@ -136,6 +193,9 @@ def _options(y_label: Phrase, least: int, lang: Lang) -> dict:
     )
 
 
+_PLACEHOLDER = (np.array([0.0, 1.0]), np.zeros(2))  # the axes of a chart before its first run
+
+
 class Charts:
     """Four uPlot charts in the current GUI container (a tab): forces, ``d``, ``ḋ``, ``d̈``; words in ``lang``."""
 
@@ -144,11 +204,13 @@ class Charts:
         x = np.linspace(0.0, 1.0, n)
         zero = np.zeros(n)
         self.lang = lang
+        self.look = NORMAL
         self._run: Run | None = None
         self._idx = np.arange(n)
         self._base: list[tuple[np.ndarray, ...]] = []
         x_label = say(lang, X_LABEL)
         self._y_labels = [say(lang, FORCES[1]), *(say(lang, label) for _a, _t, label, _s in KINEMATICS)]
+        self._heights = [(FORCES[1], FORCES[2]), *((label, KINEMATICS_HEIGHT) for _a, _t, label, _s in KINEMATICS)]
         self.forces = gui.add_uplot(
             (x, zero, zero, zero, zero, marker(n, None)),
             (
@@ -194,6 +256,47 @@ class Charts:
             handle.visible = run is not None
         if run is None:
             return
+        self._plot(run)
+        self.show_time(t)
+
+    def set_presentation(self, on: bool) -> None:
+        """Draw the axes large and dark (:data:`LARGE`, presentation mode) or as usual (:data:`NORMAL`): the
+        ticks, their room, the charts' heights and padding follow; the run and its marker stay."""
+        look = LARGE if on else NORMAL
+        if look == self.look:
+            return
+        self.look = look
+        for handle, (phrase, least) in zip(self.handles, self._heights, strict=True):
+            handle.height = chart_height(phrase, least, look)
+            handle.padding = look.padding
+        if self._run is None:
+            x_label = say(self.lang, X_LABEL)
+            for handle, y_label in zip(self.handles, self._y_labels, strict=True):
+                handle.scales, handle.axes = axes_for(*_PLACEHOLDER, y_label, x_label, look=look)
+        else:
+            self._plot(self._run, axes_only=True)
+
+    def _plot(self, run: Run, axes_only: bool = False) -> None:
+        """Decimate ``run`` into the charts' series (unless ``axes_only``) and set the axes for them."""
+        if not axes_only:
+            self._decimate(run)
+        x_label = say(self.lang, X_LABEL)
+        look = self.look
+        shown = [
+            base[1:3] if handle is not self.forces or run.tau_ref is None else base[1:]
+            for handle, base in zip(self.handles, self._base, strict=True)
+        ]
+        room = min(plot_room(y_axis(np.concatenate(s), look)[1], look) for s in shown)  # one time axis for all four
+        for handle, base, values, y_label in zip(self.handles, self._base, shown, self._y_labels, strict=True):
+            handle.scales, handle.axes = axes_for(base[0], np.concatenate(values), y_label, x_label, room, look)
+        if axes_only:
+            return
+        series = list(self.forces.series)
+        for k in (3, 4):
+            series[k] = {**series[k], "show": run.tau_ref is not None}
+        self.forces.series = tuple(series)
+
+    def _decimate(self, run: Run) -> None:
         n = len(run.t)
         step = max(1, int(np.ceil((n - 1) / (CHART_POINTS - 1))))
         self._idx = np.unique(np.r_[np.arange(0, n, step), n - 1])
@@ -203,19 +306,6 @@ class Charts:
         for attr, _title, _label, scale in KINEMATICS:
             arr = getattr(run, attr)
             self._base.append((run.t[i], arr[i, 0] * scale, arr[i, 1] * scale))
-        x_label = say(self.lang, X_LABEL)
-        shown = [
-            base[1:3] if handle is not self.forces or run.tau_ref is None else base[1:]
-            for handle, base in zip(self.handles, self._base, strict=True)
-        ]
-        room = min(plot_room(y_axis(np.concatenate(s))[1]) for s in shown)  # one time axis for the four charts
-        for handle, base, values, y_label in zip(self.handles, self._base, shown, self._y_labels, strict=True):
-            handle.scales, handle.axes = axes_for(base[0], np.concatenate(values), y_label, x_label, room)
-        series = list(self.forces.series)
-        for k in (3, 4):
-            series[k] = {**series[k], "show": run.tau_ref is not None}
-        self.forces.series = tuple(series)
-        self.show_time(t)
 
     def show_time(self, t: float | None, forces_only: bool = False) -> None:
         """Move the marker to the sample nearest ``t`` [s] (None hides it), in the force chart only if
