@@ -1,13 +1,13 @@
 """CSV as spreadsheets write it, read into SI columns; CSV written back losslessly. Rules for users: ``docs/csv.md``.
 
 Reading (the command line and the browser upload share it) is streaming, with stated limits
-(:data:`MAX_ROWS`, :data:`MAX_BYTES`, :data:`MAX_LINE`), and forgives what real files contain: a UTF-8 or UTF-16
-byte-order mark, Windows (cp1252/Latin-1) text, CRLF line ends, Excel's ``sep=;`` first line, comma,
-semicolon or tab delimiters (sniffed from the header), quoted cells, trailing empty columns, blank and ``#``
-comment lines, decimal commas and the other number forms of :func:`tpm_viz.numbers.parse_number`, units in the
-header (``t [s]``, ``p1 (mm)``, ``t_ms``, ``dp1 [mm/s]``) converted to SI, and columns it does not need
-(ignored, whatever they hold). Every refusal is one :class:`~tpm_viz.errors.InputError` line naming the row
-and column, or quoting the header it found.
+(:data:`MAX_ROWS`, :data:`MAX_BYTES`, :data:`MAX_LINE`), and forgives what real files contain: the spreadsheet
+dialects of :mod:`tpm_viz.csvdialect` (byte-order marks, Windows text, CRLF, ``sep=;``, comma, semicolon or tab
+delimiters, blank and ``#`` comment lines before the header, units in the header: ``t [s]``, ``p1 (mm)``,
+``t_ms``, ``dp1 [mm/s]``, converted to SI), quoted cells, trailing empty columns, blank and comment lines among
+the rows, decimal commas and the other number forms of :func:`tpm_viz.numbers.parse_number`, and columns it does
+not need (ignored, whatever they hold). Every refusal is one :class:`~tpm_viz.errors.InputError` line naming the
+row and column, or quoting the header it found.
 
 Writing uses 17 significant digits (lossless for float64) and leaves a cell empty where a value does not exist
 (an unreachable pose). :func:`write_columns` replaces a file atomically (temporary file, then rename).
@@ -27,12 +27,22 @@ from typing import IO
 
 import numpy as np
 
+from tpm_viz.csvdialect import (
+    DELIMITERS,
+    MAX_LINE,
+    binary_lines,
+    decode_text,
+    find_header,
+    quantity,
+    split_header,
+    text_lines,
+)
 from tpm_viz.errors import InputError
-from tpm_viz.numbers import UNITS, parse_number, shorten, unit_factor
+from tpm_viz.numbers import parse_number, shorten, unit_factor
 from tpm_viz.words import Phrase, T
 
-__all__ = ["MAX_BYTES", "MAX_LINE", "MAX_ROWS", "OPTIONAL_COLUMNS", "Table", "decode_text", "format_columns"]
-__all__ += ["parse_columns", "read_columns", "read_text", "time_unit_note", "write_columns"]
+__all__ = ["DELIMITERS", "MAX_BYTES", "MAX_LINE", "MAX_ROWS", "OPTIONAL_COLUMNS", "Table", "decode_text"]
+__all__ += ["format_columns", "parse_columns", "read_columns", "read_text", "time_unit_note", "write_columns"]
 
 OPTIONAL_COLUMNS = ("t",)
 """Columns read when present and passed through to the output (time [s])."""
@@ -40,19 +50,9 @@ MAX_ROWS = 1_000_000
 """Most data rows in one input (the command line; the upload has its own, smaller limit)."""
 MAX_BYTES = 256 * 1024 * 1024
 """Largest input [bytes] (256 MiB)."""
-MAX_LINE = 65_536
-"""Longest line of an input [bytes or characters]."""
 CHUNK = 65_536
 """Rows converted to numbers at a time while reading."""
-DELIMITERS = (";", "\t", ",")
-"""Delimiters sniffed from the header line, in order of preference on a tie."""
-_ALIASES = {"time": "t"}
-
 # Refusals too long for their raise, marked for the catalogue (gettext's N_ idiom); raised as Phrase(X.template, ...)
-_NOT_TEXT = T("{source}: line {line} is not valid {code}; save the file as UTF-8")
-_TOO_BIG = T("{source} is larger than {mib} MiB (the limit); split the file")
-_BINARY = T("{source} is not a text CSV file (binary content on line {line})")
-_LONG_LINE = T("{source}: line {line} is longer than {most} characters (the limit)")
 _FILE_TOO_BIG = T("{source} is {size} MiB; inputs are limited to {mib} MiB")
 _NOT_CSV = T("{source}: line {line}: not valid CSV ({why})")
 _TWICE = T("{source}: column {name} appears twice in the header {header}")
@@ -61,85 +61,10 @@ _CELLS = T("{source}: row {row} has {cells} cells, the header has {width}")
 _TOO_MANY = T("{source} has more than {limit} data rows (the limit); split the file")
 
 
-_QUANTITIES = "ddp:acceleration ddd:acceleration dp:velocity dd:velocity tau:force theta:angle p:length d:length"
-
-
 class Table(dict):
     """``{column: float array}`` in SI units, plus ``units``: the unit each column had in the file (``""``: none)."""
 
     units: dict[str, str]
-
-
-def _quantity(name: str) -> str | None:
-    """The quantity of a known column name (``p1`` length, ``dp1`` velocity, ...), None if unknown."""
-    base = name.split("_", 1)[0]
-    for prefix, quantity in (pair.split(":") for pair in _QUANTITIES.split()):
-        if base.startswith(prefix) and base[len(prefix) :].isdigit():
-            return quantity
-    return "time" if base == "t" else None
-
-
-def _split_header(cell: str) -> tuple[str, str]:
-    """``'t [s]'`` -> ``('t', 's')``; also ``p1 (mm)``, ``p1/mm``, ``t_ms``; the name in lower case."""
-    s = cell.strip().lstrip("\ufeff").strip()
-    name, unit = s, ""
-    if s[-1:] in (")", "]"):
-        i = s.rfind("(" if s[-1] == ")" else "[")
-        if i > 0:
-            name, unit = s[:i].rstrip().rstrip("/"), s[i + 1 : -1]
-    elif "/" in s:
-        name, unit = s.split("/", 1)
-        unit = unit.strip().strip("()[]")
-    elif "_" in s and s.rsplit("_", 1)[1].lower() in UNITS:
-        name, unit = s.rsplit("_", 1)
-    name = name.strip().lower()
-    return _ALIASES.get(name, name), unit.strip()
-
-
-def decode_text(data: bytes, source: str = "input") -> str:
-    """Bytes to text with the reader's rules: BOM (UTF-8/UTF-16), UTF-16 without BOM, UTF-8, else cp1252/Latin-1."""
-    return "".join(_binary_lines(io.BufferedReader(io.BytesIO(data)), source, len(data) + 1))
-
-
-def _binary_lines(raw, source: str, max_bytes: int) -> Iterator[str]:
-    """Decoded lines of a binary stream (see :func:`decode_text`), with the byte and line limits."""
-    head = raw.peek(4)[:4]
-    bom = head[:2] in (b"\xff\xfe", b"\xfe\xff")
-    le = len(head) == 4 and 0 not in (head[0], head[2]) and head[1] == head[3] == 0  # UTF-16-LE without BOM
-    enc = "utf-16" if bom else "utf-16-le" if le else "utf-8"
-    utf16 = enc != "utf-8"
-    errors = "strict" if utf16 else "surrogateescape"  # bytes that are not UTF-8: see _decode_line
-    readline = io.TextIOWrapper(raw, encoding=enc, errors=errors, newline="").readline  # \n, \r\n or \r
-    total, n = 0, 0
-    while True:
-        try:
-            line = readline(MAX_LINE + 1)
-        except UnicodeDecodeError:
-            raise InputError(Phrase(_NOT_TEXT.template, source=source, line=n + 1, code=enc.upper())) from None
-        if not line:
-            return
-        n += 1
-        if not line.isascii() and not utf16:
-            try:
-                line.encode("utf-8")
-            except UnicodeEncodeError:
-                line = _decode_line(line.encode("utf-8", "surrogateescape"))
-        total += len(line)
-        if total > max_bytes:
-            raise InputError(Phrase(_TOO_BIG.template, source=source, mib=max_bytes // 1048576))
-        if "\x00" in line:
-            raise InputError(Phrase(_BINARY.template, source=source, line=n))
-        if len(line) > MAX_LINE:
-            raise InputError(Phrase(_LONG_LINE.template, source=source, line=n, most=MAX_LINE))
-        yield line.lstrip("\ufeff") if n == 1 else line
-
-
-def _decode_line(b: bytes) -> str:
-    """A line that is not UTF-8: Windows' cp1252, else Latin-1 (only headers hold letters; numbers are ASCII)."""
-    try:
-        return b.decode("cp1252")
-    except UnicodeDecodeError:
-        return b.decode("latin-1")
 
 
 def _open_lines(path: str, max_bytes: int) -> tuple[Iterator[str], IO[bytes] | None]:
@@ -157,7 +82,7 @@ def _open_lines(path: str, max_bytes: int) -> tuple[Iterator[str], IO[bytes] | N
         except BaseException:
             fh.close()
             raise
-    return _binary_lines(raw, "stdin" if path == "-" else path, max_bytes), fh
+    return binary_lines(raw, "stdin" if path == "-" else path, max_bytes), fh
 
 
 def read_text(path: str, max_bytes: int = MAX_BYTES) -> str:
@@ -184,20 +109,7 @@ def parse_columns(
     text: str, required: Sequence[str], source: str | Phrase = "input", max_rows: int = MAX_ROWS
 ) -> Table:
     """Parse CSV text into SI columns ``required`` (+ ``t`` if present); rules in the module docstring."""
-    return parse_lines(_text_lines(text, source), required, source, max_rows)
-
-
-def _text_lines(text: str, source: str | Phrase) -> Iterator[str]:
-    for n, line in enumerate(io.StringIO(text, newline=""), start=1):
-        if len(line) > MAX_LINE:
-            raise InputError(Phrase(_LONG_LINE.template, source=source, line=n, most=MAX_LINE))
-        yield line.lstrip("\ufeff") if n == 1 else line
-
-
-def _sniff(line: str) -> str:
-    counts = [line.count(d) for d in DELIMITERS]
-    best = max(counts)
-    return DELIMITERS[counts.index(best)] if best else ","
+    return parse_lines(text_lines(text, source), required, source, max_rows)
 
 
 def parse_lines(
@@ -205,29 +117,19 @@ def parse_lines(
 ) -> Table:
     """The streaming core of :func:`parse_columns` and :func:`read_columns` (``lines`` keep their line ends)."""
     lines = iter(lines)
-    delimiter, skipped, header_line = None, 0, None
-    for line in lines:
-        skipped += 1
-        s = line.strip()
-        if not s or s.startswith("#"):
-            continue
-        if s.lower().startswith("sep=") and delimiter is None and len(s) == 5:
-            delimiter = s[4]
-            continue
-        header_line = line.lstrip("\ufeff")
-        break
+    delimiter, header_line, skipped = find_header(lines)
     need = ",".join(required)
     if header_line is None:
         raise InputError(Phrase("{source} is empty: expected a header with columns {need}", source=source, need=need))
-    delimiter = delimiter or _sniff(header_line)
+    header: str = header_line
 
     def chained() -> Iterator[str]:
-        yield header_line
+        yield header
         yield from lines
 
     reader = csv.reader(chained(), delimiter=delimiter)
     try:
-        return _read_records(reader, required, source, max_rows, skipped - 1, header_line)
+        return _read_records(reader, required, source, max_rows, skipped - 1, header)
     except csv.Error as exc:
         at = skipped - 1 + reader.line_num
         raise InputError(Phrase(_NOT_CSV.template, source=source, line=at, why=str(exc))) from None
@@ -243,7 +145,7 @@ def _read_records(reader, required, source, max_rows, offset, header_line) -> Ta
     for j, cell in enumerate(raw_header):
         if not cell.strip():
             continue
-        name, unit = _split_header(cell)
+        name, unit = split_header(cell)
         if name in names and name in (*required, *OPTIONAL_COLUMNS):
             raise InputError(Phrase(_TWICE.template, source=source, name=repr(name), header=shown))
         names.setdefault(name, j)
@@ -254,9 +156,7 @@ def _read_records(reader, required, source, max_rows, offset, header_line) -> Ta
         raise InputError(Phrase(_MISSING.template, source=source, name=repr(missing[0]), need=need, header=shown))
     used = [c for c in OPTIONAL_COLUMNS if c in names and c not in required] + list(required)
     idx = [names[c] for c in used]
-    factors = [
-        unit_factor(units[c], _quantity(c), f"{source}: column {shorten(raw_header[names[c]])}", c) for c in used
-    ]
+    factors = [unit_factor(units[c], quantity(c), f"{source}: column {shorten(raw_header[names[c]])}", c) for c in used]
     width = len(raw_header)
     chunks: list[np.ndarray] = []
     buf: list[list[str]] = []
