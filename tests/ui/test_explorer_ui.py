@@ -21,12 +21,14 @@ def _image(view):
     return ex._image if ex._image is not None and ex._image.visible else None
 
 
-def _region_shown(view, client) -> bool:
-    """Whether this tab shows the shared workspace floor: not shadowed, by the server's account and by the
-    messages the tab received."""
+def _region_shown(view, client) -> bool | None:
+    """Whether this tab shows the shared workspace floor (not shadowed), once the server's account and the messages
+    the tab received agree; None while they differ (the message that shadows or unshadows it is on its way: poll
+    with ``wait_for`` until the state wanted, never assert on one read)."""
     name = view.scene.shared.family("region")[0]
     hidden = name in view.scene.hidden()
-    assert hidden == (name in client.shadows())
+    if hidden != (name in client.shadows()):
+        return None
     return view.scene.shared.region.visible and not hidden
 
 
@@ -34,18 +36,19 @@ def test_a_map_is_drawn_on_the_floor_and_replaces_the_plain_workspace(connect):
     client, view = connect()
     other_client, other = connect()
     ex = view.teaching.explorer
-    assert _region_shown(view, client) and _image(view) is None
+    wait_for(lambda: _region_shown(view, client) is True, what="the floor shown in the new tab")
+    assert _image(view) is None
     client.set_value(ex.map_kind, MAP_KINDS["det_jx"])
     wait_for(lambda: _image(view) is not None, what="the map image")
     image = _image(view)
     assert image._data[:4] == b"\x89PNG" and image.render_width == pytest.approx(2 * P.l_a * 200 / 199)
     assert tuple(image.position) == pytest.approx((0.0, 0.0, explorer_module.MAP_Z))
-    wait_for(lambda: not _region_shown(view, client), what="the floor hidden in this tab")
-    assert _region_shown(other, other_client)  # only in this tab
+    wait_for(lambda: _region_shown(view, client) is False, what="the floor hidden in this tab")
+    assert _region_shown(other, other_client) is True  # only in this tab (nothing on its way to the other tab)
     assert "det J_x" in ex.legend.content and "nan" not in ex.legend.content.lower()
     client.set_value(ex.map_kind, MAP_KINDS["off"])
     wait_for(lambda: _image(view) is None, what="the map hidden")
-    wait_for(lambda: _region_shown(view, client), what="the floor back")
+    wait_for(lambda: _region_shown(view, client) is True, what="the floor back")
     client.set_value(ex.map_kind, MAP_KINDS["det_jx"])  # an own copy keeps the floor hidden under the map
     client.set_value(view.panel.own_copy, True)
     wait_for(lambda: view.scene.private is not None and not view.scene.private.region.visible, what="own floor hidden")
