@@ -156,7 +156,15 @@ def _read_records(reader, required, source, max_rows, offset, header_line) -> Ta
         raise InputError(Phrase(_MISSING.template, source=source, name=repr(missing[0]), need=need, header=shown))
     used = [c for c in OPTIONAL_COLUMNS if c in names and c not in required] + list(required)
     idx = [names[c] for c in used]
-    factors = [unit_factor(units[c], quantity(c), f"{source}: column {shorten(raw_header[names[c]])}", c) for c in used]
+    factors = [
+        unit_factor(
+            units[c],
+            quantity(c),
+            Phrase("{source}: column {name}", source=source, name=shorten(raw_header[names[c]])),
+            c,
+        )
+        for c in used
+    ]
     width = len(raw_header)
     chunks: list[np.ndarray] = []
     buf: list[list[str]] = []
