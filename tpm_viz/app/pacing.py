@@ -27,8 +27,11 @@ __all__ = ["Pacer"]
 class Pacer:
     """The interval between two drag commits of one own copy [s], from the time those commits took."""
 
-    budget: float = 0.4
-    """Fraction of the wall time the commits of own copies may take (the rest: the presenter, sending, reading)."""
+    budget: float = 0.2
+    """Fraction of the wall time the commits of own copies may take (the rest: the presenter, sending, reading).
+    Measured with 150 tabs, 30 of them dragging own copies (``bench_load.py --mode hall``, 2 cores): 0.4 gave the
+    watchers p95 205-230 ms and the own copies 335-380 ms; 0.2 gave 134 and 242 ms; 0.1 gave 158 and 289 ms (the
+    copies then wait too long between two commits)."""
     window: float = 0.5
     """Length of a measuring window [s]."""
     start: float = 0.05
