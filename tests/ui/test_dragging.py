@@ -36,7 +36,7 @@ def test_an_own_copy_drag_is_committed_in_the_drag_pool_not_on_the_event_loop(co
 
 
 def test_a_drain_scheduled_for_the_shared_mechanism_stays_its_own_after_the_tab_leaves(connect):
-    (c1, v1), (c2, v2) = connect(), connect()
+    (_c1, v1), (c2, v2) = connect(), connect()
     hub = v1.hub
     shared = v1.session
     with hub.lock:  # a drag queued and its drain scheduled, then the tab switches before the drain runs

@@ -30,6 +30,7 @@ __all__ = [
     "demo",
     "drag",
     "drive",
+    "drive_both",
     "home",
     "move",
     "paper_params",
@@ -41,6 +42,9 @@ MAX_POSITION = 10.0  # m, bound on typed positions (any pose beyond l_a is unrea
 MAX_FORCE = 1e5  # N, bound on typed forces
 MAX_SPEED = 100.0  # m/s
 MAX_ACCEL = 1e5  # m/s²
+STROKE_SLACK = 1e-9
+"""m: a typed actuator position this close to a stroke end is that end (the slack of the interactive moves on the
+stroke, ``app.moves``: a pose may sit that far beyond an end, and its other actuator is typed as it is)."""
 
 
 def _moved(state: AppState, move: Move) -> AppState:
@@ -76,6 +80,17 @@ def drive(state: AppState, i: int, d_mm) -> AppState:
     """Actuator ``i`` (0 or 1) to ``d_mm`` [mm]: forward kinematics in the current assembly mode, clamped."""
     d_req = np.array(state.pose.d, dtype=float)
     d_req[i] = read_number(d_mm, f"d{i + 1}", scale=1e-3, lo=-MAX_POSITION, hi=MAX_POSITION)
+    return _moved(state, drive_to(state.params, state.pose, d_req))
+
+
+def drive_both(state: AppState, d_mm) -> AppState:
+    """Both actuators to ``d_mm`` = (d1, d2) [mm] (a typed pair): forward kinematics in the current assembly mode,
+    clamped like :func:`drive`. A value within :data:`STROKE_SLACK` of a stroke end is that end (the round trip
+    m -> mm -> m of ``d = Δd`` may land an ulp beyond it)."""
+    d_req = read_vec2(d_mm, "actuator positions d", scale=1e-3, bound=MAX_POSITION)
+    stroke = state.params.stroke
+    near = (d_req >= -STROKE_SLACK) & (d_req <= stroke + STROKE_SLACK)
+    d_req = np.where(near, np.clip(d_req, 0.0, stroke), d_req)
     return _moved(state, drive_to(state.params, state.pose, d_req))
 
 

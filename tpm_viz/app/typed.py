@@ -6,7 +6,8 @@ minus, the field's unit after the number). This module is their logic, as plain 
 times, so that it is tested without a browser (``tests/app/test_typed_fields.py``):
 
 - :class:`Quantity`: what one field holds (name, UI unit, SI scale, accepted range): text -> SI value, or one line
-  saying what to change; SI value -> a short text that reads back to it.
+  saying what to change; SI value -> a short text that reads back to it. A length field in mm also reads a length
+  typed in m or cm (``0.15 m`` is 150 mm: :data:`OTHER_UNITS`).
 - :class:`TypedField`: one field's text and the value in use. It is *clean* (its text is the app's, written by
   :meth:`TypedField.show`), *typing* (keystrokes not yet settled: never read for use, never overwritten by the app)
   or *held* (settled but not in use: refused, or waiting for the value it asked for). A held text stays until the
@@ -26,7 +27,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.numbers import parse_number, plausibility
@@ -34,6 +35,7 @@ from tpm_viz.words import Phrase
 
 __all__ = [
     "FORCE_TYPICAL",
+    "OTHER_UNITS",
     "QUIET",
     "SHORT_DURATION",
     "Quantity",
@@ -52,6 +54,10 @@ FORCE_TYPICAL = 200.0
 times larger (2 kN) get a plausibility note."""
 SHORT_DURATION = 0.02
 """Trajectory durations below this [s] get a plausibility note (the forces grow as ``1/T²``)."""
+
+OTHER_UNITS: dict[str, tuple[tuple[str, float], ...]] = {"mm": (("cm", 10.0), ("m", 1e3))}
+"""Units accepted after a number besides the field's own, by the field's unit: (unit, its value in the field's
+unit). A length in mm may be typed in cm or m (``0.15 m``, ``15 cm``: 150 mm)."""
 
 CLEAN, TYPING, HELD = "clean", "typing", "held"
 
@@ -75,9 +81,23 @@ class Quantity:
     hi: float = math.inf
     resolution: float = 1e-9
 
+    def number(self, text: object) -> float:
+        """The number ``text`` spells in the field's unit (the unit may be typed, or one of :data:`OTHER_UNITS`:
+        ``0.15 m`` is 150 in a mm field), not range-checked; else :class:`~tpm_viz.InputError`."""
+        if isinstance(text, str) and not (self.unit and text.strip().endswith(self.unit)):
+            s = text.strip()
+            for unit, factor in OTHER_UNITS.get(self.unit, ()):
+                head = s[: -len(unit)].rstrip() if s.endswith(unit) else ""
+                if head and (head[-1].isdigit() or head[-1] in ".,"):
+                    value = parse_number(head, self.name, self.unit) * factor
+                    if not math.isfinite(value):
+                        raise InputError(Phrase("{name}: {value} is too large", name=self.name, value=s))
+                    return value
+        return parse_number(text, self.name, self.unit)
+
     def read(self, text: object) -> float:
         """The SI value ``text`` spells, else :class:`~tpm_viz.InputError` with one line saying what to change."""
-        value = parse_number(text, self.name, self.unit)
+        value = self.number(text)
         if not self.lo <= value <= self.hi:
             unit = f" {self.unit}" if self.unit else ""
             name, typed, lo, hi = self.name, _compact(value), _compact(self.lo), _compact(self.hi)
@@ -218,6 +238,12 @@ class TypedGroup:
         self.refusal: Phrase | None = None
         """Why the group's last application was refused (shown until a later success, or until no field holds a
         text of its own any more)."""
+
+    def limit(self, lo: float, hi: float) -> None:
+        """Accept values in ``[lo, hi]`` (UI units) in every field from now on (e.g. the stroke changed)."""
+        for f in self.fields.values():
+            if (f.quantity.lo, f.quantity.hi) != (lo, hi):
+                f.quantity = replace(f.quantity, lo=lo, hi=hi)
 
     def typed(self, key: str, text: str, now: float) -> None:
         """A keystroke in field ``key``."""

@@ -63,7 +63,7 @@ every commit for everybody (one broadcast drawing), and the frame where the moti
 
 def _internal_error(view: ClientView, exc: Exception) -> None:
     """The guard's report to the tab whose callback failed (the traceback is in the server log)."""
-    view.refuse(f"internal error ({type(exc).__name__}), logged on the server")
+    view.refuse(Phrase("internal error ({kind}), logged on the server", kind=type(exc).__name__))
 
 
 _callback = control
@@ -205,6 +205,7 @@ class ClientView:
         panel, scene = self.panel, self.scene
         scene.gizmo.on_update(self.drags.on_drag)
         self.typing.add(panel.p, self._apply_p)
+        self.typing.add(panel.d_typed, self._apply_d)
         for name in ("f_ext", "dp", "ddp"):
             self.typing.add(panel.boxes()[name], functools.partial(self._apply_load, name))
         self.typing.add(panel.params, self._apply_params)
@@ -245,6 +246,10 @@ class ClientView:
     def _apply_p(self, values) -> None:
         """The typed platform position (mm), settled (under the lock)."""
         self._commit(transitions.move(self.session.state, (values["p1"], values["p2"])))
+
+    def _apply_d(self, values) -> None:
+        """The typed actuator positions (mm, each already in the stroke), settled (under the lock)."""
+        self._commit(transitions.drive_both(self.session.state, (values["d1"], values["d2"])))
 
     def _apply_load(self, name: str, values) -> None:
         """A typed load vector (``f_ext`` N, ``dp`` m/s, ``ddp`` m/s²), settled (under the lock)."""

@@ -203,7 +203,8 @@ class Waker:
 def _internal_error(owner: Any, exc: Exception) -> None:
     """The guard's report to the tab whose callback failed (the traceback is in the server log)."""
     view = getattr(owner, "view", owner)
-    view.refuse(f"internal error ({type(exc).__name__}), logged on the server", resync=view is owner)
+    what = Phrase("internal error ({kind}), logged on the server", kind=type(exc).__name__)
+    view.refuse(what, resync=view is owner)
 
 
 def control(method: Any = None, *, place: str | None = None) -> Any:

@@ -3,12 +3,16 @@
 No maths here: the numbers come from a :class:`~tpm_viz.app.readouts.Readout`, formatted by :mod:`.text`.
 Units in labels: mm, N, kg, s, degrees (SI inside; the scale factors come from ``PARAM_INFO``).
 
-Typed numbers (the platform position, the load vectors, the parameters) are text fields read through
+Typed numbers (the platform and actuator positions, the load vectors, the parameters) are text fields read through
 :mod:`tpm_viz.app.typed` (:class:`~.fields.TypedBox`: scientific notation and decimal commas, applied on Enter, by
 *Apply* or after a quiet time, never per keystroke; the value in use always shown). Their groups hold values in
 the units of their labels (mm, N, m/s, m/s², kg), as the transitions take them. Refusals and notes are shown next
 to the control that caused them (:class:`~.fields.Note`); the line at the top of the panel is for the others
 (drags, the classroom).
+
+The actuators have both: a slider each, to drive by dragging (a phone's thumb), without viser's number box beside it
+(that box drops the ``e`` of ``1.5e2`` and applies per keystroke: hidden by :func:`slider_css`), and the typed box
+``d1, d2`` under them (:data:`ACTUATOR_HINT`), range-checked against the stroke ``[0, Δd]``.
 """
 
 from __future__ import annotations
@@ -23,12 +27,13 @@ from tpm_viz.app.state import AppState
 from tpm_viz.app.transitions import MAX_ACCEL, MAX_FORCE, MAX_POSITION, MAX_SPEED
 from tpm_viz.app.typed import QUIET, Quantity, TypedField, TypedGroup, force_note
 from tpm_viz.params import PARAM_INFO, Params
+from tpm_viz.ui._viser import widget_uuid
 from tpm_viz.ui.fields import Note, TypedBox
 from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.text import legend_html
 from tpm_viz.words import Lang
 
-__all__ = ["PARAM_LABELS", "Panel"]
+__all__ = ["ACTUATOR_HINT", "ACTUATOR_LABELS", "PARAM_LABELS", "Panel", "slider_css"]
 
 LIVE_DASHBOARD_INTERVAL = 0.25
 """Shortest time [s] between two refreshes of the dashboard, ``p`` and ``d`` on the intermediate frames of a drag or
@@ -77,6 +82,14 @@ VECTORS = {
 labels (the Forces tab: the external load ``f_ext`` on the platform in static mode, its velocity ``ṗ`` and
 acceleration ``p̈`` in dynamic mode)."""
 TYPED_HINT = "Scientific notation (1e-3) and decimal commas (0,5) work; Enter applies (or stop typing for a moment)"
+ACTUATOR_LABELS = {"d1": "d1 (mm)", "d2": "d2 (mm)"}
+"""Labels of the typed actuator positions (the sliders above them are "Actuator d1 (mm)", "Actuator d2 (mm)")."""
+ACTUATOR_HINT = (
+    "Actuator position along its rail, from 0 to the stroke Δd: 1.5e2, 150,5 and 0.15 m work; Enter applies "
+    "(or stop typing for a moment)"
+)
+ACTUATOR_RESOLUTION = 1e-5
+"""mm: an actuator position closer than this to 0 is shown as 0 (a pose may sit 1e-9 m beyond a stroke end)."""
 
 
 def _ui(name: str, value_si: float) -> float:
@@ -93,6 +106,28 @@ def _vector(name: str, values=(0.0, 0.0)) -> TypedGroup:
 def _vector_box(gui, name: str, values=(0.0, 0.0), hint: str = TYPED_HINT) -> TypedBox:
     keys, _unit, _bound, labels = VECTORS[name]
     return TypedBox(gui, _vector(name, values), dict(zip(keys, labels, strict=True)), dict.fromkeys(keys, hint))
+
+
+def _actuators(stroke_mm: float, d_mm) -> TypedGroup:
+    """The typed actuator positions (mm), each in the stroke ``[0, Δd]``, applied on Enter or after :data:`QUIET`."""
+    return TypedGroup(
+        {
+            key: TypedField(Quantity(key, "mm", 1.0, 0.0, stroke_mm, ACTUATOR_RESOLUTION), float(value))
+            for key, value in zip(ACTUATOR_LABELS, d_mm, strict=True)
+        },
+        quiet=QUIET,
+    )
+
+
+def slider_css(handles) -> str:
+    """A style rule that hides viser's number box beside each of these sliders (the slider itself stays): in viser
+    1.1.1 the box is the sibling after the slider's root, whose ``id`` is the handle's uuid."""
+    try:
+        uuids = [widget_uuid(h) for h in handles]
+    except AttributeError:  # a GUI without a page (the tests' stand-in for viser): nothing to hide
+        return ""
+    rules = ", ".join(f'[id="{uuid}"] ~ *' for uuid in uuids)
+    return f"<style>{rules} {{ display: none !important; }}</style>"
 
 
 def _params_group(params: Params) -> TypedGroup:
@@ -130,6 +165,11 @@ class Panel:
                 gui.add_slider(f"Actuator d{i + 1} (mm)", 0.0, stroke_mm, 0.1, 0.0, hint="Forward kinematics")
                 for i in range(2)
             ]
+            self.d_css = gui.add_html(slider_css(self.d))
+            d_mm = [float(x) * 1e3 for x in state.pose.d]
+            self.d_typed = TypedBox(
+                gui, _actuators(stroke_mm, d_mm), ACTUATOR_LABELS, dict.fromkeys(ACTUATOR_LABELS, ACTUATOR_HINT)
+            )
             self.switch_mode = gui.add_button("Switch assembly mode", icon=viser.Icon.SWITCH_HORIZONTAL)
             self.home = gui.add_button("Home (p = 0)", icon=viser.Icon.HOME)
             self.demo = {k: gui.add_button(DEMO_LABELS[k], color="gray") for k in DEMO_KINDS}
@@ -183,8 +223,10 @@ class Panel:
                 slider.max = stroke_mm
             if due:
                 self._put(slider, min(max(round(float(readout.d[i]) * 1e3, 2), 0.0), stroke_mm))
+        self.d_typed.group.limit(0.0, stroke_mm)
         if due:
             self.p.show({"p1": float(readout.p[0]) * 1e3, "p2": float(readout.p[1]) * 1e3})
+            self.d_typed.show({"d1": float(readout.d[0]) * 1e3, "d2": float(readout.d[1]) * 1e3})
         if state.load != self._shown_load:
             self._shown_load = load = state.load
             self._put(self.load_mode, load.mode)
@@ -199,14 +241,21 @@ class Panel:
 
     def draw_notes(self, lang: Lang, now: float | None = None) -> None:
         """Every note of the panel, in ``lang`` (viser gets only the changed ones)."""
-        for box in (self.p, self.f_ext, self.dp, self.ddp, self.params):
+        for box in self.boxes().values():
             box.draw(lang, now)
         for note in (self.move_note, self.forces_note):
             note.draw(lang)
 
     def boxes(self) -> dict[str, TypedBox]:
         """The typed boxes of the panel, by the name of what they hold."""
-        return {"p": self.p, "f_ext": self.f_ext, "dp": self.dp, "ddp": self.ddp, "params": self.params}
+        return {
+            "p": self.p,
+            "d": self.d_typed,
+            "f_ext": self.f_ext,
+            "dp": self.dp,
+            "ddp": self.ddp,
+            "params": self.params,
+        }
 
     def forget(self) -> None:
         """Write every widget again at the next :meth:`show` (after a refused input left the browser's value)."""
