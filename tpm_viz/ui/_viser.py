@@ -15,8 +15,8 @@ tpm-viz needs these things viser's public API does not offer:
   websockets module viser serves with (:data:`ws_server`; :mod:`.limits` replaces the ``ServerProtocol`` it builds per
   connection: viser accepts 50 MiB frames and answers an over-long URL segment with HTTP 500), and viser's decoding of
   incoming messages (:func:`quiet_decoding`); a tab's GUI texts and the values it sends (:func:`reword`);
-- the serialisation of outgoing messages (``Message.as_serializable_dict``), done once per message instead of once
-  per tab it goes to (:func:`share_serialization`).
+- outgoing messages: serialised once for every tab (:func:`share_serialization`), senders woken safely from any
+  thread (``AsyncMessageBuffer``'s event: :func:`safe_wakeups`).
 
 :func:`check_viser` runs when the server is built: the installed viser must be the tested minor version
 (:data:`TESTED`, pinned in ``pyproject.toml``) and every internal above must exist, else the app stops at start with
@@ -30,7 +30,6 @@ import asyncio
 import contextlib
 import copy
 import dataclasses
-import inspect
 import threading
 import uuid
 from collections.abc import Callable, Iterator
@@ -39,32 +38,17 @@ from typing import Any, cast
 import viser
 from viser import _messages
 from viser.infra import _infra
+from viser.infra._async_message_buffer import AsyncMessageBuffer
 
 from tpm_viz.errors import TpmVizError
-from tpm_viz.ui.wire import GuiUpdate, Handshake, Malformed, Upload, Wrapper, message_bytes, renumbered
+from tpm_viz.ui import wire
+from tpm_viz.ui.wire import Malformed
 
-ws_server = _infra.websockets.asyncio.server
-"""websockets' asyncio server, as viser imported it (tpm-viz does not depend on websockets directly)."""
+ws_server = _infra.websockets.asyncio.server  # websockets' server, as viser imported it (not a tpm-viz dependency)
 
-__all__ = [
-    "TESTED",
-    "ClientDoor",
-    "IncompatibleViserError",
-    "Malformed",
-    "ServerDoor",
-    "check_viser",
-    "connection_request",
-    "disable_share_url",
-    "drop_gizmo_echo",
-    "hook_handshakes",
-    "quiet_decoding",
-    "reword",
-    "share_serialization",
-    "thread_pool",
-    "widget_uuid",
-    "widget_value",
-    "ws_server",
-]
+__all__ = ["TESTED", "ClientDoor", "IncompatibleViserError", "Malformed", "ServerDoor", "check_viser"]
+__all__ += ["connection_request", "disable_share_url", "drop_gizmo_echo", "hook_handshakes", "quiet_decoding", "reword"]
+__all__ += ["safe_wakeups", "share_serialization", "thread_pool", "widget_uuid", "widget_value", "ws_server"]
 
 TESTED = "1.1"
 """The viser minor version tpm-viz is tested with (``pyproject.toml`` pins ``viser>=1.1.1,<1.2``)."""
@@ -83,31 +67,17 @@ def check_viser(version: str | None = None) -> None:
     """Raise :class:`IncompatibleViserError` (one line: what to install) unless viser is the tested minor version
     and has every internal this module uses. ``version`` defaults to the installed one (a test passes another)."""
     version = viser.__version__ if version is None else version
-    fix = f"install the tested version: pip install 'viser>={TESTED}.1,<{_next_minor(TESTED)}'"
+    fix = f"install the tested version: pip install 'viser>={TESTED}.1,<{wire.next_minor(TESTED)}'"
     if version.split(".")[:2] != TESTED.split("."):
         raise IncompatibleViserError(f"viser {version} is installed but tpm-viz is tested with viser {TESTED}.x; {fix}")
-    missing = [f"ViserServer.{a}" for a in _SERVER_ATTRS if not _has_attr_or_init(viser.ViserServer, a)]
+    missing = [f"ViserServer.{a}" for a in _SERVER_ATTRS if not wire.has_attr_or_init(viser.ViserServer, a)]
     missing += [f"GuiApi.{m}" for m in _GUI_METHODS if not hasattr(viser.GuiApi, m)]
     missing += [f"_messages.{m}" for m in _MESSAGES if not hasattr(_messages, m)]
-    missing += [f"WebsockServer.{a}" for a in _WEBSOCK_ATTRS if not _has_attr_or_init(viser.infra.WebsockServer, a)]
+    missing += [f"WebsockServer.{a}" for a in _WEBSOCK_ATTRS if not wire.has_attr_or_init(viser.infra.WebsockServer, a)]
     if not hasattr(ws_server, "ServerProtocol"):
         missing.append("websockets.asyncio.server.ServerProtocol")
     if missing:
         raise IncompatibleViserError(f"viser {version} lacks {', '.join(missing)}; {fix}")
-
-
-def _next_minor(minor: str) -> str:
-    return f"{minor.split('.')[0]}.{int(minor.split('.')[1]) + 1}"
-
-
-def _has_attr_or_init(cls: type, name: str) -> bool:
-    """Whether ``cls`` has ``name`` or assigns ``self.name`` in its ``__init__`` (instance attributes)."""
-    if hasattr(cls, name):
-        return True
-    try:
-        return f"self.{name}" in inspect.getsource(cls.__init__)
-    except (OSError, TypeError):
-        return False
 
 
 def thread_pool(server: viser.ViserServer) -> Any:
@@ -144,10 +114,10 @@ class ClientDoor:
     def __init__(self, client: viser.ClientHandle) -> None:
         self._conn = client._websock_connection
         self._gui = client.gui
-        self.gui_update: GuiUpdate = cast(GuiUpdate, self._gui._handle_gui_updates)
+        self.gui_update: wire.GuiUpdate = cast(wire.GuiUpdate, self._gui._handle_gui_updates)
         """viser's own handler of ``GuiUpdateMessage`` (call it to let a message through)."""
-        self.upload_start: Upload = cast(Upload, self._gui._handle_file_transfer_start)
-        self.upload_part: Upload = cast(Upload, self._gui._handle_file_transfer_part)
+        self.upload_start: wire.Upload = cast(wire.Upload, self._gui._handle_file_transfer_start)
+        self.upload_part: wire.Upload = cast(wire.Upload, self._gui._handle_file_transfer_part)
 
     def widget(self, uuid: str) -> Any:
         """The GUI handle with this uuid, or None."""
@@ -167,7 +137,7 @@ class ClientDoor:
         if size is not None:
             self._conn.queue_message(_messages.FileTransferPartAck(button, transfer, size, size))
 
-    def replace(self, gui_update: GuiUpdate, upload_start: Upload, upload_part: Upload) -> None:
+    def replace(self, gui_update: wire.GuiUpdate, upload_start: wire.Upload, upload_part: wire.Upload) -> None:
         """Route this tab's GUI updates and upload messages to the given handlers instead of viser's."""
         pairs: tuple[tuple[Any, Any, Any], ...] = (
             (_messages.GuiUpdateMessage, self.gui_update, gui_update),
@@ -190,7 +160,7 @@ class ServerDoor:
         """The server's event loop (None before it starts)."""
         return cast("asyncio.AbstractEventLoop | None", self._ws._background_event_loop)
 
-    def on_connect(self, cb: Callable[[int], None], wrap: Wrapper) -> None:
+    def on_connect(self, cb: Callable[[int], None], wrap: wire.Wrapper) -> None:
         """Run ``cb(client_id)`` on the event loop for every new websocket connection, before any of its messages
         is handled, and route that connection's messages through ``wrap(dispatch)``."""
 
@@ -214,7 +184,7 @@ class ServerDoor:
 
         self._ws.on_client_disconnect(disconnected)
 
-    def wrap_server_dispatch(self, wrap: Wrapper) -> None:
+    def wrap_server_dispatch(self, wrap: wire.Wrapper) -> None:
         """Route the messages handled at the server level (server-scoped widgets and scene) through ``wrap``."""
         self._ws._handle_incoming_message = wrap(self._ws._handle_incoming_message)
 
@@ -233,7 +203,7 @@ class ServerDoor:
             return len(messages), -1
         transport = connection.transport  # the frame being written (up to one window of 128 messages)
         written = transport.get_write_buffer_size() if transport is not None else 0
-        return len(messages), written + sum(map(message_bytes, messages))
+        return len(messages), written + sum(map(wire.message_bytes, messages))
 
     def notify(self, client_id: int, title: str, body: str) -> None:
         """Show a red notification in that tab (a connection not yet registered as a viser client included)."""
@@ -305,6 +275,36 @@ def quiet_decoding(on_garbage: Callable[[str], object]) -> None:
     _messages.Message._tpm_viz_quiet = True  # type: ignore[attr-defined]
 
 
+def safe_wakeups() -> None:
+    """Make viser's wake-up of its senders safe from other threads (process-wide; before the server is built):
+    ``AsyncMessageBuffer.push`` calls ``asyncio.Event.set()`` on the calling thread, which races the loop adding a
+    waiter ("deque mutated during iteration") and leaves that waiter asleep for good: a tab that stops receiving.
+    Off the loop, ``set`` goes to the loop (once until it ran; not at all if set: the sender reads after clearing)."""
+    if getattr(AsyncMessageBuffer, "_tpm_viz_safe", False):
+        return
+    init = AsyncMessageBuffer.__init__
+
+    def __init__(self: Any, *args: Any, **kwargs: Any) -> None:
+        init(self, *args, **kwargs)
+        event, loop, pending = self.message_event, self.event_loop, [False]
+
+        def run() -> None:
+            pending[0] = False
+            asyncio.Event.set(event)
+
+        def set_() -> None:
+            if asyncio._get_running_loop() is loop:
+                asyncio.Event.set(event)
+            elif not (event.is_set() or pending[0]) and not loop.is_closed():
+                pending[0] = True
+                loop.call_soon_threadsafe(run)
+
+        event.set = set_
+
+    AsyncMessageBuffer.__init__ = __init__  # type: ignore[method-assign]
+    AsyncMessageBuffer._tpm_viz_safe = True  # type: ignore[attr-defined]
+
+
 def share_serialization() -> None:
     """Make each outgoing message's wire dict once, not once per tab (process-wide): a broadcast update reaching 150
     tabs was serialised 150 times (a fifth of the server's time, ``bench_load.py --mode hall --profile``). Queued
@@ -324,7 +324,7 @@ def share_serialization() -> None:
         _, out, start, buffers = cached
         shift = len(binary_buffers) - start
         binary_buffers.extend(buffers)
-        return renumbered(out, shift) if buffers and shift else out
+        return wire.renumbered(out, shift) if buffers and shift else out
 
     _messages.Message.as_serializable_dict = as_serializable_dict  # type: ignore[method-assign]
     _messages.Message._tpm_viz_shared = True  # type: ignore[attr-defined]
@@ -335,7 +335,7 @@ _HANDSHAKE_LOCK = threading.Lock()
 
 
 @contextlib.contextmanager
-def hook_handshakes(hook: Handshake) -> Iterator[None]:
+def hook_handshakes(hook: wire.Handshake) -> Iterator[None]:
     """While a ``ViserServer`` is built inside this block, every HTTP request and websocket handshake of the server
     it starts goes through ``hook`` first (viser passes its page server to websockets' ``serve(process_request=)``;
     ``ViserServer()`` returns once ``serve`` was entered, so the block covers it)."""

@@ -36,7 +36,14 @@ from tpm_viz.app.readouts import Reference
 from tpm_viz.app.state import AppState
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.params import Params
-from tpm_viz.ui._viser import check_viser, disable_share_url, hook_handshakes, share_serialization, thread_pool
+from tpm_viz.ui._viser import (
+    check_viser,
+    disable_share_url,
+    hook_handshakes,
+    safe_wakeups,
+    share_serialization,
+    thread_pool,
+)
 from tpm_viz.ui.classroom import Classroom, Handshakes, local_addresses, qr_text, student_urls
 from tpm_viz.ui.client import ClientView
 from tpm_viz.ui.continuity import Store
@@ -75,6 +82,7 @@ def build_server(host: str = "127.0.0.1", port: int = 8080) -> viser.ViserServer
     Raises :class:`~tpm_viz.ui._viser.IncompatibleViserError` (one line) if the installed viser is not the tested one.
     """
     check_viser()
+    safe_wakeups()  # viser's senders woken safely from the callback threads (before its buffers exist)
     with (
         contextlib.redirect_stdout(io.StringIO()),
         hook_handshakes(Handshakes()),

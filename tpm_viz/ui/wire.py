@@ -3,10 +3,22 @@ for an undecodable message, and small functions on messages. Nothing here touche
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Awaitable, Callable
 from typing import Any
 
-__all__ = ["GuiUpdate", "Handshake", "Incoming", "Malformed", "Upload", "Wrapper", "message_bytes", "renumbered"]
+__all__ = [
+    "GuiUpdate",
+    "Handshake",
+    "Incoming",
+    "Malformed",
+    "Upload",
+    "Wrapper",
+    "has_attr_or_init",
+    "message_bytes",
+    "next_minor",
+    "renumbered",
+]
 
 GuiUpdate = Callable[[Any, Any], Awaitable[None]]
 Upload = Callable[[Any, Any], None]
@@ -49,3 +61,17 @@ def renumbered(value: Any, shift: int) -> Any:
     if isinstance(value, (list, tuple)):
         return type(value)(renumbered(v, shift) for v in value)
     return value
+
+
+def next_minor(minor: str) -> str:
+    return f"{minor.split('.')[0]}.{int(minor.split('.')[1]) + 1}"
+
+
+def has_attr_or_init(cls: type, name: str) -> bool:
+    """Whether ``cls`` has ``name`` or assigns ``self.name`` in its ``__init__`` (instance attributes)."""
+    if hasattr(cls, name):
+        return True
+    try:
+        return f"self.{name}" in inspect.getsource(cls.__init__)
+    except (OSError, TypeError):
+        return False
