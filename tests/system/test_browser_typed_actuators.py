@@ -25,8 +25,10 @@ A = 0.482  # m, the paper's a (Table 1): rail i starts at -a e_i
 PAUSE = 0.08  # s, longer than the client's 50 ms input throttle
 
 
-def _slider1_positions(frames: list[bytes]) -> list[tuple[float, ...]]:
-    """Every position of the broadcast node ``/tpm/slider1`` in the frames the page received, in order."""
+def _slider1_positions(page, frames: list[bytes]) -> list[tuple[float, ...]]:
+    """Every position of the broadcast node ``/tpm/slider1`` in the frames the page received, in order. Playwright's
+    sync API delivers the page's events only while one of its calls runs: a short wait lets the frames in first."""
+    page.wait_for_timeout(20)
     out = []
     for raw in list(frames):
         for m in decode_batch(raw):
@@ -46,8 +48,8 @@ def test_typing_1_5e2_into_d1_puts_the_actuator_at_150_mm(app, browser):
     page.goto(f"http://127.0.0.1:{app.port}/")
     page.wait_for_selector("[data-q=p1]", timeout=20_000)
     view = wait_for(lambda: next(iter(app.views.values()), None), what="the tab's view")
-    wait_for(lambda: _slider1_positions(frames), what="the slider's first position")
-    assert _slider1_positions(frames)[-1][0] == pytest.approx(0.130 - A, abs=1e-12)  # home: d1 = a - b - l_a
+    wait_for(lambda: _slider1_positions(page, frames), what="the slider's first position")
+    assert _slider1_positions(page, frames)[-1][0] == pytest.approx(0.130 - A, abs=1e-12)  # home: d1 = a - b - l_a
 
     # The slider is there to drag, without viser's number box beside it.
     slider = page.locator(f'[id="{view.panel.d[0]._impl.uuid}"]')
@@ -58,13 +60,15 @@ def test_typing_1_5e2_into_d1_puts_the_actuator_at_150_mm(app, browser):
     assert field.input_value() == "130"
     field.click()
     field.press("Control+a")
+    started = time.monotonic()
     page.keyboard.type("1.5e2", delay=60)  # one key at a time, as a person types
     time.sleep(0.3)
-    assert view.session.state.pose.d[0] == pytest.approx(0.13)  # nothing applied mid-typing ("1" is 1 mm)
+    if time.monotonic() - started < 0.8 * QUIET:  # a loaded machine may stall the keys for longer than the quiet
+        assert view.session.state.pose.d[0] == pytest.approx(0.13)  # time: then "1" was a pause (tests/ui checks it)
     field.press("Enter")
     wait_for(lambda: view.session.state.pose.d[0] == 0.15, what="d1 = 150 mm in the server's state")
-    wait_for(lambda: _slider1_positions(frames)[-1][0] == pytest.approx(0.150 - A, abs=1e-12), what="A_1 in 3D")
-    x, y = _slider1_positions(frames)[-1][:2]
+    wait_for(lambda: _slider1_positions(page, frames)[-1][0] == pytest.approx(0.150 - A, abs=1e-12), what="A_1 in 3D")
+    x, y = _slider1_positions(page, frames)[-1][:2]
     assert (x, y) == (pytest.approx(0.15 - A, abs=1e-12), pytest.approx(0.0, abs=1e-12))  # on rail 1, eq. (1)
     wait_for(lambda: page.locator("[data-q=d1]").first.inner_text().startswith("150.0"), what="the readout")
     assert field.input_value() == "1.5e2"  # the text typed stays: it means the value in use
