@@ -67,7 +67,10 @@ def test_a_tab_opens_in_the_language_its_browser_asks_for(classroom_app):
     wait_for(lambda: korean.uuid("파라미터 적용"), what="Korean labels")
     assert sorted(v.lang.value for v in views) == ["en", "ko"]
     assert english.uuid("Apply parameters") and not english.uuid("파라미터 적용")
-    assert {"이동", "힘", "파라미터", "수식"} <= korean.tabs() and "Move" in english.tabs()
+    # the last tab's name may arrive after the button: wait for the whole page, then compare
+    wait_for(lambda: {"이동", "힘", "파라미터", "수식"} <= korean.tabs(), what="the Korean tab names")
+    wait_for(lambda: "Move" in english.tabs(), what="the English tab names")
+    assert not {"이동", "힘"} & english.tabs()
     assert korean.shown("언어")["value"] == "한국어" and english.shown("Language")["value"] == "English"
     load = korean.shown("하중")
     assert load["options"] == ["정적", "동적"] and load["value"] == "정적"
