@@ -32,6 +32,7 @@ import copy
 import dataclasses
 import threading
 import uuid
+import weakref
 from collections.abc import Callable, Iterator
 from typing import Any, cast
 
@@ -42,6 +43,7 @@ from viser.infra._async_message_buffer import AsyncMessageBuffer
 
 from tpm_viz.errors import TpmVizError
 from tpm_viz.ui import wire
+from tpm_viz.ui.wakeups import Wakeups, thread_safe_set
 from tpm_viz.ui.wire import Malformed
 
 ws_server = _infra.websockets.asyncio.server  # websockets' server, as viser imported it (not a tpm-viz dependency)
@@ -276,30 +278,19 @@ def quiet_decoding(on_garbage: Callable[[str], object]) -> None:
 
 
 def safe_wakeups() -> None:
-    """Make viser's wake-up of its senders safe from other threads (process-wide; before the server is built):
-    ``AsyncMessageBuffer.push`` calls ``asyncio.Event.set()`` on the calling thread, which races the loop adding a
-    waiter ("deque mutated during iteration") and leaves that waiter asleep for good: a tab that stops receiving.
-    Off the loop, ``set`` goes to the loop (once until it ran; not at all if set: the sender reads after clearing)."""
+    """Wake viser's senders safely and once per loop turn (process-wide; before the server is built; :mod:`.wakeups`):
+    each ``AsyncMessageBuffer`` sees its loop through one shared :class:`~.wakeups.Wakeups` (its self-pipe writes
+    coalesced), and its message event's ``set`` is safe from the callback threads."""
     if getattr(AsyncMessageBuffer, "_tpm_viz_safe", False):
         return
     init = AsyncMessageBuffer.__init__
+    shared: weakref.WeakKeyDictionary[Any, Wakeups] = weakref.WeakKeyDictionary()
 
     def __init__(self: Any, *args: Any, **kwargs: Any) -> None:
         init(self, *args, **kwargs)
-        event, loop, pending = self.message_event, self.event_loop, [False]
-
-        def run() -> None:
-            pending[0] = False
-            asyncio.Event.set(event)
-
-        def set_() -> None:
-            if asyncio._get_running_loop() is loop:
-                asyncio.Event.set(event)
-            elif not (event.is_set() or pending[0]) and not loop.is_closed():
-                pending[0] = True
-                loop.call_soon_threadsafe(run)
-
-        event.set = set_
+        loop = self.event_loop
+        self.event_loop = shared.get(loop) or shared.setdefault(loop, Wakeups(loop))
+        self.message_event.set = thread_safe_set(self.message_event, self.event_loop)
 
     AsyncMessageBuffer.__init__ = __init__  # type: ignore[method-assign]
     AsyncMessageBuffer._tpm_viz_safe = True  # type: ignore[attr-defined]
