@@ -17,7 +17,8 @@ from tpm_viz import (
 )
 from tpm_viz.app.moves import Pose, drive_to
 from tpm_viz.app.poses import preset_pose
-from tpm_viz.app.readouts import Load, evaluate
+from tpm_viz.app.readouts import Load, evaluate, with_reference
+from tpm_viz.multibody import inverse_dynamics as pinocchio_forces
 from tpm_viz.paper.jacobians import jacobians
 
 P = Params.paper()
@@ -65,6 +66,30 @@ def test_reference_and_difference():
 
     r = evaluate(P, POSE, Load("dynamic", dp=(0.1, 0.1)), reference=reference)
     np.testing.assert_allclose(r.forces.diff, 0.5)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_live_readout_completed_with_the_reference_is_the_full_readout(seed):
+    """Mid-drag the kinematics are computed once (live) and the reference forces added when the numbers are shown:
+    every field equals the readout computed with the reference from the start (Pinocchio as the reference)."""
+    rng = np.random.default_rng(seed)
+    pose = drive_to(P, POSE, rng.uniform(0.02, P.stroke - 0.02, 2)).pose
+    load = Load("dynamic", dp=tuple(rng.normal(0, 0.3, 2)), ddp=tuple(rng.normal(0, 3.0, 2)))
+    live = evaluate(P, pose, load)
+    full = evaluate(P, pose, load, reference=pinocchio_forces)
+    done = with_reference(live, P, pose, load, pinocchio_forces)
+    assert live.forces.tau_ref is None and done.forces.tau_ref is not None
+    np.testing.assert_allclose(done.forces.tau_ref, done.forces.tau, rtol=1e-9, atol=1e-9)  # two models agree
+    for name in ("p", "d", "theta", "other_p"):
+        np.testing.assert_array_equal(getattr(done, name), getattr(full, name))
+    np.testing.assert_array_equal(done.forces.tau_ref, full.forces.tau_ref)
+    assert (done.det_jx, done.cond, done.mode, done.alerts, done.forces.note) == (
+        full.det_jx,
+        full.cond,
+        full.mode,
+        full.alerts,
+        full.forces.note,
+    )
 
 
 def test_reference_errors_become_a_note_not_an_exception():

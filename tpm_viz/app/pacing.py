@@ -20,7 +20,13 @@ import math
 import threading
 from dataclasses import dataclass, field
 
-__all__ = ["Pacer"]
+__all__ = ["BUSY_NUMBERS_INTERVAL", "Pacer"]
+
+BUSY_NUMBERS_INTERVAL = 1.0
+"""While own copies are paced, a dragged copy's numbers (its panel: both dynamic models, the typed boxes) are
+refreshed at most once per this many seconds [s] mid-drag; its mechanism moves at every commit and the numbers are
+always refreshed when the drag ends. The panel was half of such a commit (1.7 of 3.7 ms of CPU, ``bench_load.py
+--mode hall``), and a number that changes four times a second cannot be read during a drag anyway."""
 
 
 @dataclass

@@ -14,6 +14,7 @@ Every number in a :class:`Readout` is finite; what cannot be computed is ``None`
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import NamedTuple, Protocol
@@ -31,6 +32,7 @@ from tpm_viz.params import Params
 from tpm_viz.words import Phrase, T
 
 __all__ = ["LOAD_MODES", "Alert", "Forces", "Load", "Readout", "Reference", "evaluate", "joined", "reason"]
+__all__ += ["with_reference"]
 
 LOAD_MODES = ("static", "dynamic")
 
@@ -183,6 +185,12 @@ def _forces(params: Params, pose: Pose, load: Load, reference: Reference | None)
         if not _finite(tau_ref):
             tau_ref = None
     return Forces(tau, tau_ref, equation, joined(notes))
+
+
+def with_reference(readout: Readout, params: Params, pose: Pose, load: Load, reference: Reference | None) -> Readout:
+    """``readout`` (of ``pose`` under ``load``, computed without a reference) with the reference forces added: the
+    same numbers as :func:`evaluate` with ``reference``, without computing the kinematics again."""
+    return dataclasses.replace(readout, forces=_forces(params, pose, load, reference))
 
 
 def evaluate(

@@ -211,8 +211,9 @@ class Panel:
         dashboard's messages in ``lang``."""
         state, readout = frame.state, frame.readout
         now = time.monotonic()
-        due = not frame.in_drag or now - self._dashboard_at >= LIVE_DASHBOARD_INTERVAL
-        if due:  # mid-drag the numbers are refreshed at most 10 times a second (load: bench_load.py)
+        every = LIVE_DASHBOARD_INTERVAL if frame.numbers_every is None else frame.numbers_every
+        due = not frame.in_drag or now - self._dashboard_at >= every
+        if due:  # mid-drag the numbers are refreshed at most 4 times a second, less on a busy server (bench_load.py)
             self.dashboard.content = frame.dashboard_in(lang)
             self._dashboard_at = now
         if not frame.in_drag or not self.equations.content:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import itertools
 import threading
+import time
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any, Protocol
@@ -27,8 +28,8 @@ import numpy as np
 
 from tpm_viz.app.access import Access
 from tpm_viz.app.inputs import read_number, read_vec2
-from tpm_viz.app.pacing import Pacer
-from tpm_viz.app.readouts import Readout, Reference, evaluate
+from tpm_viz.app.pacing import BUSY_NUMBERS_INTERVAL, Pacer
+from tpm_viz.app.readouts import Readout, Reference, evaluate, with_reference
 from tpm_viz.app.state import AppState
 from tpm_viz.errors import InputError
 from tpm_viz.ui.drags import DragQueue
@@ -139,8 +140,9 @@ class Hub:
         """The :class:`~tpm_viz.ui.snapshot.Snapshot` of ``state`` with the data every view draws, computed and checked
         before anything changes: raises :class:`~tpm_viz.InputError` if a drawn number is not finite."""
         frame = Snapshot(state, self.evaluate(state, live=dragging), in_drag=dragging)
-        if dragging and self.reference is not None:
-            frame.complete_readout = lambda: self.evaluate(state)  # both models, computed when displayed
+        if dragging and self.reference is not None:  # both models, computed when displayed (the kinematics once)
+            live, reference = frame.readout, self.reference
+            frame.complete_readout = lambda: with_reference(live, state.params, state.pose, state.load, reference)
         positions, wxyzs = frame.links
         if not (np.all(np.isfinite(positions)) and np.all(np.isfinite(wxyzs))):
             raise InputError("this pose cannot be drawn (non-finite geometry); the last good state stays")
@@ -183,6 +185,8 @@ class Hub:
             if origin is not None:
                 self.authorize(origin, session)
             frame = self.frame(state, dragging)
+            if dragging and not session.shared and self.pacer.interval(time.monotonic()) > 0:
+                frame.numbers_every = BUSY_NUMBERS_INTERVAL  # a busy server: the mechanism first, numbers later
             session.state, session.frame = state, frame
             self._draw(session, list(session.views), origin, dragging)
 

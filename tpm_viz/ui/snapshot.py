@@ -34,6 +34,9 @@ class Snapshot:
         self.readout = readout
         self.in_drag = in_drag
         """True for the intermediate frames of a gizmo drag (views may skip costly, non-essential parts)."""
+        self.numbers_every: float | None = None
+        """Mid-drag, the shortest time [s] between two refreshes of a panel's numbers, or None: the panel's own
+        (a busy server draws the mechanism at every commit and the numbers less often, :mod:`tpm_viz.app.pacing`)."""
         self.complete_readout: Callable[[], Readout] | None = None
         """For a live frame whose ``readout`` lacks the reference forces: computes the readout with them."""
         self._dashboards: dict[Lang, str] = {}
