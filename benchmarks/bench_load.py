@@ -39,7 +39,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository root: tests.support
 
-from tests.support.protocol import ServerProcess, Tab, machine_busy_seconds
+from tests.support.protocol import ServerProcess, Tab, machine_busy_seconds, stolen_seconds
 
 TOKEN = "bench-presenter-token"
 _HALL_OWN = [30]  # --own (set by main)
@@ -92,12 +92,14 @@ async def _scenario(server: ServerProcess, n: int, mode: str, seconds: float, ra
     rng = random.Random(0)
     profiler = _start_profile(server.pid, seconds)
     cpu0, t0, own0, all0 = server.cpu_seconds(), time.perf_counter(), time.process_time(), machine_busy_seconds()
+    stolen0 = stolen_seconds()
     sends = await asyncio.gather(*(_drag_loop(t, seconds, rate, k, rng) for k, t in enumerate(draggers)))
     if profiler is not None:
         await asyncio.to_thread(profiler.wait, 30)
     await asyncio.sleep(0.5)  # the last updates arrive
     wall, cpu, own_cpu = time.perf_counter() - t0, server.cpu_seconds() - cpu0, time.process_time() - own0
     others = max(0.0, machine_busy_seconds() - all0 - cpu - own_cpu)
+    stolen = stolen_seconds() - stolen0
     own = [x for t in draggers for x in t.latencies]
     watched = [x for t in tabs[1:] for x in t.latencies] if mode == "presenter" else []
     per_tab = []
@@ -113,6 +115,7 @@ async def _scenario(server: ServerProcess, n: int, mode: str, seconds: float, ra
         "cpu": cpu / wall,
         "client_cpu": own_cpu / wall,
         "others": others / wall,
+        "stolen": stolen / wall,
         "own": np.array(own) * 1e3,
         "watched": np.array(watched) * 1e3,
         "rss": server.rss_mb(),
@@ -150,7 +153,7 @@ def _line(r: dict, mode: str) -> str:
         f"  N = {r['n']:>3}   server CPU {100 * r['cpu']:5.1f} %   latency median {np.median(own):6.1f} ms"
         f"   p95 {np.percentile(own, 95):6.1f} ms   max {own.max():6.1f} ms   merged {100 * merged:4.1f} %"
         f"   ({r['sends']} updates, RSS {r['rss']:.0f} MB; CPU of this client {100 * r['client_cpu']:.0f} %,"
-        f" of other processes {100 * r['others']:.0f} %)"
+        f" of other processes {100 * r['others']:.0f} %, stolen by the host {100 * r['stolen']:.0f} %)"
     )
     if mode in ("presenter", "hall") and len(r["watched"]):
         w = r["watched"]
