@@ -37,6 +37,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import dataclasses
+import functools
 import math
 import time
 import types
@@ -161,18 +162,22 @@ def message_problem(message: Any) -> str | None:
     """Why an incoming message does not match its declared field types (None if it does)."""
     if isinstance(message, Malformed):
         return message.problem
-    for name, annotation, finite in _schema(type(message)):
-        problem = _value_problem(getattr(message, name, None), annotation, finite)
+    for name, check in _schema(type(message)):
+        problem = check(getattr(message, name, None))
         if problem is not None:
             return f"{type(message).__name__}.{name}: {problem}"
     return None
 
 
-_SCHEMAS: dict[type, tuple[tuple[str, Any, bool], ...]] = {}
+Check = Callable[[Any], "str | None"]
+"""A field's check: why a value does not match the field's declared type, or None."""
+
+_SCHEMAS: dict[type, tuple[tuple[str, Check], ...]] = {}
 
 
-def _schema(cls: type) -> tuple[tuple[str, Any, bool], ...]:
-    """``(field, annotation, must be finite)`` of a message class (empty if its annotations cannot be read)."""
+def _schema(cls: type) -> tuple[tuple[str, Check], ...]:
+    """``(field, check)`` of a message class, built once per class (empty if its annotations cannot be read): every
+    incoming message is checked on the event loop, 600 a second in a lecture hall (``bench_load.py --mode hall``)."""
     schema = _SCHEMAS.get(cls)
     if schema is None:
         try:
@@ -181,45 +186,71 @@ def _schema(cls: type) -> tuple[tuple[str, Any, bool], ...]:
         except Exception:  # an unknown message shape: viser alone decides
             names, hints = [], {}
         finite = cls.__name__ != "ViewerCameraMessage"  # a browser's camera is never dropped (the tab would not start)
-        schema = _SCHEMAS[cls] = tuple((n, hints[n], finite) for n in names if n in hints and n not in _SKIP)
+        schema = tuple((n, _check(hints[n], finite)) for n in names if n in hints and n not in _SKIP)
+        _SCHEMAS[cls] = schema
     return schema
 
 
-def _value_problem(value: Any, annotation: Any, finite: bool) -> str | None:
+def _ok(value: Any) -> None:
+    return None
+
+
+def _check(annotation: Any, finite: bool) -> Check:
+    """The check of a value against ``annotation`` (numbers finite if ``finite``); nested props and anything else
+    pass (viser's own decoding decides)."""
     origin, args = typing.get_origin(annotation), typing.get_args(annotation)
     if annotation is Any or annotation is object:
-        return None
+        return _ok
     if annotation in (float, int):
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            return f"a number is due, got {type(value).__name__}"
-        if finite and isinstance(value, float) and not math.isfinite(value):
-            return "not a finite number"
-        return None
+        return functools.partial(_number, finite=finite)
     if annotation is bool:
-        return None if isinstance(value, bool) else f"a boolean is due, got {type(value).__name__}"
+        return lambda v: None if isinstance(v, bool) else f"a boolean is due, got {type(v).__name__}"
     if annotation is str:
-        if not isinstance(value, str):
-            return f"text is due, got {type(value).__name__}"
-        return None if len(value) <= _MAX_FIELD_TEXT else "text too long"
+        return _text
     if annotation is bytes:
-        return None if isinstance(value, (bytes, bytearray, memoryview)) else "bytes are due"
+        return lambda v: None if isinstance(v, (bytes, bytearray, memoryview)) else "bytes are due"
     if annotation is type(None):
-        return None if value is None else "None is due"
+        return lambda v: None if v is None else "None is due"
     if origin in (typing.Union, types.UnionType):
-        found = [_value_problem(value, a, finite) for a in args]
-        return None if any(p is None for p in found) else next(p for p in found if p)
+        return functools.partial(_any_of, tuple(_check(a, finite) for a in args))
     if origin is typing.Literal:
-        return None if value in args else "not one of the allowed values"
+        return lambda v: None if v in args else "not one of the allowed values"
     if origin is tuple:
-        if not isinstance(value, (tuple, list)):
-            return f"a sequence is due, got {type(value).__name__}"
-        items = args[:1] * len(value) if len(args) == 2 and args[1] is Ellipsis else args
-        if len(items) != len(value):
-            return f"{len(items)} items are due, got {len(value)}"
-        problems = (_value_problem(v, a, finite) for v, a in zip(value, items, strict=True))
-        return next((p for p in problems if p is not None), None)
+        if len(args) == 2 and args[1] is Ellipsis:
+            return functools.partial(_sequence, None, _check(args[0], finite))
+        return functools.partial(_sequence, tuple(_check(a, finite) for a in args), _ok)
     if origin is dict:
-        return None if isinstance(value, dict) else "a map is due"
+        return lambda v: None if isinstance(v, dict) else "a map is due"
     if origin is list:
-        return None if isinstance(value, (list, tuple)) else "a list is due"
-    return None  # nested props and anything else: viser's own decoding decides
+        return lambda v: None if isinstance(v, (list, tuple)) else "a list is due"
+    return _ok
+
+
+def _number(value: Any, finite: bool) -> str | None:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return f"a number is due, got {type(value).__name__}"
+    if finite and isinstance(value, float) and not math.isfinite(value):
+        return "not a finite number"
+    return None
+
+
+def _text(value: Any) -> str | None:
+    if not isinstance(value, str):
+        return f"text is due, got {type(value).__name__}"
+    return None if len(value) <= _MAX_FIELD_TEXT else "text too long"
+
+
+def _any_of(checks: tuple[Check, ...], value: Any) -> str | None:
+    found = [check(value) for check in checks]
+    return None if any(p is None for p in found) else next(p for p in found if p)
+
+
+def _sequence(items: tuple[Check, ...] | None, each: Check, value: Any) -> str | None:
+    """A fixed tuple (``items``: one check per item) or a variadic one (every item checked with ``each``)."""
+    if not isinstance(value, (tuple, list)):
+        return f"a sequence is due, got {type(value).__name__}"
+    if items is None:
+        return next((p for v in value if (p := each(v)) is not None), None)
+    if len(items) != len(value):
+        return f"{len(items)} items are due, got {len(value)}"
+    return next((p for check, v in zip(items, value, strict=True) if (p := check(v)) is not None), None)
