@@ -8,9 +8,11 @@ import numpy as np
 import pytest
 
 from tpm_viz import Params
+from tpm_viz.app import transitions
 from tpm_viz.app.inputs import read_choice, read_flag, read_number, read_params, read_upload, read_vec2
 from tpm_viz.app.overlays import colour_scale
 from tpm_viz.app.runs import Source, build_run
+from tpm_viz.app.state import AppState
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.numbers import parse_number, unit_factor
 from tpm_viz.paper.trajectories import parse_trajectory_csv
@@ -101,6 +103,41 @@ def test_a_field_named_by_a_phrase_keeps_its_phrase():
     assert str(exc).startswith("a very long name a very long name a very: 'x' is not a number")  # cut at 40
     exc = refused(lambda: read_number("x", T("time t")))
     assert str(exc) == "time t must be a number, got 'x'" and exc.args[0].values["name"] == T("time t")
+
+
+@pytest.mark.parametrize(
+    ("refuse", "english", "korean"),
+    [
+        (lambda s: transitions.move(s, ("a", 1)), "platform position p must be a number, got 'a'", "플랫폼 위치 p"),
+        (lambda s: transitions.drag(s, (1.0,)), "platform position must be two numbers, got [1.0]", "플랫폼 위치"),
+        (
+            lambda s: transitions.drive_both(s, (1, 2, 3)),
+            "actuator positions d must be two numbers, got",
+            "구동기 위치 d",
+        ),
+        (
+            lambda s: transitions.set_load(s, "fast", (0, 0), (0, 0), (0, 0)),
+            "load must be one of static, dynamic, got 'fast'",
+            "하중",
+        ),
+        (
+            lambda s: transitions.set_load(s, "dynamic", (0, 0), ("x", 0), (0, 0)),
+            "platform velocity must be a number",
+            "플랫폼 속도",
+        ),
+        (
+            lambda s: transitions.set_load(s, "dynamic", (0, 0), (0, 0), (1, 2, 3)),
+            "platform acceleration must be two",
+            "플랫폼 가속도",
+        ),
+        (lambda s: transitions.demo(s, "dance"), "demo must be one of", "시연"),
+    ],
+)
+def test_the_widget_a_refusal_names_is_in_the_tabs_language(refuse, english, korean):
+    exc = refused(lambda: refuse(AppState.initial(P)))
+    assert str(exc).startswith(english)
+    text = say(Lang.KO, exc.args[0])
+    assert text.startswith(korean) and not any(w in text for w in ("platform", "actuator", "load", "demo"))
 
 
 def test_the_reference_note_of_a_run_says_why_there_is_no_reference():

@@ -20,6 +20,7 @@ from tpm_viz.app.poses import DEMO_KINDS, go_home, preset_pose, settle
 from tpm_viz.app.readouts import LOAD_MODES, Load
 from tpm_viz.app.state import AppState, TrajectorySample
 from tpm_viz.params import Params
+from tpm_viz.words import T
 
 __all__ = [
     "MAX_ACCEL",
@@ -66,13 +67,13 @@ def drag(state: AppState, position) -> AppState:
         xy = list(position)[:2]
     except TypeError:
         xy = position
-    p_req = read_vec2(xy, "platform position", bound=MAX_POSITION)
+    p_req = read_vec2(xy, T("platform position"), bound=MAX_POSITION)
     return _moved(state, drag_to(state.params, state.pose, p_req))
 
 
 def move(state: AppState, p_mm) -> AppState:
     """The typed platform position ``p`` [mm]: clamped inverse kinematics."""
-    p_req = read_vec2(p_mm, "platform position p", scale=1e-3, bound=MAX_POSITION)
+    p_req = read_vec2(p_mm, T("platform position p"), scale=1e-3, bound=MAX_POSITION)
     return _moved(state, drag_to(state.params, state.pose, p_req))
 
 
@@ -87,7 +88,7 @@ def drive_both(state: AppState, d_mm) -> AppState:
     """Both actuators to ``d_mm`` = (d1, d2) [mm] (a typed pair): forward kinematics in the current assembly mode,
     clamped like :func:`drive`. A value within :data:`STROKE_SLACK` of a stroke end is that end (the round trip
     m -> mm -> m of ``d = Δd`` may land an ulp beyond it)."""
-    d_req = read_vec2(d_mm, "actuator positions d", scale=1e-3, bound=MAX_POSITION)
+    d_req = read_vec2(d_mm, T("actuator positions d"), scale=1e-3, bound=MAX_POSITION)
     stroke = state.params.stroke
     near = (d_req >= -STROKE_SLACK) & (d_req <= stroke + STROKE_SLACK)
     d_req = np.where(near, np.clip(d_req, 0.0, stroke), d_req)
@@ -106,17 +107,17 @@ def home(state: AppState) -> AppState:
 
 def demo(state: AppState, kind) -> AppState:
     """A pose near an inverse singularity, the direct singularity or a stroke end (``DEMO_KINDS``)."""
-    kind = read_choice(kind, "demo", DEMO_KINDS)
+    kind = read_choice(kind, T("demo"), DEMO_KINDS)
     return _moved(state, preset_pose(state.params, kind, near=state.pose))
 
 
 def set_load(state: AppState, mode, f_ext, dp, ddp) -> AppState:
     """The load inputs; the same state object if nothing changed."""
     load = Load(
-        mode=read_choice(mode, "load", LOAD_MODES),
+        mode=read_choice(mode, T("load"), LOAD_MODES),
         f_ext=tuple(read_vec2(f_ext, "f_ext", bound=MAX_FORCE)),
-        dp=tuple(read_vec2(dp, "platform velocity", bound=MAX_SPEED)),
-        ddp=tuple(read_vec2(ddp, "platform acceleration", bound=MAX_ACCEL)),
+        dp=tuple(read_vec2(dp, T("platform velocity"), bound=MAX_SPEED)),
+        ddp=tuple(read_vec2(ddp, T("platform acceleration"), bound=MAX_ACCEL)),
     )
     return state if load == state.load else state.replace(load=load, note="")
 
