@@ -92,3 +92,33 @@ def test_large_axes_keep_three_time_ticks_for_any_run_length(connect, duration):
     for handle in view.teaching.player.charts.handles:
         x = handle.axes[0]
         assert len(x["values"]) >= 3 and x["splits"][0] == 0.0 and x["splits"][-1] <= duration
+
+
+def test_the_control_and_planner_charts_follow_presentation_mode_too(connect):
+    """The *Control* and *Planner* tabs' time charts (ui/teaching/motion.py): large, near-black axes with room for
+    the 18 px labels (the y title, rotated, within the plot in English and Korean, measured with DejaVu Sans), and
+    exactly their usual axes, height and padding again when presentation mode is turned off."""
+    client, view = connect()
+    charts = (*view.teaching.control.charts, *view.teaching.planner.charts)
+    assert len(charts) == 3
+    before = [(c.handle.axes, c.handle.height, c.handle.padding) for c in charts]
+    client.set_value(view.panel.presentation, True)
+    wait_for(lambda: all("font" in a for c in charts for a in c.handle.axes), what="the large axes sent")
+    bold = _font(True)
+    hangul = ImageFont.truetype(font_manager.findfont(font_manager.FontProperties(family="NanumGothic")), SIZE)
+    for chart, (axes0, height0, _padding0) in zip(charts, before, strict=True):
+        x, y = chart.handle.axes
+        for axis in (x, y):
+            assert _px(axis["font"]) >= 16 and axis["labelFont"].startswith("bold")
+            colour = axis["stroke"].lstrip("#")
+            assert max(int(colour[k : k + 2], 16) for k in (0, 2, 4)) < 64
+            assert axis["labelSize"] >= bold.getbbox("Ty")[3]
+            assert axis["ticks"]["size"] == TICK  # uPlot takes the ticks whole: without a size it draws no values
+        assert TICK + GAP + _font(False).getbbox("0,5")[3] <= x["size"]
+        assert y["size"] >= 1.5 * axes0[1]["size"]  # the value labels grow with the font
+        room = chart.handle.height - chart.handle.padding[0] - x["size"]
+        assert bold.getlength(y["label"]) <= room and chart.handle.height > height0
+        assert hangul.getlength("힘 (N)") <= room  # the Korean title of the force charts
+    client.set_value(view.panel.presentation, False)
+    wait_for(lambda: not any("font" in a for c in charts for a in c.handle.axes), what="the usual axes sent")
+    assert [(c.handle.axes, c.handle.height, c.handle.padding) for c in charts] == before

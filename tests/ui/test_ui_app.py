@@ -5,6 +5,7 @@ check that each control changes the right state and the right scene and panel ha
 from __future__ import annotations
 
 import io
+import itertools
 import re
 import socket
 import threading
@@ -386,7 +387,7 @@ def test_a_class_pulling_the_shared_platform_at_once_is_paced_and_the_latest_dra
     assert 2 <= len(commits) < sends  # merged: latest value wins
     # each drain sets the earliest time of the next one (its own start + the interval); a commit can start late
     # (the GIL), so the gaps between commits are not checked, the rule is: no commit before the time the last allowed
-    for (_, allowed), (began, due) in zip(commits, commits[1:], strict=False):
+    for (_, allowed), (began, due) in itertools.pairwise(commits):
         assert began >= allowed - 1e-3
         assert due - began <= dragging.SHARED_DRAG_INTERVAL + 1e-9  # next_at = the drain's start + the interval
     assert len({id(f) for f in drawn}) == len(drawn) <= len(commits)  # one broadcast drawing per commit

@@ -240,7 +240,7 @@ class Look:
         self.view.scene.set_presentation(on)
         teaching = getattr(self.view, "teaching", None)  # None only while the tab is being built
         if teaching is not None:
-            teaching.player.charts.set_presentation(on)
+            teaching.set_presentation(on)
         self.show()
         self.view.frame_camera(self.view.session.state.params)
 

@@ -90,6 +90,7 @@ class ControlView:
         """The payload [kg] and mass error of the last lesson run (to word it again in another language)."""
         self.table: dict[ControllerKind, ControlRun] = {}
         self._table_key: tuple | None = None
+        self.charts: tuple[TimeChart, ...] = ()  # built with the tab
         self._ghost: viser.BoxHandle | None = None
         self._paths: dict[str, viser.LineSegmentsHandle] = {}
         self._last_push = 0.0
@@ -141,6 +142,7 @@ class ControlView:
                 ("τ₂ ff", "#fca5a5", (4.0, 3.0)),
             ),
         )
+        self.charts = (self.error_chart, self.force_chart)
         self.table_html = gui.add_html("")
         self.lesson_text = gui.add_html("")
         self._show_gains()

@@ -11,6 +11,7 @@ new motion. Refusals (presenter mode, a pose that cannot be drawn) raise :class:
 
 from __future__ import annotations
 
+import math
 import threading
 import time
 from collections.abc import Callable
@@ -25,7 +26,7 @@ from tpm_viz.app.state import AppState, TrajectorySample
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.params import Params
 from tpm_viz.ui.guard import report
-from tpm_viz.ui.teaching.charts import marker
+from tpm_viz.ui.teaching.charts import LARGE, NORMAL, TICK_PX, AxisLook, marker
 from tpm_viz.words import Phrase
 
 __all__ = ["FPS", "Motion", "MotionPlayer", "TimeChart"]
@@ -175,6 +176,23 @@ def _series(label: str, colour: str, dash: tuple[float, float] | None = None, sc
     return s
 
 
+def _axes(y_label: str, look: AxisLook) -> tuple[Any, ...]:
+    """The time and value axes of a :class:`TimeChart` in ``look`` (the normal look: uPlot's own, sizes only)."""
+    if look == NORMAL:
+        return {"label": X_LABEL, "size": 40}, {"label": y_label, "size": 62}
+    grow = look.px / NORMAL.px
+    extra: dict[str, Any] = {"labelSize": look.label, **look.style()}
+    if look.colour is not None:
+        extra["ticks"] = {"size": TICK_PX, "stroke": look.colour, "width": look.tick_width}  # all of it, or none
+    x = {"label": X_LABEL, "size": 40 + look.x_axis - NORMAL.x_axis, **extra}
+    return x, {"label": y_label, "size": math.ceil(62 * grow), **extra}
+
+
+def _padding(look: AxisLook) -> tuple[int, int, int, int]:
+    """uPlot's padding of a :class:`TimeChart`: room above the top tick and past the last time label."""
+    return (look.px, math.ceil(1.5 * look.px), 0, 0)
+
+
 class TimeChart:
     """One uPlot chart of series against time, with a time marker; built once, hidden until it has data.
 
@@ -183,6 +201,7 @@ class TimeChart:
 
     def __init__(self, gui: viser.GuiApi, title: str, y_label: str, lines, height: int = 200) -> None:
         self.lines = tuple(lines)
+        self.y_label, self.height, self.look = y_label, height, NORMAL
         n = 2
         zero = np.zeros(n)
         series = [{"label": X_LABEL}, *(_series(*line) for line in self.lines), _series("now", MARKER, None, "c")]
@@ -191,11 +210,11 @@ class TimeChart:
             tuple(series),
             title=title,
             scales={"x": {"time": False}, "c": {"range": (0.0, 1.0)}},
-            axes=({"label": X_LABEL, "size": 40}, {"label": y_label, "size": 62}),
+            axes=_axes(y_label, NORMAL),
             legend={"live": False},
             cursor={"points": {"show": False}},
             height=height,
-            padding=(12, 18, 0, 0),
+            padding=_padding(NORMAL),
             visible=False,
         )
         self._base: tuple[np.ndarray, ...] | None = None
@@ -213,6 +232,17 @@ class TimeChart:
         self._base = (t[i], *(c[i] for c in cols))
         self.mark(None)
         self.handle.visible = True
+
+    def set_presentation(self, on: bool) -> None:
+        """Axes large and dark in presentation mode (:data:`~.charts.LARGE`: 18 px, near-black, like the player's
+        charts), as uPlot draws them otherwise; the chart grows by the room the larger axes take."""
+        look = LARGE if on else NORMAL
+        if look == self.look:
+            return
+        self.look = look
+        self.handle.axes = _axes(self.y_label, look)
+        self.handle.padding = _padding(look)
+        self.handle.height = self.height + (look.x_axis - NORMAL.x_axis) + (look.label - NORMAL.label)
 
     def hide(self) -> None:
         self._base = None

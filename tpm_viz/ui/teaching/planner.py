@@ -112,6 +112,7 @@ class PlannerView:
         self._bars: viser.LineSegmentsHandle | None = None
         self._ticks: viser.LineSegmentsHandle | None = None
         self._last_push = 0.0
+        self.charts: tuple[TimeChart, ...] = ()  # built with the tab
 
     def build(self, gui: viser.GuiApi) -> None:
         """The *Planner* tab's widgets (inside the tab's context)."""
@@ -144,6 +145,7 @@ class PlannerView:
                 ("−F_max", "#64748b", (6.0, 4.0)),
             ),
         )
+        self.charts = (self.chart,)
         self.sizing = gui.add_html("")
         self.industry = gui.add_html(industry_html())
         for handle in (self.path, self.waypoints, self.force, self.speed):

@@ -100,6 +100,12 @@ class Teaching:
         self.control.render(frame)
         self.planner.render(frame)
 
+    def set_presentation(self, on: bool) -> None:
+        """Presentation mode on or off for every chart of the tab (player, control, planner)."""
+        self.player.charts.set_presentation(on)
+        for chart in (*self.control.charts, *self.planner.charts):
+            chart.set_presentation(on)
+
     def words_changed(self) -> None:
         """The tab's language changed: the texts the tabs wrote themselves, again in it (under the hub's lock)."""
         self.player.refresh()
