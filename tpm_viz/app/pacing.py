@@ -33,11 +33,13 @@ always refreshed when the drag ends. The panel was half of such a commit (1.7 of
 class Pacer:
     """The interval between two drag commits of one own copy [s], from the time those commits took."""
 
-    budget: float = 0.2
+    budget: float = 0.1
     """Fraction of the wall time the commits of own copies may take (the rest: the presenter, sending, reading).
-    Measured with 150 tabs, 30 of them dragging own copies (``bench_load.py --mode hall``, 2 cores): 0.4 gave the
-    watchers p95 205-230 ms and the own copies 335-380 ms; 0.2 gave 134 and 242 ms; 0.1 gave 158 and 289 ms (the
-    copies then wait too long between two commits)."""
+    Measured with 150 tabs, 30 of them dragging own copies (``bench_load.py --mode hall``, 2 cores), p95 of the
+    watchers / median tab's p95 of the own copies: with commits of ~3 ms, 0.4 gave 205-230 / 335-380 ms, 0.2 gave
+    134 / 242 ms and 0.1 gave 158 / 289 ms. With the cheaper commits of :data:`BUSY_NUMBERS_INTERVAL` and coalesced
+    wake-ups (~2 ms), 0.1 gave 134-146 / 272-334 ms against 148-193 / 291-382 ms for 0.2 (runs alternated; the
+    server then spends ~85 % of a core whatever the budget: the reading and sending of 150 tabs set it)."""
     window: float = 0.5
     """Length of a measuring window [s]."""
     start: float = 0.05
