@@ -9,7 +9,10 @@ For each N (default 1, 10, 30) a fresh server (``python app.py --port 0``) and N
   updates that the server merged into a later one (latest value wins) have no latency and count as "merged";
 - the server log: lines reporting an exception (should be none);
 - the CPU of this benchmark's own process and of any other process (the machine has 2 cores: a busy neighbour,
-  e.g. a test run, skews the latencies; rerun on a quiet machine).
+  e.g. a test run, skews the latencies; rerun on a quiet machine), and the CPU time the virtual machine's host
+  stole (it runs other machines on our cores: a run with much of it measured the host);
+- hall: of the watchers' and the own copies' latencies, the part in the server (the input sent -> the server
+  encoded the frame carrying the update, from the frame's own timestamp; the rest is sending and the tab).
 
 Scenarios (``--mode``): ``private`` (default: every tab on its own copy, a class working on its own),
 ``presenter`` (presenter mode: one presenter drags the shared mechanism, N-1 tabs watch; the watchers'
@@ -89,6 +92,7 @@ async def _scenario(server: ServerProcess, n: int, mode: str, seconds: float, ra
     await _quiet(server)
     for tab in tabs:
         tab.latencies.clear()
+        tab.in_server.clear()
     rng = random.Random(0)
     profiler = _start_profile(server.pid, seconds)
     cpu0, t0, own0, all0 = server.cpu_seconds(), time.perf_counter(), time.process_time(), machine_busy_seconds()
@@ -103,10 +107,13 @@ async def _scenario(server: ServerProcess, n: int, mode: str, seconds: float, ra
     own = [x for t in draggers for x in t.latencies]
     watched = [x for t in tabs[1:] for x in t.latencies] if mode == "presenter" else []
     per_tab = []
+    split: dict[str, list[float]] = {}  # of the latencies: send -> the server encoded the frame
     if mode == "hall":
         own = list(tabs[0].latencies)  # the presenter's own drag
         watched = [x for t in tabs[len(draggers) :] for x in t.latencies]
         per_tab = [np.percentile(t.latencies, 95) * 1e3 for t in draggers[1:] if t.latencies]
+        split["watchers"] = [x for t in tabs[len(draggers) :] for x in t.in_server]
+        split["own copies"] = [x for t in draggers[1:] for x in t.in_server]
     for tab in tabs:
         await tab.close()
     return {
@@ -120,6 +127,7 @@ async def _scenario(server: ServerProcess, n: int, mode: str, seconds: float, ra
         "watched": np.array(watched) * 1e3,
         "rss": server.rss_mb(),
         "per_tab": per_tab,
+        "split": {k: np.array(v) * 1e3 for k, v in split.items() if v},
     }
 
 
@@ -163,6 +171,11 @@ def _line(r: dict, mode: str) -> str:
         text += (
             f"\n           {len(p)} own copies: p95 per tab median {np.median(p):6.1f} ms, worst {p.max():6.1f} ms"
             f", {int((p > 150).sum())} tab(s) over 150 ms"
+        )
+    for who, part in r.get("split", {}).items():  # where the time goes: the rest is sending, the network, the tab
+        text += (
+            f"\n           {who}: in the server (input sent -> update encoded) median {np.median(part):6.1f} ms"
+            f"   p95 {np.percentile(part, 95):6.1f} ms"
         )
     return text
 

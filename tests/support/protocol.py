@@ -126,11 +126,18 @@ _encode = msgspec.msgpack.encode
 
 def decode_batch(raw: bytes) -> list[dict]:
     """The messages of one server -> client websocket frame."""
+    return decode_frame(raw)[0]
+
+
+def decode_frame(raw: bytes) -> tuple[list[dict], float | None]:
+    """The messages of one server -> client websocket frame and the server's ``time.perf_counter()`` when it encoded
+    them (on Linux the same clock in every process of the machine)."""
     size, compressed = int.from_bytes(raw[:8], "little"), int.from_bytes(raw[8:16], "little")
     if not hasattr(_local, "zstd"):
         _local.zstd = zstandard.ZstdDecompressor()
     inner = _local.zstd.decompress(raw[16 : 16 + compressed], max_output_size=size)
-    return msgspec.msgpack.decode(inner)["messages"]
+    frame = msgspec.msgpack.decode(inner)
+    return frame["messages"], frame.get("timestampSec")
 
 
 def key(x: float, y: float) -> tuple[int, int]:
@@ -150,6 +157,7 @@ class Tab:
         self.watch: dict[tuple[int, int], float] | None = None  # another tab's ``log``: this tab times its sends
         self._seen: set[tuple[int, int]] = set()
         self.latencies: list[float] = []
+        self.in_server: list[float] = []  # of each latency: send -> the server encoded the frame (same order)
         self.received = 0
         self.ready = asyncio.Event()
         self.ws = None
@@ -175,15 +183,18 @@ class Tab:
             async for raw in self.ws:
                 now = time.perf_counter()
                 self.received += 1
-                for m in decode_batch(raw):
+                messages, encoded = decode_frame(raw)
+                for m in messages:
                     kind = m["type"]
                     if kind == "SetPositionMessage" and m["name"] in PLATFORM_NODES and m["owner"] in (self.owner, ""):
                         k = key(m["position"][0], m["position"][1])
-                        if k in self.sent:
-                            self.latencies.append(now - self.sent.pop(k))
-                        elif self.watch is not None and k in self.watch and k not in self._seen:
+                        sent = self.sent.pop(k, None)
+                        if sent is None and self.watch is not None and k in self.watch and k not in self._seen:
                             self._seen.add(k)
-                            self.latencies.append(now - self.watch[k])
+                            sent = self.watch[k]
+                        if sent is not None:
+                            self.latencies.append(now - sent)
+                            self.in_server.append((encoded if encoded is not None else now) - sent)
                     elif kind == "TransformControlsMessage" and m["name"] == "/gizmo":
                         self.owner = m["owner"]
                     elif kind.startswith("Gui") and "uuid" in m and isinstance(m.get("props"), dict):
