@@ -2,12 +2,13 @@
 
 1. Server side, one drag update: clamped inverse kinematics, both dynamic models (closed form and Pinocchio),
    the scene and panel push and the flush, exactly as a gizmo event runs it (``Dragging.drain``),
-   with 1, 10 and 30 tabs on the shared mechanism (protocol-level clients).
+   with 1, 10 and 30 tabs on the shared mechanism (protocol-level clients), and one tab on its own copy.
 2. End to end in headless Chromium: from a browser input to the scene update arriving in the page (decoded by
    viser's websocket worker), for a gizmo drag with the real mouse and for a typed actuator position.
 3. Start-up: ``python app.py --port 0`` to the first line, and to a served page (HTTP 200 on ``/``).
 
-Run: ``python benchmarks/bench_ui.py`` (add ``--quick`` for fewer samples). Needs /usr/bin/chromium for part 2.
+Run: ``python benchmarks/bench_ui.py`` (add ``--quick`` for fewer samples, ``--server-only`` for part 1). Needs
+/usr/bin/chromium for part 2.
 """
 
 from __future__ import annotations
@@ -64,6 +65,19 @@ def bench_server(samples: int) -> None:
             view.drags.drain()
             times.append(time.perf_counter() - t0)
         _stats(f"{tabs} tab(s) on the shared mechanism", times)
+        if tabs == 1:  # the same tab on its own copy (a student's drag: its scene, panel and teaching layer)
+            with app.hub.lock:
+                view.switch(True)
+            times = []
+            for k in range(samples):
+                angle = 2 * np.pi * k / samples
+                target = np.array([0.09 * np.cos(angle), 0.09 * np.sin(angle), 0.09])
+                view.session.drags.push(view, PendingDrag("update", target, next(app.hub.arrivals)))
+                t0 = time.perf_counter()
+                view.drags.drain()
+                times.append(time.perf_counter() - t0)
+                time.sleep(0.002)  # a browser's next event comes later: the loop sends in between
+            _stats("1 tab on its own copy", times)
         for c in clients:
             c.close()
         app.stop()
@@ -207,11 +221,13 @@ def bench_startup(runs: int) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer samples")
+    parser.add_argument("--server-only", action="store_true", help="part 1 only (no browser, no start-up)")
     args = parser.parse_args()
     n = 100 if args.quick else 500
     bench_server(n)
-    bench_browser(60 if args.quick else 200)
-    bench_startup(3 if args.quick else 5)
+    if not args.server_only:
+        bench_browser(60 if args.quick else 200)
+        bench_startup(3 if args.quick else 5)
     print(f"({statistics.__name__} of {os.cpu_count()} CPU(s); python {sys.version.split()[0]})")
 
 

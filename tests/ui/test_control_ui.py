@@ -44,7 +44,8 @@ def test_simulate_shows_the_run_its_charts_and_its_row_equal_to_the_library(conn
     client.set_value(cv.wn, 15.0)
     client.set_value(cv.payload, 0.5)
     wait_for(lambda: cv.wn.value == 15.0 and cv.payload.value == 0.5, what="the sliders")
-    assert "K_p = ω² = <span data-q='kp'>8883</span>" in cv.gains.content  # (2π 15)² = 8882.6
+    # viser stores a value when it arrives and runs the callback later, in its pool: wait for the gains it writes
+    wait_for(lambda: "K_p = ω² = <span data-q='kp'>8883</span>" in cv.gains.content, what="K_p")  # (2π 15)² = 8882.6
     client.click(cv.simulate)
     _simulated(view)
     expected = simulate(P, "line", ControlSetup(controller="ctc", gains=Gains(15.0, 1.0), payload=0.5))
