@@ -14,12 +14,11 @@ from __future__ import annotations
 
 import os
 import tempfile
-import time
 
 import pytest
 
 from tests.support.protocol import wait_for
-from tests.system.test_browser_charts import PAUSE, _check_chart
+from tests.system.test_browser_charts import _check_chart, open_with_a_run
 from tpm_viz.ui.teaching.charts import FORCES, KINEMATICS
 from tpm_viz.words import Lang
 
@@ -85,19 +84,8 @@ def _check_all(page, charts, where: str) -> None:
 def test_presentation_mode_draws_the_chart_axes_large_and_dark_and_whole(app, browser):
     shots = tempfile.mkdtemp(prefix="tpm-viz-chart-presentation-")
     print(f"screenshots in {shots}")
-    page = browser.new_page()
-    page.set_viewport_size({"width": 1024, "height": 768})
-    errors: list[str] = []
-    page.on("pageerror", lambda exc: errors.append(str(exc)))
-    page.goto(f"http://127.0.0.1:{app.port}/")
-    page.wait_for_selector("[data-q=p1]", timeout=30_000)
-    view = wait_for(lambda: next(iter(app.views.values()), None), what="the tab's view")
+    page, errors, view = open_with_a_run(app, browser)
     charts = view.teaching.player.charts
-    page.get_by_role("tab", name="Player").click()
-    page.locator(f'[id="{view.teaching.player.choice._impl.uuid}"]').click()
-    page.get_by_role("option", name="circle (Fig. 5)", exact=True).click()
-    time.sleep(PAUSE)
-    wait_for(lambda: charts.forces.visible and charts.forces.data[0][-1] == 0.5, what="the run")
 
     normal = _fonts(page, charts, None, 13.0)  # before: uPlot's 12 px in viser's grey
     assert {a["tick"] for a in normal} == {12.0} and {a["title"] for a in normal} == {12.0}

@@ -102,8 +102,9 @@ def _check_chart(handle, page, y_label, where: str) -> None:
     assert m["title"] is None or m["title"]["scroll"] <= m["title"]["client"] + 1, where
 
 
-def test_chart_axes_are_whole_on_a_laptop_and_on_a_phone(app, browser):
-    y_labels = [FORCES[1], *(label for _attr, _title, label, _scale in KINEMATICS)]
+def open_with_a_run(app, browser):
+    """A 1024x768 page on ``app`` that loaded the circle of Fig. 5 (0.5 s) through the real UI: ``(page, the page's
+    errors, the tab's view)``."""
     page = browser.new_page()
     page.set_viewport_size({"width": 1024, "height": 768})
     errors: list[str] = []
@@ -111,12 +112,19 @@ def test_chart_axes_are_whole_on_a_laptop_and_on_a_phone(app, browser):
     page.goto(f"http://127.0.0.1:{app.port}/")
     page.wait_for_selector("[data-q=p1]", timeout=30_000)
     view = wait_for(lambda: next(iter(app.views.values()), None), what="the tab's view")
-    player = view.teaching.player
+    charts = view.teaching.player.charts
     page.get_by_role("tab", name="Player").click()
-    page.locator(f'[id="{player.choice._impl.uuid}"]').click()  # the real UI for the first run
+    page.locator(f'[id="{view.teaching.player.choice._impl.uuid}"]').click()
     page.get_by_role("option", name="circle (Fig. 5)", exact=True).click()
     time.sleep(PAUSE)
-    wait_for(lambda: player.charts.forces.visible and player.charts.forces.data[0][-1] == 0.5, what="the run")
+    wait_for(lambda: charts.forces.visible and charts.forces.data[0][-1] == 0.5, what="the run")
+    return page, errors, view
+
+
+def test_chart_axes_are_whole_on_a_laptop_and_on_a_phone(app, browser):
+    y_labels = [FORCES[1], *(label for _attr, _title, label, _scale in KINEMATICS)]
+    page, errors, view = open_with_a_run(app, browser)
+    player = view.teaching.player
     runs = app.services.runs
     for size in ({"width": 1024, "height": 768}, {"width": 390, "height": 844}, {"width": 320, "height": 568}):
         page.set_viewport_size(size)
