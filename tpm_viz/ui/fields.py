@@ -125,9 +125,14 @@ class TypedBox:
         return {key: handle.value for key, handle in self.inputs.items()}
 
     def show(self, values: Mapping[str, float], force: bool = False) -> None:
-        """The values in use (by key): written into the fields that show them (see ``TypedGroup.show``)."""
+        """The values in use (by key): written into the fields that show them (see ``TypedGroup.show``). A keystroke
+        viser has stored but the tab's callback has not seen yet (the field's text is not the group's) is never
+        written over, unless ``force``: the callback takes it next (another tab's move in between must not)."""
+        arrived = {key: self.inputs[key].value for key in values}
+        known = {key: self.group.fields[key].text for key in values}
         for key, text in self.group.show(values, force).items():
-            self.inputs[key].value = text
+            if force or arrived[key] == known[key]:
+                self.inputs[key].value = text
 
     def tell(self, what: Phrase | str | BaseException | None, lang: Lang) -> None:
         """The group's values were refused as a whole (``what``), or accepted (None)."""

@@ -133,7 +133,8 @@ class Hub:
     def evaluate(self, state: AppState, live: bool = False) -> Readout:
         """All numbers for ``state``: closed form and reference (Pinocchio) forces. ``live`` (an intermediate frame
         of a drag or a playback) leaves the reference out: :meth:`frame` adds it lazily, for the dashboards that
-        are actually redrawn (at most 10 Hz mid-drag), so every displayed force has both numbers beside it."""
+        are actually redrawn (4 Hz mid-drag, once a second on a busy server), so every displayed force has both
+        numbers beside it."""
         return evaluate(state.params, state.pose, state.load, None if live else self.reference)
 
     def frame(self, state: AppState, dragging: bool = False):
