@@ -7,7 +7,8 @@ from __future__ import annotations
 import re
 
 from tests.support.protocol import wait_for
-from tpm_viz.words import Lang
+from tpm_viz.ui.text import LEGEND
+from tpm_viz.words import Lang, catalogue
 
 HANGUL = re.compile("[\uac00-\ud7a3]")
 
@@ -77,3 +78,15 @@ def test_the_explorer_legend_follows_the_language(connect):
     assert "J의 조건수 (로그 눈금)" in ev.legend.content and "100" in ev.legend.content
     _switch(view, Lang.EN)
     assert "condition number of J (log scale)" in ev.legend.content
+
+
+def test_the_scene_labels_are_symbols_and_the_legend_says_what_they_mean_in_both_languages(connect):
+    """The 3D labels are drawn once for every tab (broadcast), so they carry no words a Korean tab would read in
+    English; the legend, a per-tab text, names P′ in each language."""
+    _client, view = connect()
+    texts = sorted(label.text for label in view.hub.shared.scene.labels)
+    assert texts == sorted(["O", "A₁", "A₂", "B₁", "B₂", "P", "P′"])
+    entry = next(text for _colour, text in LEGEND if "P′" in text)
+    assert "other assembly mode" in entry
+    korean = catalogue(Lang.KO)[entry]
+    assert "P′" in korean and "조립 모드" in korean

@@ -103,7 +103,8 @@ class MechanismScene:
             self.labels.append(scene.add_label(f"{r}/platform/label_B{i + 1}", f"B{'₁₂'[i]}", anchor="bottom-right"))
         self.label_p = scene.add_label(f"{r}/platform/label_P", "P", anchor="bottom-left")
         self.labels.append(self.label_p)
-        self.ghost_label = scene.add_label(f"{r}/ghost/label", "P′ (other assembly mode)", anchor="center-center")
+        # symbols only: the scene is drawn once for every tab, whatever its language (the legend says what P′ is)
+        self.ghost_label = scene.add_label(f"{r}/ghost/label", "P′", anchor="center-center")
         self.labels.append(self.ghost_label)
         self.forces = [
             scene.add_arrows(
