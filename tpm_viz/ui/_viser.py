@@ -16,7 +16,8 @@ tpm-viz needs these things viser's public API does not offer:
   connection: viser accepts 50 MiB frames and answers an over-long URL segment with HTTP 500), and viser's decoding of
   incoming messages (:func:`quiet_decoding`); a tab's GUI texts and the values it sends (:func:`reword`);
 - outgoing messages: serialised once for every tab (:func:`share_serialization`), senders woken safely from any
-  thread (``AsyncMessageBuffer``'s event: :func:`safe_wakeups`).
+  thread (``AsyncMessageBuffer``'s event: :func:`safe_wakeups`), windows sent with less work per tab (viser's
+  ``_message_producer`` and ``AsyncMessageBuffer._window_loop``: :func:`lean_senders`).
 
 :func:`check_viser` runs when the server is built: the installed viser must be the tested minor version
 (:data:`TESTED`, pinned in ``pyproject.toml``) and every internal above must exist, else the app stops at start with
@@ -44,12 +45,14 @@ from viser.infra._async_message_buffer import AsyncMessageBuffer
 from tpm_viz.errors import TpmVizError
 from tpm_viz.ui import wire
 from tpm_viz.ui.wakeups import Wakeups, thread_safe_set
+from tpm_viz.ui.windows import Frames, Tick, encoder, producer, window_loop
 from tpm_viz.ui.wire import Malformed
 
 ws_server = _infra.websockets.asyncio.server  # websockets' server, as viser imported it (not a tpm-viz dependency)
 
 __all__ = ["TESTED", "ClientDoor", "IncompatibleViserError", "Malformed", "ServerDoor", "check_viser"]
-__all__ += ["connection_request", "disable_share_url", "drop_gizmo_echo", "hook_handshakes", "quiet_decoding", "reword"]
+__all__ += ["connection_request", "disable_share_url", "drop_gizmo_echo", "hook_handshakes", "lean_senders"]
+__all__ += ["quiet_decoding", "reword"]
 __all__ += ["safe_wakeups", "share_serialization", "thread_pool", "widget_uuid", "widget_value", "ws_server"]
 
 TESTED = "1.1"
@@ -76,6 +79,10 @@ def check_viser(version: str | None = None) -> None:
     missing += [f"GuiApi.{m}" for m in _GUI_METHODS if not hasattr(viser.GuiApi, m)]
     missing += [f"_messages.{m}" for m in _MESSAGES if not hasattr(_messages, m)]
     missing += [f"WebsockServer.{a}" for a in _WEBSOCK_ATTRS if not wire.has_attr_or_init(viser.infra.WebsockServer, a)]
+    missing += [
+        f"viser.infra._infra.{f}" for f in ("_message_producer", "_append_aligned_buffers") if not hasattr(_infra, f)
+    ]
+    missing += [] if hasattr(AsyncMessageBuffer, "_window_loop") else ["AsyncMessageBuffer._window_loop"]
     if not hasattr(ws_server, "ServerProtocol"):
         missing.append("websockets.asyncio.server.ServerProtocol")
     if missing:
@@ -233,6 +240,7 @@ class ServerDoor:
 
 _DESERIALIZE = _messages.Message.deserialize.__func__  # type: ignore[attr-defined]
 _SERIALIZE = _messages.Message.as_serializable_dict
+_WINDOW_LOOP = AsyncMessageBuffer._window_loop  # viser's own (tests compare :mod:`.windows` with it)
 _BIG_MESSAGE = 64 << 10
 """Incoming messages larger than this [bytes] must be upload parts (nothing else a browser sends is that big): a
 big map or list in any other message would hold the event loop while it is decoded."""
@@ -296,6 +304,26 @@ def safe_wakeups() -> None:
     AsyncMessageBuffer._tpm_viz_safe = True  # type: ignore[attr-defined]
 
 
+def lean_senders() -> None:
+    """Send the tabs their windows with less work per tab (process-wide, once, before the server is built;
+    :mod:`.windows`): a window of the shared buffer encoded once for every tab, one pause timer per buffer."""
+    if getattr(AsyncMessageBuffer, "_tpm_viz_lean", False):
+        return
+    init, zstd = AsyncMessageBuffer.__init__, _infra.zstandard.ZstdCompressor(level=1)  # used on the loop only
+    encode = encoder(_infra.msgspec.msgpack.encode, zstd.compress, _infra._append_aligned_buffers)
+
+    def __init__(self: Any, *args: Any, **kwargs: Any) -> None:
+        init(self, *args, **kwargs)
+        self.tick, self.frames = Tick(self.event_loop, self.window_duration_sec), Frames(encode)
+        flush_set = self.flush_event.set
+        self.flush_event.set = lambda: (flush_set(), self.tick.flushed())[0]
+
+    AsyncMessageBuffer.__init__ = __init__  # type: ignore[method-assign]
+    AsyncMessageBuffer._window_loop = window_loop  # type: ignore[assignment,method-assign]
+    _infra._message_producer = producer(encode)
+    AsyncMessageBuffer._tpm_viz_lean = True  # type: ignore[attr-defined]
+
+
 def share_serialization() -> None:
     """Make each outgoing message's wire dict once, not once per tab (process-wide): a broadcast update reaching 150
     tabs was serialised 150 times (a fifth of the server's time, ``bench_load.py --mode hall --profile``). Queued
@@ -304,20 +332,7 @@ def share_serialization() -> None:
     if getattr(_messages.Message, "_tpm_viz_shared", False):
         return
 
-    def as_serializable_dict(self: Any, binary_buffers: list | None = None) -> dict[str, Any]:
-        cached = self.__dict__.get("_tpm_viz_wire")
-        if binary_buffers is None or cached is None or cached[0] != id(self):
-            start = 0 if binary_buffers is None else len(binary_buffers)
-            out = _SERIALIZE(self, binary_buffers)
-            if binary_buffers is not None:
-                self.__dict__["_tpm_viz_wire"] = (id(self), out, start, tuple(binary_buffers[start:]))
-            return out
-        _, out, start, buffers = cached
-        shift = len(binary_buffers) - start
-        binary_buffers.extend(buffers)
-        return wire.renumbered(out, shift) if buffers and shift else out
-
-    _messages.Message.as_serializable_dict = as_serializable_dict  # type: ignore[method-assign]
+    _messages.Message.as_serializable_dict = wire.shared_serializer(_SERIALIZE)  # type: ignore[method-assign]
     _messages.Message._tpm_viz_shared = True  # type: ignore[attr-defined]
 
 
@@ -332,17 +347,7 @@ def hook_handshakes(hook: wire.Handshake) -> Iterator[None]:
     ``ViserServer()`` returns once ``serve`` was entered, so the block covers it)."""
     with _HANDSHAKE_LOCK:
         original = ws_server.serve
-
-        def serve(*args: Any, **kwargs: Any) -> Any:
-            inner = kwargs.get("process_request")
-
-            def process_request(connection: Any, request: Any) -> Any:
-                return hook(connection, request, lambda: None if inner is None else inner(connection, request))
-
-            kwargs["process_request"] = process_request
-            return original(*args, **kwargs)
-
-        ws_server.serve = serve  # type: ignore[assignment]
+        ws_server.serve = wire.hooked_serve(original, hook)  # type: ignore[assignment]
         try:
             yield
         finally:

@@ -40,6 +40,7 @@ from tpm_viz.ui._viser import (
     check_viser,
     disable_share_url,
     hook_handshakes,
+    lean_senders,
     safe_wakeups,
     share_serialization,
     thread_pool,
@@ -83,6 +84,7 @@ def build_server(host: str = "127.0.0.1", port: int = 8080) -> viser.ViserServer
     """
     check_viser()
     safe_wakeups()  # viser's senders woken safely from the callback threads (before its buffers exist)
+    lean_senders()  # a shared window encoded once for every tab, one pause timer per buffer
     with (
         contextlib.redirect_stdout(io.StringIO()),
         hook_handshakes(Handshakes()),

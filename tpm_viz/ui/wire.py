@@ -15,9 +15,11 @@ __all__ = [
     "Upload",
     "Wrapper",
     "has_attr_or_init",
+    "hooked_serve",
     "message_bytes",
     "next_minor",
     "renumbered",
+    "shared_serializer",
 ]
 
 GuiUpdate = Callable[[Any, Any], Awaitable[None]]
@@ -75,3 +77,40 @@ def has_attr_or_init(cls: type, name: str) -> bool:
         return f"self.{name}" in inspect.getsource(cls.__init__)
     except (OSError, TypeError):
         return False
+
+
+def shared_serializer(serialize: Callable[..., dict[str, Any]]) -> Callable[..., dict[str, Any]]:
+    """viser's ``Message.as_serializable_dict`` that makes a message's wire dict once for every tab (``serialize``:
+    viser's own): the first call with a list of array buffers keeps the dict and the buffers it added in the
+    message; a later call (another tab's window) appends the same buffers and renumbers their placeholders."""
+
+    def as_serializable_dict(self: Any, binary_buffers: list | None = None) -> dict[str, Any]:
+        cached = self.__dict__.get("_tpm_viz_wire")
+        if binary_buffers is None or cached is None or cached[0] != id(self):
+            start = 0 if binary_buffers is None else len(binary_buffers)
+            out = serialize(self, binary_buffers)
+            if binary_buffers is not None:
+                self.__dict__["_tpm_viz_wire"] = (id(self), out, start, tuple(binary_buffers[start:]))
+            return out
+        _, out, start, buffers = cached
+        shift = len(binary_buffers) - start
+        binary_buffers.extend(buffers)
+        return renumbered(out, shift) if buffers and shift else out
+
+    return as_serializable_dict
+
+
+def hooked_serve(serve: Callable[..., Any], hook: Handshake) -> Callable[..., Any]:
+    """websockets' ``serve`` that passes every HTTP request and websocket handshake through ``hook`` first (before
+    the ``process_request`` it is given: viser's page server)."""
+
+    def hooked(*args: Any, **kwargs: Any) -> Any:
+        inner = kwargs.get("process_request")
+
+        def process_request(connection: Any, request: Any) -> Any:
+            return hook(connection, request, lambda: None if inner is None else inner(connection, request))
+
+        kwargs["process_request"] = process_request
+        return serve(*args, **kwargs)
+
+    return hooked
