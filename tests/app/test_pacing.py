@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tpm_viz.app.pacing import Pacer
+from tpm_viz.app.pacing import WATCH_INTERVAL, WATCH_TABS, Pacer, watch_phase, watch_slot
 
 
 def _simulate(pacer: Pacer, students: int, cost: float, seconds: float, rate: float = 20.0) -> list[float]:
@@ -66,3 +66,39 @@ def test_the_pacing_ends_when_the_class_stops_dragging():
         pacer.spent(0.0, 5.0 + 0.6 * (k + 1))
     assert pacer.interval(9.0) == 0.0
     assert math.isclose(pacer.load(9.0), 0.0, abs_tol=1e-12)
+
+
+def _watch(tabs: int, seconds: float = 8.0, rate: float = 20.0) -> tuple[list[int], list[int]]:
+    """A drag committed at ``rate`` Hz, watched by ``tabs`` tabs (phases of tabs numbered 0..tabs-1, as they joined):
+    returns how many tabs draw at each commit and how many times each tab drew."""
+    phases = [watch_phase(k) for k in range(tabs)]
+    slots: list[int | None] = [None] * tabs
+    per_commit, per_tab = [], [0] * tabs
+    for n in range(int(seconds * rate)):
+        now = 1000.0 + (n + 0.5) / rate  # commits mid-way between slot edges of phase 0 (no rounding luck)
+        drawn = 0
+        for k in range(tabs):
+            slot = watch_slot(now, tabs, phases[k])
+            if slot != slots[k]:
+                slots[k], drawn, per_tab[k] = slot, drawn + 1, per_tab[k] + (n > 0)
+        per_commit.append(drawn)
+    return per_commit[1:], per_tab  # not the first commit: it draws everybody (nobody has a slot yet)
+
+
+@pytest.mark.parametrize("tabs", [1, 10, 30, 60, 150])
+def test_watching_tabs_draw_in_turn_at_the_rate_their_number_allows(tabs):
+    per_commit, per_tab = _watch(tabs)
+    interval = WATCH_INTERVAL * max(1.0, (tabs / WATCH_TABS) ** 2)  # the documented rule, written out
+    expected = 8.0 / interval  # draws per tab over 8 s
+    assert all(abs(count - expected) <= 1.5 for count in per_tab)
+    fair_share = tabs * (1 / 20.0) / interval  # tabs per commit if spread evenly
+    assert max(per_commit) <= math.ceil(fair_share) + 2  # never the whole hall at one commit
+    if tabs >= 60:
+        assert max(per_commit) <= tabs // 3  # (all at once before: each commit drew none or all of them)
+
+
+def test_phases_of_consecutive_tabs_are_spread_evenly():
+    for tabs in (2, 7, 30, 150):
+        phases = sorted(watch_phase(k) for k in range(tabs))
+        gaps = [b - a for a, b in zip(phases, [*phases[1:], phases[0] + 1.0], strict=True)]
+        assert max(gaps) < 3.0 / tabs  # the three-gap theorem: no gap above ~2.6 / tabs

@@ -20,13 +20,57 @@ import math
 import threading
 from dataclasses import dataclass, field
 
-__all__ = ["BUSY_NUMBERS_INTERVAL", "Pacer"]
+__all__ = [
+    "BUSY_NUMBERS_INTERVAL",
+    "WATCH_INTERVAL",
+    "WATCH_TABS",
+    "Pacer",
+    "watch_interval",
+    "watch_phase",
+    "watch_slot",
+]
 
+LIVE_NUMBERS_INTERVAL = 0.25
+"""Shortest time [s] between two refreshes of a panel's dashboard, ``p`` and ``d`` on the intermediate frames of a
+drag or a playback (the scene itself moves at every frame; the frame where the motion stops is always shown), and
+the age up to which a dashboard shows the numbers of an earlier frame of the drag. Each new set of numbers evaluates
+both models (closed form and Pinocchio), so that the two numbers shown side by side always belong to the same
+state."""
 BUSY_NUMBERS_INTERVAL = 1.0
 """While own copies are paced, a dragged copy's numbers (its panel: both dynamic models, the typed boxes) are
 refreshed at most once per this many seconds [s] mid-drag; its mechanism moves at every commit and the numbers are
 always refreshed when the drag ends. The panel was half of such a commit (1.7 of 3.7 ms of CPU, ``bench_load.py
 --mode hall``), and a number that changes four times a second cannot be read during a drag anyway."""
+
+
+WATCH_INTERVAL = 0.05
+"""While another tab drags (or a trajectory plays), a watching tab's own part of a frame (gizmo, panel, teaching
+layer) is drawn at most once per this many seconds [s] (20 Hz); the mechanism itself is drawn at every commit, once
+for all tabs, and the last frame of a drag is always drawn."""
+WATCH_TABS = 30
+"""Beyond this many tabs on one session, :data:`WATCH_INTERVAL` grows with the square of their number (60 tabs:
+5 Hz each, 150 watchers: 0.8 Hz each), so that the per-tab parts of a lecture hall (gizmo, panel: one message
+batch per tab) cost less than those of 30 tabs (``benchmarks/bench_load.py --mode hall``)."""
+_GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
+
+
+def watch_interval(tabs: int) -> float:
+    """How often [s] each of ``tabs`` tabs watching one session draws its own part of an intermediate frame."""
+    return WATCH_INTERVAL * max(1.0, (tabs / WATCH_TABS) ** 2)
+
+
+def watch_phase(index: int) -> float:
+    """The phase in [0, 1) of the tab numbered ``index``: consecutive numbers are spread evenly over the interval
+    (the golden-ratio sequence), so that any number of tabs that joined one after the other draw in turn."""
+    return (index * _GOLDEN) % 1.0
+
+
+def watch_slot(now: float, tabs: int, phase: float) -> int:
+    """The slot of a watching tab with ``phase`` at ``now`` (``time.monotonic()``): it draws an intermediate frame
+    when its slot changes, once per :func:`watch_interval`. The slots of different phases change at different
+    commits: before, every watcher drew at the same commit once per interval, a burst of 120 panels that held the
+    hub and then the senders (the lecture hall's p95)."""
+    return math.floor(now / watch_interval(tabs) + phase)
 
 
 @dataclass

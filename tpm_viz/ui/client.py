@@ -20,6 +20,7 @@ import viser
 
 from tpm_viz import meshes
 from tpm_viz.app import transitions
+from tpm_viz.app.pacing import watch_phase, watch_slot
 from tpm_viz.app.poses import DEMO_KINDS
 from tpm_viz.app.state import AppState
 from tpm_viz.params import Params
@@ -49,18 +50,6 @@ def _size(params: Params) -> float:
     return hi - lo
 
 
-WATCH_INTERVAL = 0.05
-"""While another tab drags (or a trajectory plays), this tab's own part of a frame (gizmo, panel, teaching layer)
-is drawn at most once per this many seconds (20 Hz); the mechanism itself is drawn at every commit, once for all
-tabs, and the last frame of a drag is always drawn."""
-WATCH_TABS = 30
-"""Beyond this many tabs on one session, :data:`WATCH_INTERVAL` grows with the square of their number (60 tabs:
-5 Hz each, 150 watchers: 0.8 Hz each), so that the per-tab parts of a lecture hall (gizmo, panel: one message
-batch per tab, serialised per tab by viser) cost less than those of 30 tabs; the mechanism itself still moves at
-every commit for everybody (one broadcast drawing), and the frame where the motion stops is always drawn
-(``benchmarks/bench_load.py --mode hall``)."""
-
-
 def _internal_error(view: ClientView, exc: Exception) -> None:
     """The guard's report to the tab whose callback failed (the traceback is in the server log)."""
     view.refuse(Phrase("internal error ({kind}), logged on the server", kind=type(exc).__name__))
@@ -82,7 +71,8 @@ class ClientView:
         self.login: LoginPanel | None = None
         """The presenter login of this tab (presenter mode only)."""
         self._notified: tuple[str, float] = ("", 0.0)
-        self._drawn_at = -1.0  # time.monotonic() of this tab's last render
+        self._slot: int | None = None  # the watch slot of this tab's last render (None: draw the next frame)
+        self._phase = watch_phase(client.client_id)  # watching tabs draw in turn, not all at one commit
         self.typing = Typing(self)
         """The typed number fields of this tab (Enter, Apply, the quiet time: :mod:`.fields`)."""
         self.drags = Dragging(self)
@@ -127,23 +117,22 @@ class ClientView:
         else:
             self.scene.close_private()
             self.session = self.hub.join(self, private=False)
-        self._drawn_at = -1.0
+        self._slot = None
         self.teaching.switched(old)
         self.hub.membership_changed()
 
     # -- drawing -------------------------------------------------------------------------------------------
     def render(self, frame: Snapshot, *, dragging: bool = False) -> None:
         """Draw this tab's part of ``frame`` (called by the hub under its lock, after the session's mechanism) and
-        flush at once; another tab's intermediate frames at most every :data:`WATCH_INTERVAL`."""
+        flush at once; another tab's intermediate frames once per watch slot (:func:`~tpm_viz.app.pacing.watch_slot`:
+        20 Hz, less in a lecture hall, the tabs in turn)."""
         if self.closed:
             return
-        now = time.monotonic()
-        if frame.in_drag and not dragging:
-            session = getattr(self, "session", None)  # None during the first render (inside Hub.join)
-            tabs = 1 if session is None else len(session.views)
-            if now - self._drawn_at < WATCH_INTERVAL * max(1.0, (tabs / WATCH_TABS) ** 2):
-                return
-        self._drawn_at = now
+        session = getattr(self, "session", None)  # None during the first render (inside Hub.join)
+        slot = watch_slot(time.monotonic(), 1 if session is None else len(session.views), self._phase)
+        if frame.in_drag and not dragging and slot == self._slot:
+            return
+        self._slot = slot
         with self.client.atomic():
             self.scene.update(frame, dragging=dragging)
             self.panel.show(frame, self.lang)
@@ -172,7 +161,7 @@ class ClientView:
             self.scene.forget()
             if self.session.scene is not None:
                 self.session.scene.update(self.session.frame)  # a private copy written again
-            self._drawn_at = -1.0
+            self._slot = None
             self.render(self.session.frame)
         self.client.flush()
 

@@ -21,6 +21,7 @@ import time
 
 import viser
 
+from tpm_viz.app.pacing import LIVE_NUMBERS_INTERVAL
 from tpm_viz.app.poses import DEMO_KINDS
 from tpm_viz.app.readouts import LOAD_MODES, Load
 from tpm_viz.app.state import AppState
@@ -34,12 +35,6 @@ from tpm_viz.ui.text import legend_html
 from tpm_viz.words import Lang
 
 __all__ = ["ACTUATOR_HINT", "ACTUATOR_LABELS", "PARAM_LABELS", "Panel", "slider_css"]
-
-LIVE_DASHBOARD_INTERVAL = 0.25
-"""Shortest time [s] between two refreshes of the dashboard, ``p`` and ``d`` on the intermediate frames of a drag or
-a playback (the scene itself moves at every frame; the frame where the motion stops is always shown). Each refresh
-evaluates both models (closed form and Pinocchio, ~0.2 ms more), so that the two numbers shown side by side always
-belong to the same state; 4 Hz keeps 30 tabs dragging at 20 Hz within the load target."""
 
 _UNSET = object()
 
@@ -211,7 +206,7 @@ class Panel:
         dashboard's messages in ``lang``."""
         state, readout = frame.state, frame.readout
         now = time.monotonic()
-        every = LIVE_DASHBOARD_INTERVAL if frame.numbers_every is None else frame.numbers_every
+        every = LIVE_NUMBERS_INTERVAL if frame.numbers_every is None else frame.numbers_every
         due = not frame.in_drag or now - self._dashboard_at >= every
         if due:  # mid-drag the numbers are refreshed at most 4 times a second, less on a busy server (bench_load.py)
             self.dashboard.content = frame.dashboard_in(lang)

@@ -28,7 +28,7 @@ import numpy as np
 
 from tpm_viz.app.access import Access
 from tpm_viz.app.inputs import read_number, read_vec2
-from tpm_viz.app.pacing import BUSY_NUMBERS_INTERVAL, Pacer
+from tpm_viz.app.pacing import BUSY_NUMBERS_INTERVAL, LIVE_NUMBERS_INTERVAL, Pacer
 from tpm_viz.app.readouts import Readout, Reference, evaluate, with_reference
 from tpm_viz.app.state import AppState
 from tpm_viz.errors import InputError
@@ -186,6 +186,7 @@ class Hub:
             if origin is not None:
                 self.authorize(origin, session)
             frame = self.frame(state, dragging)
+            frame.follow(session.frame, LIVE_NUMBERS_INTERVAL)
             if dragging and not session.shared and self.pacer.interval(time.monotonic()) > 0:
                 frame.numbers_every = BUSY_NUMBERS_INTERVAL  # a busy server: the mechanism first, numbers later
             session.state, session.frame = state, frame

@@ -7,6 +7,7 @@ and the dashboard HTML are the same for all of them, so they are computed at mos
 from __future__ import annotations
 
 import html
+import time
 from collections.abc import Callable
 from functools import cached_property
 
@@ -40,6 +41,18 @@ class Snapshot:
         self.complete_readout: Callable[[], Readout] | None = None
         """For a live frame whose ``readout`` lacks the reference forces: computes the readout with them."""
         self._dashboards: dict[Lang, str] = {}
+        self.made_at = time.monotonic()
+        self.numbers: Snapshot = self
+        """The frame whose numbers the dashboard shows: this one, or mid-drag a recent one (:meth:`follow`)."""
+
+    def follow(self, previous: Snapshot | None, within: float) -> None:
+        """Mid-drag, let the dashboard show the numbers of ``previous``'s numbers frame if that frame is less than
+        ``within`` [s] older than this one. A dashboard is refreshed a few times a second mid-drag, and each tab's
+        at its own commit (watching tabs in turn, :func:`~tpm_viz.app.pacing.watch_slot`): without this, nearly every
+        commit of a watched drag would compute the reference (Pinocchio) forces for some tab's dashboard."""
+        if self.in_drag and previous is not None and previous.in_drag:
+            if self.made_at - previous.numbers.made_at < within:
+                self.numbers = previous.numbers
 
     @cached_property
     def displayed_readout(self) -> Readout:
@@ -76,7 +89,9 @@ class Snapshot:
         return self.dashboard_in(Lang.EN)
 
     def dashboard_in(self, lang: Lang) -> str:
-        """The HTML of the always-visible top of the panel, its messages in ``lang`` (built once per language)."""
-        if lang not in self._dashboards:
-            self._dashboards[lang] = dashboard_html(self.state, self.displayed_readout, lang)
-        return self._dashboards[lang]
+        """The HTML of the always-visible top of the panel, its messages in ``lang`` (built once per language, from the
+        numbers frame :attr:`numbers`)."""
+        numbers = self.numbers
+        if lang not in numbers._dashboards:
+            numbers._dashboards[lang] = dashboard_html(numbers.state, numbers.displayed_readout, lang)
+        return numbers._dashboards[lang]
