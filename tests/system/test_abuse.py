@@ -158,9 +158,20 @@ def test_an_export_flood_runs_at_most_twice_and_other_tabs_stay_responsive(app, 
 
 
 # -- bounded memory -------------------------------------------------------------------------------------------------
-def test_a_tab_that_stops_reading_is_dropped(app, connect):
+@pytest.mark.parametrize("bad_round", [False, True], ids=["", "after a failed watchdog round"])
+def test_a_tab_that_stops_reading_is_dropped(app, connect, monkeypatch, bad_round):
     guard = guard_of(app.server)
     guard.limits.max_backlog_bytes, guard.limits.backlog_grace = 2 << 20, 1.0
+    if bad_round:  # one round fails (as a dict changed by the loop once made it): the watchdog goes on
+        over, failed = guard._over, []
+
+        def once(client_id):
+            if not failed:
+                failed.append(client_id)
+                raise RuntimeError("dictionary changed size during iteration")
+            return over(client_id)
+
+        monkeypatch.setattr(guard, "_over", once)
     _client, other = connect()
     silent = open_silent_tab(app.port)
     view = wait_for(lambda: next((v for v in app.views.values() if v is not other), None), what="the silent tab")

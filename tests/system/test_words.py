@@ -111,6 +111,7 @@ def _texts_of(message: dict) -> list[str]:
 def wire_texts(port: int, seconds: float = 4.0) -> set[str]:
     """The words of every GUI element a new tab of the app on ``port`` is sent in its first ``seconds``."""
     seen: set[str] = set()
+    messages: list[dict] = []  # in order, across frames: a window of 128 may end between an element and its content
     ws = connect_sync(
         f"ws://127.0.0.1:{port}", subprotocols=[f"viser-v{viser.__version__}"], max_size=None, compression=None
     )
@@ -122,16 +123,16 @@ def wire_texts(port: int, seconds: float = 4.0) -> set[str]:
                 raw = ws.recv(timeout=0.2)
             except TimeoutError:
                 continue
-            batch = decode_batch(raw)
-            for message, after in zip(batch, [*batch[1:], {}], strict=True):
-                if message["type"].startswith("Gui") and message["type"] != "GuiUpdateMessage":
-                    seen.update(_texts_of(message))
-                    if after.get("type") == "GuiUpdateMessage" and after.get("uuid") == message.get("uuid"):
-                        seen.update(_texts_of({"props": after.get("updates")}))  # add_markdown's own content
-                elif message["type"] == "GuiUpdateMessage" and "_tab_labels" in (message.get("updates") or {}):
-                    seen.update(_texts_of({"props": {"_tab_labels": message["updates"]["_tab_labels"]}}))  # add_tab
+            messages.extend(decode_batch(raw))
     finally:
         ws.close()
+    for message, after in zip(messages, [*messages[1:], {}], strict=True):
+        if message["type"].startswith("Gui") and message["type"] != "GuiUpdateMessage":
+            seen.update(_texts_of(message))
+            if after.get("type") == "GuiUpdateMessage" and after.get("uuid") == message.get("uuid"):
+                seen.update(_texts_of({"props": after.get("updates")}))  # add_markdown's own content
+        elif message["type"] == "GuiUpdateMessage" and "_tab_labels" in (message.get("updates") or {}):
+            seen.update(_texts_of({"props": {"_tab_labels": message["updates"]["_tab_labels"]}}))  # add_tab
     return seen
 
 

@@ -77,6 +77,13 @@ def is_loopback(host: str) -> bool:
         return False
 
 
+GIL_SWITCH_INTERVAL = 0.0005
+"""How long [s] a thread may keep the GIL while another waits for it (Python's default: 5 ms). The event loop that
+reads and writes every tab's socket gives the GIL away at each system call, and got it back only after a drag commit
+in the pool had run for up to 5 ms more: in a lecture hall, hundreds of times a second (``bench_load.py --mode
+hall``)."""
+
+
 def build_server(host: str = "127.0.0.1", port: int = 8080) -> viser.ViserServer:
     """A quiet viser server: no share tunnel, no environment map or shadows (fast first paint).
 
@@ -85,6 +92,7 @@ def build_server(host: str = "127.0.0.1", port: int = 8080) -> viser.ViserServer
     check_viser()
     safe_wakeups()  # viser's senders woken safely from the callback threads (before its buffers exist)
     lean_senders()  # a shared window encoded once for every tab, one pause timer per buffer
+    sys.setswitchinterval(GIL_SWITCH_INTERVAL)
     with (
         contextlib.redirect_stdout(io.StringIO()),
         hook_handshakes(Handshakes()),

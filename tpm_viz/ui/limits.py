@@ -36,7 +36,7 @@ from typing import Any
 import viser
 
 from tpm_viz.ui._viser import ServerDoor, quiet_decoding, thread_pool, ws_server
-from tpm_viz.ui.guard import FAULTS, log_fault
+from tpm_viz.ui.guard import FAULTS, log_fault, report
 from tpm_viz.ui.transport import message_problem
 
 __all__ = [
@@ -250,20 +250,10 @@ class ServerGuard:
                 return
             now = time.monotonic()
             live = set(self.door.live())
-            for client_id in live:
-                if self._over(client_id):
-                    since = over.setdefault(client_id, now)
-                    self.gate.blocked.add(client_id)
-                    if now - since >= self.limits.backlog_grace:
-                        mb = self.limits.max_backlog_bytes / 2**20
-                        log_fault(client_id, "backlog", f"connection dropped: over {mb:g} MiB unsent for a while")
-                        self.door.abort(client_id)
-                        self.aborted += 1
-                        del over[client_id]
-                elif over.pop(client_id, None) is not None:
-                    self.gate.blocked.discard(client_id)
-            for client_id in set(over) - live:
-                del over[client_id]
+            try:
+                self._check(live, over, now)
+            except Exception as exc:  # one bad round must not stop the watchdog: logged, the next one runs
+                report(exc, "the watchdog's round")
             if known - live:
                 trim_at = trim_at or now + 1.0  # once the departed tabs' teardown has run
             known = live
@@ -271,6 +261,23 @@ class ServerGuard:
                 _malloc_trim()
                 self.trims += 1
                 trim_at = 0.0
+
+    def _check(self, live: set[int], over: dict[int, float], now: float) -> None:
+        """Block the tabs whose backlog is over the limit (``over``: since when), drop those over it for too long."""
+        for client_id in live:
+            if self._over(client_id):
+                since = over.setdefault(client_id, now)
+                self.gate.blocked.add(client_id)
+                if now - since >= self.limits.backlog_grace:
+                    mb = self.limits.max_backlog_bytes / 2**20
+                    log_fault(client_id, "backlog", f"connection dropped: over {mb:g} MiB unsent for a while")
+                    self.door.abort(client_id)
+                    self.aborted += 1
+                    del over[client_id]
+            elif over.pop(client_id, None) is not None:
+                self.gate.blocked.discard(client_id)
+        for client_id in set(over) - live:
+            del over[client_id]
 
     def _over(self, client_id: int) -> bool:
         _count, size = self.door.backlog(client_id, self.limits.max_backlog_messages)

@@ -15,6 +15,7 @@ from typing import Any
 import viser
 
 from tpm_viz.ui._viser import widget_uuid
+from tpm_viz.words import Lang, T, say
 
 __all__ = ["LoginPanel", "mask_css"]
 
@@ -30,7 +31,9 @@ class LoginPanel:
 
     def __init__(self, gui: viser.GuiApi, on_login: Callable[[Any], None]) -> None:
         with gui.add_folder("Presenter login", expand_by_default=False):
-            self.status = gui.add_markdown("Students: you watch the presenter here, or work on your own copy.")
+            self.status = gui.add_markdown(
+                say(Lang.EN, T("Students: you watch the presenter here, or work on your own copy."))
+            )
             self.token = gui.add_text(
                 "Presenter token", "", hint="Shown as dots and cleared as soon as it is read; not for the projector"
             )

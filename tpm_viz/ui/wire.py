@@ -46,7 +46,7 @@ class Malformed:
 def message_bytes(message: Any) -> int:
     """Rough size of a queued message [bytes]: its bytes, text and array payloads plus a fixed overhead."""
     size = 64
-    for value in vars(message).values():
+    for value in list(vars(message).values()):  # a copy: the event loop may add to a message's dict meanwhile
         if isinstance(value, (bytes, bytearray, str)):
             size += len(value)
         else:
