@@ -21,6 +21,7 @@ viser name: :mod:`._viser` installs it (``lean_senders``), with viser's own enco
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import time
 from collections import OrderedDict
 from collections.abc import AsyncGenerator, Callable, Sequence
@@ -83,18 +84,12 @@ class Tick:
 def _take(buffer: Any, last: int, newest: int, client_id: int) -> tuple[list[Any], int]:
     """The next window after message id ``last`` (at most up to ``newest``) and the last id it covers."""
     window: list[Any] = []
-    size, messages = buffer.max_window_size, buffer.message_from_id
-    if buffer.persistent_messages:
+    size, shared = buffer.max_window_size, buffer.persistent_messages
+    get = buffer.message_from_id.get if shared else buffer.pop_message_locked  # a tab's own buffer: sent is removed
+    with contextlib.nullcontext() if shared else buffer.buffer_lock:
         while last < newest and len(window) < size and buffer.atomic_counter == 0:
             last += 1
-            message = messages.get(last)
-            if message is not None and message.excluded_self_client != client_id:
-                window.append(message)
-        return window, last
-    with buffer.buffer_lock:  # a tab's own buffer: what is sent is removed
-        while last < newest and len(window) < size and buffer.atomic_counter == 0:
-            last += 1
-            message = buffer.pop_message_locked(last)
+            message = get(last)
             if message is not None and message.excluded_self_client != client_id:
                 window.append(message)
     return window, last
