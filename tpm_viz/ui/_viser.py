@@ -314,9 +314,9 @@ def lean_senders() -> None:
 
     def __init__(self: Any, *args: Any, **kwargs: Any) -> None:
         init(self, *args, **kwargs)
-        self.tick, self.frames = Tick(self.event_loop, self.window_duration_sec), Frames(encode)
-        flush_set = self.flush_event.set
-        self.flush_event.set = lambda: (flush_set(), self.tick.flushed())[0]
+        self.tick = Tick(self.event_loop, self.window_duration_sec)
+        self.frames = Frames(encode) if self.persistent_messages else None  # only the shared buffer's are shared
+        self.flush_event.set = self.tick.after(self.flush_event.set)  # viser sets it on the loop
 
     AsyncMessageBuffer.__init__ = __init__  # type: ignore[method-assign]
     AsyncMessageBuffer._window_loop = window_loop  # type: ignore[assignment,method-assign]

@@ -67,6 +67,15 @@ class Tick:
         self.flushes += 1
         self._ring()
 
+    def after(self, flush_set: Callable[[], None]) -> Callable[[], None]:
+        """``flush_set`` (viser's flush event's ``set``) followed by :meth:`flushed`."""
+
+        def flush() -> None:
+            flush_set()
+            self.flushed()
+
+        return flush
+
     async def pause(self) -> None:
         """Wait for the next flush or the end of the current pause."""
         if self._timer is None:
@@ -147,11 +156,11 @@ class Frames:
 
 def producer(encode: Encode) -> Callable[..., Any]:
     """viser's ``_message_producer`` (same signature), sending each tab the windows of ``buffer``: encoded once for
-    all tabs if the buffer is the shared one (``buffer.frames``, a :class:`Frames`), else with ``encode``."""
+    all tabs if the buffer is the shared one (its ``frames``, a :class:`Frames`), else with ``encode``."""
 
     async def produce(websocket: Any, buffer: Any, client_id: int, backlog_done_message: Any = None) -> None:
         windows = buffer.window_generator(client_id, backlog_done_message=backlog_done_message)
-        frames: Frames | None = buffer.frames if buffer.persistent_messages else None
+        frames: Frames | None = buffer.frames  # the shared buffer's (None for a tab's own buffer)
         try:
             while not buffer.done:
                 try:
