@@ -1,0 +1,175 @@
+"""The parallel 2-PPa as its own closed-loop Pinocchio model (``docs/parallel.md``, ``docs/pinocchio.md``).
+
+Same construction, mass model and solves as :class:`~tpm_viz.multibody.model.MultibodyModel` (it subclasses it:
+the rank-revealing inverse and forward dynamics, the Newton assembly and the lock are the perpendicular model's);
+only the tree, the closures and the starting guesses differ. Depth-first tree, ``q = (d_1, φ_10, φ_p, φ_11, d_2,
+φ_20, φ_21)`` (read :attr:`index`)::
+
+    universe ─PX─ slider1 (origin A_1 = (d_1 - a, 0)) ─RZ─ link1_0 (pivot A_1) ─RZ─ platform (pivot B_1)
+                                                    └RZ─ link1_1 (pivot A_1 + s e_2)
+    universe ─PX─ slider2 (frame turned by π at (a, 0): origin A_2 = (a - d_2, 0)) ─RZ─ link2_0 (pivot A_2)
+                                                                                  └RZ─ link2_1 (pivot A_2 + s e_2)
+
+Each link's x axis runs along the link: ``φ_1k = θ_1`` and, in slider 2's turned frame, ``φ_2k = -θ_2``
+(``θ_i`` measured from the rail inwards, ``docs/parallel.md``); ``φ_p = -θ_1`` keeps the platform translating.
+Closures: the tips of link1_1, link2_0 and link2_1 to ``B_1 + s e_2``, ``B_2 = B_1 + 2b e_1`` and
+``B_2 + s e_2`` on the platform (``CONTACT_3D``, ``LOCAL_WORLD_ALIGNED``; 9 rows of rank 5 as in the
+perpendicular model). Independent of the closed form of :mod:`tpm_viz.paper.parallel_dynamics`.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+import pinocchio as pin
+
+from tpm_viz.errors import InputError, SingularConfigurationError, UnreachablePoseError
+from tpm_viz.multibody.locking import locked
+from tpm_viz.multibody.model import MultibodyModel, _point_mass, _rod, _se3
+from tpm_viz.numbers import fixed
+from tpm_viz.paper import parallel as par
+from tpm_viz.params import Params
+from tpm_viz.words import Phrase
+
+__all__ = ["ParallelMultibodyModel", "inverse_dynamics", "parallel_model_for"]
+
+_SINGULAR_RTOL = 1e-9
+
+
+def _build_parallel(params: Params) -> tuple[pin.Model, list[pin.RigidConstraintModel], dict[str, int]]:
+    """The Pinocchio model of the parallel arrangement, its closures and the part frame ids."""
+    a, b, la, sp = params.a, params.b, params.l_a, params.pivot_spacing
+    model = pin.Model()
+    model.gravity = pin.Motion.Zero()  # horizontal mechanism, U = 0
+    rod = _rod(params.m_b / 2.0, la)
+    tree = [
+        ("slider1", "universe", pin.JointModelPX(), _se3([-a, 0, 0]), _point_mass(params.m_a)),
+        ("link1_0", "slider1", pin.JointModelRZ(), _se3([0, 0, 0]), rod),
+        ("platform", "link1_0", pin.JointModelRZ(), _se3([la, 0, 0]), _point_mass(params.m_p, [b, 0, 0])),
+        ("link1_1", "slider1", pin.JointModelRZ(), _se3([0, sp, 0]), rod),
+        ("slider2", "universe", pin.JointModelPX(), _se3([a, 0, 0], math.pi), _point_mass(params.m_a)),
+        ("link2_0", "slider2", pin.JointModelRZ(), _se3([0, 0, 0]), rod),
+        ("link2_1", "slider2", pin.JointModelRZ(), _se3([0, -sp, 0]), rod),  # +s e_2 in the world
+    ]
+    joints = {"universe": 0}
+    for name, parent, joint, placement, inertia in tree:
+        joints[name] = model.addJoint(joints[parent], joint, placement, name)
+        model.appendBodyToJoint(joints[name], inertia, pin.SE3.Identity())
+    del joints["universe"]
+    frames = {}
+    for name, jid in joints.items():
+        origin = [b, 0, 0] if name == "platform" else [0, 0, 0]  # platform frame at P = B_1 + b e_1
+        frames[name] = model.addFrame(pin.Frame(name, jid, _se3(origin), pin.FrameType.OP_FRAME), False)
+    tip = _se3([la, 0, 0])
+    on_platform = {"link1_1": [0, sp, 0], "link2_0": [2 * b, 0, 0], "link2_1": [2 * b, sp, 0]}  # from B_1
+    closures = [
+        pin.RigidConstraintModel(
+            pin.ContactType.CONTACT_3D,
+            model,
+            joints[link],
+            tip,
+            joints["platform"],
+            _se3(xyz),
+            pin.ReferenceFrame.LOCAL_WORLD_ALIGNED,
+        )
+        for link, xyz in on_platform.items()
+    ]
+    return model, closures, frames
+
+
+class ParallelMultibodyModel(MultibodyModel):
+    """The closed-loop Pinocchio model of the parallel arrangement (see the module docstring); the public
+    methods are :class:`MultibodyModel`'s (``inverse_dynamics``, ``configuration``, ``placements``, ...)."""
+
+    _build_model = staticmethod(_build_parallel)
+
+    def _guess_from_platform(self, p: np.ndarray, d: np.ndarray | None) -> np.ndarray:
+        """Working mode (eq. P3), ``sin θ_i = p_2 / l_a``, or links pointing at the pivots from given ``d``."""
+        if d is not None:
+            return self._guess_from_both(p, d)
+        theta = math.asin(float(p[1]) / self.params.l_a)
+        return self._pack(par.inverse_kinematics(self.params, p), theta, -theta)
+
+    def _guess_from_both(self, p: np.ndarray, d: np.ndarray) -> np.ndarray:
+        """Links pointing from ``A_i`` towards ``B_i``; leg 2's link direction is ``(-cos φ, -sin φ)``."""
+        pose_a = np.array([[d[0] - self.params.a, 0.0], [self.params.a - d[1], 0.0]])
+        b = np.array([[p[0] - self.params.b, p[1]], [p[0] + self.params.b, p[1]]])
+        u = b - pose_a
+        return self._pack(d, math.atan2(u[0, 1], u[0, 0]), math.atan2(-u[1, 1], -u[1, 0]))
+
+    def _configure(self, p: np.ndarray, d: np.ndarray | None):
+        """``(q, J_c, J_P)`` at the closed-loop configuration of ``p``: Newton from the working-mode guess
+        (or from ``d``'s branch), then the last pose as a continuation start."""
+        la, (p1, p2) = self.params.l_a, p.tolist()
+        if not abs(p2) < la:
+            raise UnreachablePoseError(
+                Phrase(
+                    "platform position ({x}, {y}) mm is unreachable: |p2| must be below l_a = {l_a:.1f} mm",
+                    x=fixed(p1, ".1f", 1e3),
+                    y=fixed(p2, ".1f", 1e3),
+                    l_a=la * 1e3,
+                )
+            )
+        starts = [self._guess_from_platform(p, d)]
+        if d is None and self._last is not None:
+            p_last, q_last, dq_dp = self._last
+            starts.append(q_last if dq_dp is None else q_last + dq_dp @ (p - p_last))
+        for start in starts:
+            q, ok, jc, jp = self._newton(start, p, "platform")
+            working = min(math.cos(x) for x in self._link_angles(q)) > 0  # c_i = l_a cos θ_i > 0 (eq. P3)
+            if ok and self._is_parallelogram(q) and (d is not None or working):
+                q = self._wrap(q)
+                if d is None:
+                    self._last = (p.copy(), q, None)
+                return q, jc, jp
+        raise SingularConfigurationError(
+            Phrase(
+                "no closed-loop configuration found at ({x}, {y}) mm (too close to cos θ_i = 0, eq. 11)",
+                x=fixed(p1, ".1f", 1e3),
+                y=fixed(p2, ".1f", 1e3),
+            )
+        )
+
+    def _tau(self, q, v, a, n, jp, f_ext) -> tuple[np.ndarray, np.ndarray]:
+        """The perpendicular model's solve, after a scale-free check of ``Nᵀ Sᵀ = Jᵀ``: here its second row
+        ``(tan θ_1, tan θ_2)`` vanishes at the direct singularity, which a per-row test cannot see."""
+        g = n[self._slider_idx].T
+        if abs(np.linalg.det(g)) < _SINGULAR_RTOL * float(np.max(np.abs(g))) ** 2:
+            raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq="sin(θ1 + θ2) = 0"))
+        return super()._tau(q, v, a, n, jp, f_ext)
+
+    @locked
+    def configuration_from_actuators(self, d, mode: int = +1) -> np.ndarray:
+        """Full ``q`` (7,) for actuator positions ``d`` (2,) [m] in assembly ``mode`` (+1: ``det J_x =
+        sin(θ1 + θ2) > 0``, the upper one with the legs inwards), by Newton on the closures."""
+        if mode not in (1, -1):
+            raise InputError(f"assembly mode must be +1 or -1, got {mode!r}")
+        d = self._one(d, "d")
+        sol = par.forward_kinematics_both(self.params, d)
+        if not bool(sol.exists):
+            raise UnreachablePoseError(
+                Phrase("actuator positions cannot be assembled: the leg circles are more than 2 l_a apart")
+            )
+        for p0 in (sol.plus, sol.minus):  # guesses only: Newton on Pinocchio's closures decides
+            q, ok, _, _ = self._newton(self._guess_from_both(p0, d), d, "actuators")
+            f1, f2 = self._link_angles(q)  # (θ_1, -θ_2)
+            if ok and self._is_parallelogram(q) and np.sign(math.sin(f1 - f2)) == mode:
+                return self._wrap(q)
+        raise SingularConfigurationError(
+            Phrase("assembly mode {mode} not found: d is at or near the direct singularity", mode=f"{mode:+d}")
+        )
+
+
+@functools.lru_cache(maxsize=16)
+def parallel_model_for(params: Params) -> ParallelMultibodyModel:
+    """The cached :class:`ParallelMultibodyModel` of a parameter set."""
+    return ParallelMultibodyModel(params)
+
+
+def inverse_dynamics(params: Params, p, dp, ddp, f_ext=None) -> np.ndarray:
+    """Actuator forces ``τ`` [N], shape ``(..., 2)``, from the parallel Pinocchio model (one cached per params)."""
+    if not isinstance(params, Params):
+        raise InputError(f"inverse_dynamics needs a tpm_viz.Params, got {type(params).__name__}")
+    return parallel_model_for(params).inverse_dynamics(p, dp, ddp, f_ext)
