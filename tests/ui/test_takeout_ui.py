@@ -1,0 +1,173 @@
+"""*Record clip* and *Download report* in the Player, Control and Planner tabs, without a browser: a protocol-level
+client clicks, the downloads viser would send are caught and decoded (frames, size, rate, the forces drawn), the
+page answers while a clip records, and the bounds (one clip per tab, the server's slots) refuse with one line."""
+
+from __future__ import annotations
+
+import html.parser
+import io
+
+import av
+import numpy as np
+import pytest
+from PIL import Image
+
+from tests.support.protocol import wait_for
+from tpm_viz.clips import ClipRenderer
+from tpm_viz.ui.teaching.recording import APP_FRAMES, SLOTS, frames_of
+from tpm_viz.words import Lang, say
+
+BLUE, RED = (31, 119, 180), (214, 39, 40)  # the bars of τ1 and τ2 (tpm_viz.clips.BAR_COLOURS)
+
+
+def _catch(view) -> list[tuple[str, bytes]]:
+    sent: list[tuple[str, bytes]] = []
+    view.client.send_file_download = lambda name, data, **kw: sent.append((name, data))
+    return sent
+
+
+def _refusals(view) -> list[str]:
+    """What the tab is told it was refused (English), caught on its way to the panel."""
+    told: list[str] = []
+    refuse = view.refuse
+
+    def spy(what, *args, **kwargs):
+        told.append(say(Lang.EN, what))
+        return refuse(what, *args, **kwargs)
+
+    view.refuse = spy
+    return told
+
+
+def _takeout(view, where: str):
+    return next(t for t in view.teaching.takeouts if t.where == where)
+
+
+def _bar(frame: np.ndarray, row: int, colour, zero_x: float) -> float:
+    cols = np.flatnonzero(np.abs(frame[row].astype(int) - np.array(colour)).sum(axis=1) < 90)
+    if cols.size == 0:
+        return 0.0
+    left, right = cols.min(), cols.max() + 1
+    return float(right - zero_x) if abs(right - zero_x) > abs(left - zero_x) else float(left - zero_x)
+
+
+def _check_bars(frames, clip, size, tol_px: float) -> None:
+    geometry = ClipRenderer(clip, "geometry", size).geometry()
+    for k in range(0, len(frames), 40):
+        for i, colour in enumerate((BLUE, RED)):
+            drawn = _bar(frames[k], geometry.rows[i], colour, geometry.zero_x) / geometry.px_per_newton
+            assert drawn == pytest.approx(clip.tau[k, i], abs=tol_px / geometry.px_per_newton), (k, i)
+
+
+class _Numbers(html.parser.HTMLParser):
+    def __init__(self, text: str) -> None:
+        super().__init__()
+        self.values: dict[str, float] = {}
+        self.cells: list[float] = []
+        self._key = None
+        self.feed(text)
+
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        if tag == "tr":
+            self._key = a.get("data-key")
+        if tag == "td" and "data-value" in a:
+            self.cells.append(float(a["data-value"]))
+            if self._key:
+                self.values[self._key] = float(a["data-value"])
+
+
+def test_player_records_a_gif_of_its_run_and_stays_usable(connect):
+    client, view = connect()
+    client.set_value(view.teaching.player.choice, "line (Fig. 4)")
+    wait_for(lambda: view.teaching.services.runs.of(view.session).run is not None, what="the line")
+    run = view.teaching.services.runs.of(view.session).run
+    take = _takeout(view, "player")
+    sent, told = _catch(view), _refusals(view)
+    client.set_value(take.size, "640×360")
+    client.set_value(take.rate, "10")
+    wait_for(lambda: take.size.value == "640×360" and take.rate.value == "10", what="the clip settings")
+    client.click(take.record)
+    wait_for(lambda: take.recording is not None and take.recording.done > 0, timeout=60, what="the first frames")
+    client.click(take.record)  # one recording per tab
+    wait_for(lambda: any("already being recorded" in t for t in told), what="the refusal")
+    client.set_value(view.teaching.player.time, 0.1)  # the page answers meanwhile
+    wait_for(lambda: abs(view.session.state.trajectory.t - 0.1) < 1e-6, what="the seek during the recording")
+    assert take.recording is not None and take.recording.done < take.recording.total
+    assert "Recording the clip" in take.line.content
+    wait_for(lambda: sent, timeout=300, what="the clip")
+    name, data = sent[0]
+    assert name == "tpm-line-T0.2s-640x360-10fps.gif" and "Clip ready" in take.line.content
+    im = Image.open(io.BytesIO(data))
+    assert (im.n_frames, im.size) == (len(run.t), (640, 360)) == (401, (640, 360))
+    frames = []
+    for k in range(im.n_frames):
+        im.seek(k)
+        frames.append(np.asarray(im.convert("RGB")))
+        assert im.info["duration"] == 100
+    assert np.abs(frames[0].astype(int) - frames[-1]).sum() > 0
+    _check_bars(frames, run, (640, 360), tol_px=1.5)
+    assert take.recording is None and SLOTS._value == 3  # the slot came back
+
+
+def test_control_records_an_mp4_of_the_actual_motion(connect):
+    client, view = connect()
+    cv = view.teaching.control
+    client.click(cv.simulate)
+    wait_for(lambda: cv.run is not None and not cv.busy, timeout=30, what="the simulation")
+    take = _takeout(view, "control")
+    sent = _catch(view)
+    client.set_value(take.format, "MP4 (H.264)")
+    client.set_value(take.size, "640×360")
+    wait_for(lambda: take.format.value == "MP4 (H.264)" and take.size.value == "640×360", what="the settings")
+    client.click(take.record)
+    wait_for(lambda: sent, timeout=300, what="the clip")
+    name, data = sent[0]
+    clip = frames_of(cv.player.motion.params, cv.run.t, cv.run.p, cv.run.tau)
+    assert name.startswith("tpm-control-ctc") and name.endswith("-640x360-20fps.mp4")
+    with av.open(io.BytesIO(data)) as container:
+        stream = container.streams.video[0]
+        frames = [f.to_ndarray(format="rgb24") for f in container.decode(stream)]
+        assert float(stream.average_rate) == 20.0 and stream.codec_context.name == "h264"
+    assert len(frames) == len(clip.t) == min(len(cv.run.t), APP_FRAMES)
+    assert frames[0].shape == (360, 640, 3)
+    _check_bars(frames, clip, (640, 360), tol_px=3.0)
+
+
+def test_reports_of_the_player_and_the_planner(connect):
+    client, view = connect()
+    sent = _catch(view)
+    client.set_value(view.teaching.player.choice, "circle (Fig. 5)")
+    wait_for(lambda: view.teaching.services.runs.of(view.session).run is not None, what="the circle")
+    run = view.teaching.services.runs.of(view.session).run
+    client.click(_takeout(view, "player").report)
+    wait_for(lambda: sent, timeout=60, what="the player's report")
+    name, data = sent[0]
+    numbers = _Numbers(data.decode("utf-8"))
+    assert name == "tpm-circle-T0.5s-report.html"
+    assert numbers.values["peak"] == run.peak and numbers.values["max_diff"] == run.max_diff
+
+    pv = view.teaching.planner
+    wait_for(lambda: pv.result is not None, timeout=30, what="the first plan")
+    client.click(_takeout(view, "planner").report)
+    wait_for(lambda: len(sent) == 2, timeout=60, what="the planner's report")
+    text = sent[1][1].decode("utf-8")
+    assert "<h2>Planner</h2>" in text
+    assert pytest.approx(pv.result.cycle_time, rel=1e-12) in _Numbers(text).cells
+
+
+def test_nothing_to_record_and_no_free_slot_are_refused_in_one_line(connect):
+    client, view = connect()
+    take, control, told = _takeout(view, "planner"), _takeout(view, "control"), _refusals(view)
+    client.click(control.record)
+    wait_for(lambda: any("nothing to record yet" in t for t in told), what="the refusal")
+    taken = [SLOTS.acquire(blocking=False) for _ in range(3)]
+    try:
+        wait_for(lambda: view.teaching.planner.result is not None, timeout=30, what="the first plan")
+        client.click(take.record)
+        wait_for(lambda: any("recording other clips" in t for t in told), what="the busy refusal")
+        assert take.recording is None
+    finally:
+        for ok in taken:
+            if ok:
+                SLOTS.release()
