@@ -123,7 +123,7 @@ BAD = {
         "a segment motion needs motion.end",
     ),
     "crossing": (
-        GOOD.replace("[pose]\np = [0.0, 0.0]\n", "[motion]\nkind = 'csv'\nfile = '../csv/cross.csv'\n"),
+        GOOD.replace("[pose]\np = [0.0, 0.0]\n", "[motion]\nkind = 'csv'\nfile = 'csv/cross.csv'\n"),
         4,
         "the motion: at t = 0.820 s, p = (-181.6, -181.6) mm: the platform would come too close to the direct "
         "singularity",
@@ -131,7 +131,7 @@ BAD = {
     "missing_csv": (
         GOOD.replace("[pose]\np = [0.0, 0.0]\n", "[motion]\nkind = 'csv'\nfile = 'nope.csv'\n"),
         6,
-        "motion.file 'nope.csv': No such file or directory",
+        "motion.file 'nope.csv': cannot open (No such file or directory)",
     ),
 }
 
@@ -139,9 +139,9 @@ BAD = {
 @pytest.mark.parametrize("case", sorted(BAD))
 def test_a_lesson_with_a_mistake_is_refused_with_file_line_and_what_and_the_others_still_load(tmp_path, case):
     text, line, what = BAD[case]
-    (tmp_path / "csv").mkdir()
-    shutil.copy(ASSETS / "trajectories" / "singular_crossing.csv", tmp_path / "csv" / "cross.csv")
     folder = _folder(tmp_path, {"01-first.toml": GOOD, "02-bad.toml": text, "03-last.toml": GOOD.replace("7.", "8.")})
+    (folder / "csv").mkdir()  # a lesson's CSV lives inside the lessons folder
+    shutil.copy(ASSETS / "trajectories" / "singular_crossing.csv", folder / "csv" / "cross.csv")
     lessons, problems = load_lessons(folder)
     assert [d.key for d in lessons] == ["first", "last"]
     assert [d.title for d in lessons] == ["7. Mine", "8. Mine"]
@@ -170,8 +170,8 @@ def test_a_lecturer_lesson_may_play_a_csv_omit_the_camera_and_carry_a_korean_tex
         "[motion]\nkind = 'csv'\nfile = '../trajectories/figure_eight.csv'\nduration = 4.0\ncompare = [2.0, 4.0]\n"
         "[checks]\npeak_ratio = { value = 4.0, tol = 1e-6 }\ndet_jx_start = 1.0\n"
     )
-    folder = _folder(tmp_path, {"eight.toml": text})
-    shutil.copytree(ASSETS / "trajectories", tmp_path / "trajectories")
+    folder = _folder(tmp_path, {"eight.toml": text.replace("../trajectories/", "trajectories/")})
+    shutil.copytree(ASSETS / "trajectories", folder / "trajectories")  # inside the lessons folder
     (demo,), problems = load_lessons(folder)
     assert problems == ()
     assert demo.key == "eight" and demo.camera is None and demo.text == "A figure eight through the centre."

@@ -19,13 +19,14 @@ import re
 
 import numpy as np
 
+from tpm_viz import files
 from tpm_viz.app.demos import CHECK_NAMES, LANGUAGES, Camera, Check, Demo, Motion, demo_params, demo_pose, demo_source
 from tpm_viz.app.lesson_toml import MAX_FILE_BYTES, LessonError, Problem, Reader, line_of, parse
 from tpm_viz.app.moves import check, why_not
 from tpm_viz.app.overlays import MAP_KINDS
 from tpm_viz.app.readouts import reason
 from tpm_viz.app.runs import check_path
-from tpm_viz.errors import InputError, TpmVizError
+from tpm_viz.errors import FileRefusedError, InputError, TpmVizError
 from tpm_viz.paper.trajectories import parse_trajectory_csv
 from tpm_viz.params import PARAM_INFO, Params
 from tpm_viz.words import Phrase, T
@@ -58,7 +59,7 @@ def _params(r: Reader) -> tuple[tuple[str, float], ...]:
     return overrides
 
 
-def _motion(r: Reader, path: pathlib.Path) -> tuple[Motion | None, tuple[float, ...]]:
+def _motion(r: Reader, path: pathlib.Path, root: pathlib.Path) -> tuple[Motion | None, tuple[float, ...]]:
     t = "motion"
     values = r.table(t, ("kind", "duration", "start", "end", "file", "compare"))
     if not values:
@@ -91,18 +92,31 @@ def _motion(r: Reader, path: pathlib.Path) -> tuple[Motion | None, tuple[float, 
     if kind == "csv":
         name = r.string(t, values, "file")
         try:
-            csv = (path.parent / name).read_bytes()
-            if len(csv) > MAX_FILE_BYTES:
-                raise InputError(Phrase("larger than {limit} KiB", limit=MAX_FILE_BYTES // 1024))
-            traj = parse_trajectory_csv(csv.decode("utf-8-sig"), name=pathlib.Path(name).stem)
-        except OSError as exc:
-            r.fail(t, "file", Phrase("motion.file {name}: {why}", name=repr(name), why=exc.strerror or str(exc)))
-        except (TpmVizError, UnicodeDecodeError) as exc:
+            csv = _lesson_csv(path.parent / name, root)
+        except FileRefusedError as exc:
+            r.fail(t, "file", Phrase("motion.file {name}: {why}", name=repr(name), why=exc.why))
+        try:
+            traj = parse_trajectory_csv(csv, name=pathlib.Path(name).stem)
+        except TpmVizError as exc:
             r.fail(t, "file", Phrase("motion.file {name}: {why}", name=repr(name), why=reason(exc)))
         if math.isnan(duration):
             duration = traj.duration  # the file's own timing
         return Motion(kind, duration, file=name, trajectory=traj), compare
     return Motion(kind, duration), compare
+
+
+def _lesson_csv(target: pathlib.Path, root: pathlib.Path) -> str:
+    """The text of a lesson's CSV: a regular file inside the lessons folder ``root`` or the packaged
+    ``trajectories/`` (never /dev/zero, a FIFO, /proc or /etc/passwd; a refusal quotes nothing of the file)."""
+    try:
+        return files.read_text(target, MAX_FILE_BYTES, root)
+    except FileRefusedError:
+        packaged = assets_dir() / "trajectories"
+        try:
+            return files.read_text(target, MAX_FILE_BYTES, packaged)
+        except FileRefusedError:
+            pass
+        raise
 
 
 def _pose(r: Reader) -> dict:
@@ -150,10 +164,12 @@ def _key_of(path: pathlib.Path) -> str:
     return re.sub(r"^[0-9]+[-_ .]*", "", path.stem) or path.stem
 
 
-def load_lesson(path) -> Demo:
-    """One lesson file (raises :class:`LessonError`; its ``line`` says where)."""
+def load_lesson(path, root=None) -> Demo:
+    """One lesson file (raises :class:`LessonError`; its ``line`` says where). It and the CSV file it names must be
+    regular files inside ``root`` (default: the lesson's own folder), read by :mod:`tpm_viz.files`."""
     path = pathlib.Path(path)
-    text, data = parse(path)
+    root = path.parent if root is None else pathlib.Path(root)
+    text, data = parse(path, root)
     r = Reader(text, data)
     for key in data:
         if key not in TOP_KEYS:
@@ -182,7 +198,7 @@ def load_lesson(path) -> Demo:
     if not isinstance(ellipses, bool):
         r.fail("view", "ellipses", Phrase("view.ellipses must be true or false, got {got}", got=repr(ellipses)))
     params = _params(r)
-    motion, compare = _motion(r, path)
+    motion, compare = _motion(r, path, root)
     pose = _pose(r)
     if motion is not None and pose:
         r.fail("pose", "", Phrase("give [pose] or [motion], not both (a motion starts at its first point)"))
@@ -237,22 +253,22 @@ def load_lessons(directory) -> tuple[tuple[Demo, ...], tuple[Problem, ...]]:
     is refused too."""
     directory = pathlib.Path(directory)
     if directory.is_file() and directory.suffix == ".toml":
-        files = [directory]  # one lesson file
+        paths, root = [directory], directory.parent  # one lesson file
     elif not directory.is_dir():
         return (), (Problem(Phrase("{path}: not a folder of lessons", path=str(directory))),)
     else:
-        files = sorted(p for p in directory.glob("*.toml") if not p.name.startswith("."))  # no editor backups
-    if not files:
+        paths, root = sorted(p for p in directory.glob("*.toml") if not p.name.startswith(".")), directory  # no backups
+    if not paths:
         return (), (Problem(Phrase("{path}: no lesson files (*.toml)", path=str(directory))),)
     lessons: list[Demo] = []
     problems: list[Problem] = []
-    for path in files:
+    for path in paths:
         try:
-            demo = load_lesson(path)
+            demo = load_lesson(path, root)
             for other in lessons:
                 for what in ("key", "title"):
                     if getattr(other, what) == getattr(demo, what):
-                        line = line_of(path.read_text(encoding="utf-8-sig"), "", what)
+                        line = line_of(parse(path, root)[0], "", what)
                         raise LessonError(
                             Phrase(
                                 "{what} {value} is already used by {other}",

@@ -11,13 +11,16 @@ import re
 import tomllib
 from typing import NoReturn
 
-from tpm_viz.errors import InputError
+from tpm_viz import files
+from tpm_viz.errors import FileRefusedError, InputError
 from tpm_viz.words import Phrase
 
 __all__ = ["MAX_FILE_BYTES", "LessonError", "Problem", "Reader", "line_of", "parse"]
 
 MAX_FILE_BYTES = 256 * 1024
 """Largest lesson, preset or lesson CSV file [bytes]."""
+MAX_DEPTH = 8
+"""Deepest nesting of tables and arrays in a lesson or preset file (the format needs 3)."""
 
 
 class Problem(str):
@@ -165,14 +168,24 @@ def _name(table: str, key: str) -> str:
     return f"{table}.{key}" if table else key
 
 
-def parse(path: pathlib.Path) -> tuple[str, dict]:
-    """The text and the TOML data of ``path`` (:class:`LessonError` with the line on any problem)."""
+def parse(path: pathlib.Path, root: pathlib.Path | None = None) -> tuple[str, dict]:
+    """The text and the TOML data of ``path`` (:class:`LessonError` with the line on any problem), read with
+    :mod:`tpm_viz.files`' rules (a regular file inside ``root`` if given, at most :data:`MAX_FILE_BYTES`, nested
+    at most :data:`MAX_DEPTH` levels); a refusal never quotes the file."""
     try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise LessonError(Phrase("cannot read: {why}", why=exc.strerror or str(exc))) from None
-    if len(raw) > MAX_FILE_BYTES:
-        raise LessonError(Phrase("larger than {limit} KiB", limit=MAX_FILE_BYTES // 1024))
+        raw = files.read_bytes(path, MAX_FILE_BYTES, root)
+    except FileRefusedError as exc:
+        raise LessonError(exc.why) from None  # type: ignore[arg-type]
+    try:
+        text, data = _parse_text(raw)
+    except RecursionError:
+        raise LessonError(Phrase(files.TOO_DEEP.template, depth=MAX_DEPTH)) from None
+    if files.depth_of(data) > MAX_DEPTH:
+        raise LessonError(Phrase(files.TOO_DEEP.template, depth=MAX_DEPTH))
+    return text, data
+
+
+def _parse_text(raw: bytes) -> tuple[str, dict]:
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
