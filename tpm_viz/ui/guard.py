@@ -27,7 +27,8 @@ import logging
 import threading
 import time
 
-__all__ = ["ACTIVITY", "FAULTS", "Activity", "Faults", "guard_executor", "guarded", "log", "log_fault", "report"]
+__all__ = ["ACTIVITY", "FAULTS", "TRACEBACK_INTERVAL", "Activity", "Faults", "guard_executor", "guarded", "log"]
+__all__ += ["log_fault", "report"]
 
 log = logging.getLogger("tpm_viz.ui")
 
@@ -120,13 +121,40 @@ log_fault = FAULTS
 """``log_fault(client_id, kind, text)``: the rate-limited warning of :class:`Faults` (one shared instance)."""
 
 
-def report(exc: BaseException, what: str) -> None:
-    """Log an unexpected exception of ``what`` with its traceback, then count it.
+TRACEBACK_INTERVAL = 60.0
+"""A tab's callback failing in the same place and way logs its traceback once per this many seconds [s]; the others
+in between are one rate-limited line per tab (:func:`log_fault`), so a tab that triggers a bug on purpose cannot
+fill the log (a failure of the server's own threads always logs its traceback)."""
+_TRACED: dict[tuple[str, str], float] = {}
+_TRACED_LOCK = threading.Lock()
+
+
+def report(exc: BaseException, what: str, client: object = None) -> None:
+    """Log an unexpected exception of ``what`` (for the tab ``client``, if known) with its traceback, then count it;
+    the same failure again within :data:`TRACEBACK_INTERVAL` is one line through the per-tab limit.
 
     Logged first: whoever waits on the count (a health page, a test) then finds the log line written.
     """
-    log.error("%s failed: %s: %s", what, type(exc).__name__, exc, exc_info=exc)
+    key, now = (what, type(exc).__name__), time.monotonic()
+    with _TRACED_LOCK:
+        first = client is None or now - _TRACED.get(key, -TRACEBACK_INTERVAL) >= TRACEBACK_INTERVAL
+        if first and client is not None:
+            _TRACED[key] = now
+            if len(_TRACED) > Faults.MAX_KEYS:
+                del _TRACED[next(iter(_TRACED))]
+    if first:
+        log.error("%s failed: %s: %s", what, type(exc).__name__, exc, exc_info=exc)
+    else:
+        log_fault(client, f"error {what}", f"{what} failed again: {type(exc).__name__}")
     ACTIVITY.error()
+
+
+def _client_of(args: tuple) -> object:
+    """The tab a callback ran for (its event's ``client_id`` or client's), or None."""
+    first = args[0] if args else None
+    client = getattr(first, "client", None)
+    found = getattr(first, "client_id", None) if client is None else getattr(client, "client_id", None)
+    return found if isinstance(found, int) else None
 
 
 def _notify(on_error, args, exc: Exception, what: str) -> None:
@@ -155,7 +183,7 @@ def guarded(func=None, *, on_error=None):
                 try:
                     return await fn(*args, **kwargs)
                 except Exception as exc:
-                    report(exc, what)
+                    report(exc, what, _client_of(args))
                     _notify(on_error, args, exc, what)
                     return None
                 finally:
@@ -169,7 +197,7 @@ def guarded(func=None, *, on_error=None):
             try:
                 return fn(*args, **kwargs)
             except Exception as exc:
-                report(exc, what)
+                report(exc, what, _client_of(args))
                 _notify(on_error, args, exc, what)
                 return None
             finally:

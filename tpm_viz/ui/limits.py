@@ -13,7 +13,9 @@
   after tabs leave it returns freed heap to the system (``malloc_trim``); at most :attr:`Limits.max_connections`
   tabs (the next one is told so in a notification, then closed). Uploads are bounded per tab in :mod:`.transport`.
 - **Well-formed messages only**: every incoming message is checked against its declared field types
-  (:func:`~.transport.message_problem`) before viser dispatches it; a handler that still fails is one log line.
+  (:func:`~.transport.message_problem`) before viser dispatches it; a handler that still fails is one log line. A
+  tab that sends more than :attr:`Limits.max_malformed` malformed messages within :attr:`Limits.malformed_window`
+  seconds is dropped.
 - **HTTP**: a path the app does not serve is a 404 (414 for an over-long one), never a 500.
 
 All drops are logged through :func:`~.guard.log_fault` (one line per second per tab and kind, with counts).
@@ -22,6 +24,7 @@ All drops are logged through :func:`~.guard.log_fault` (one line per second per 
 from __future__ import annotations
 
 import asyncio
+import collections
 import concurrent.futures
 import ctypes
 import dataclasses
@@ -64,6 +67,8 @@ class Limits:
     backlog_grace: float = 5.0
     check_interval: float = 0.25
     refuse_close_delay: float = 1.0
+    max_malformed: int = 1000
+    malformed_window: float = 10.0
 
 
 def _client_of(args: tuple) -> int | None:
@@ -189,6 +194,9 @@ class ServerGuard:
         pool.submit = self.gate.submit
         self.accepted: set[int] = set()
         self.refused: set[int] = set()
+        self._malformed: dict[int, collections.deque[float]] = {}
+        """Times of each tab's recent malformed messages (at most ``max_malformed + 1`` each)."""
+        self.dropped = 0
         self.aborted = 0
         self.trims = 0
         limit_frames(server, limits.max_frame_bytes)
@@ -216,6 +224,7 @@ class ServerGuard:
     def _disconnected(self, client_id: int) -> None:
         self.accepted.discard(client_id)
         self.refused.discard(client_id)
+        self._malformed.pop(client_id, None)
         self.gate.forget(client_id)
         FAULTS.forget(client_id)
 
@@ -228,16 +237,36 @@ class ServerGuard:
                 if problem is not None:
                     if log:
                         log_fault(client_id, "message", f"message dropped: {problem}")
+                        self._count_malformed(client_id)
                     return
                 try:
                     await dispatch(client_id, message)
                 except Exception as exc:  # viser's own handler choked on a message: one line, not a traceback
                     name = type(message).__name__
-                    log_fault(client_id, "handler", f"{name} failed in viser: {type(exc).__name__}: {exc}")
+                    log_fault(client_id, "handler", f"{name} failed in viser: {type(exc).__name__}: {str(exc)[:200]}")
+                    if log:
+                        self._count_malformed(client_id)
 
             return handle
 
         return wrap
+
+    def _count_malformed(self, client_id: int) -> None:
+        """One more malformed message from this tab: over ``max_malformed`` in ``malformed_window`` seconds, the
+        tab is dropped (a browser never sends one; a script that keeps trying costs the server only this count)."""
+        now, window = time.monotonic(), self.limits.malformed_window
+        times = self._malformed.setdefault(client_id, collections.deque(maxlen=self.limits.max_malformed + 1))
+        times.append(now)
+        if len(times) > self.limits.max_malformed and now - times[0] <= window:
+            self.refused.add(client_id)  # nothing more of it is handled
+            self._malformed.pop(client_id, None)
+            self.dropped += 1
+            log_fault(
+                client_id,
+                "dropped",
+                f"connection closed: over {self.limits.max_malformed} malformed messages in {window:g} s",
+            )
+            self.door.close(client_id, 1008, "malformed messages")
 
     # -- the watchdog --------------------------------------------------------------------------------------------
     def _watch(self) -> None:
