@@ -19,6 +19,7 @@ from tpm_viz.numbers import parse_number
 from tpm_viz.params import PARAM_INFO, Params
 
 __all__ = [
+    "MAX_COUNT",
     "MAX_MESSAGE",
     "MAX_SECONDS",
     "MIN_SECONDS",
@@ -30,6 +31,7 @@ __all__ = [
     "port_number",
     "positive",
     "positive_float",
+    "within",
     "write_output",
 ]
 
@@ -37,6 +39,8 @@ MAX_MESSAGE = 300
 """Longest error message printed [characters] (a huge cell or argument is cut, never echoed whole)."""
 MIN_SECONDS, MAX_SECONDS = 1e-9, 1e6
 """Bounds of every duration and time step on the command line [s]."""
+MAX_COUNT = 100_000
+"""Most samples, random states and the like a count option may ask for (each costs a model evaluation or more)."""
 
 
 def one_line(message: str) -> str:
@@ -88,6 +92,20 @@ def positive(value: float | None, name: str) -> float | None:
     """``value`` if None or positive and finite; else :class:`~tpm_viz.errors.InputError` naming ``name``."""
     if value is not None and (not math.isfinite(value) or value <= 0):
         raise InputError(f"{name} must be a positive, finite number, got {value:g}")
+    return value
+
+
+def within(value: float, name: str, low: float, high: float, unit: str = "") -> float:
+    """``value`` if it is a finite number from ``low`` to ``high``; else a one-line
+    :class:`~tpm_viz.errors.InputError` naming ``name`` and the range (a 309-digit value is never printed whole)."""
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+    try:
+        ok = ok and math.isfinite(value) and low <= value <= high
+        shown = f"{value:g}"
+    except (OverflowError, TypeError, ValueError):  # an int beyond float range
+        ok, shown = False, str(value)[:12] + "..."
+    if not ok:
+        raise InputError(f"{name} must be from {low:g} to {high:g}{unit}, got {shown}")
     return value
 
 

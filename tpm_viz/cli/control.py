@@ -13,7 +13,7 @@ import argparse
 import math
 import sys
 
-from tpm_viz.cli.common import check_output, params_from_args, positive
+from tpm_viz.cli.common import check_output, params_from_args, positive, within
 from tpm_viz.csvio import read_text, write_columns
 from tpm_viz.errors import InputError
 from tpm_viz.paper.control import Gains
@@ -57,6 +57,15 @@ def _cmd_control(args) -> int:
     params = params_from_args(args)
     reference, duration, horizon = _reference(args)
     err = 0.0 if args.mass_error is None else args.mass_error
+    within(
+        args.wn, "--wn (natural frequency)", 1e-3, 1e4, " Hz"
+    )  # absurd values refused here, in one line, before any work
+    within(args.zeta, "--zeta (damping ratio)", 0.0, 1e3)
+    within(args.rate, "--rate", 1.0, 1e6, " Hz")
+    within(args.noise, "--noise", 0.0, 1.0, " m")
+    within(args.seed, "--seed", 0, 2**32 - 1)
+    within(err, "--mass-error", -0.99, 100.0)
+    within(args.payload, "--payload", 0.0, 1e4, " kg")
     setup = ControlSetup(
         controller=args.controller,
         gains=Gains(args.wn, args.zeta),
@@ -67,6 +76,7 @@ def _cmd_control(args) -> int:
         noise=args.noise,
         offset=_offset(args.offset),
         seed=args.seed,
+        feedforward_at=args.feedforward_at,
     )
     run = simulate(params, reference, setup, duration=duration, horizon=horizon)
     write_columns(args.output, run.columns())
@@ -113,6 +123,12 @@ def register(subparsers, common_parent: argparse.ArgumentParser) -> None:
     c.add_argument("--rate", type=float, default=1000.0, metavar="HZ", help="controller sample rate [Hz] (1000)")
     c.add_argument("--noise", type=float, default=0.0, metavar="M", help="std of the measured position [m] (0)")
     c.add_argument("--seed", type=int, default=0, help="seed of the measurement noise (0)")
+    c.add_argument(
+        "--feedforward-at",
+        choices=["sample", "mid"],
+        default="sample",
+        help="where in the hold interval the reference's acceleration (pdff: force) is fed forward (sample)",
+    )
     c.add_argument("--offset", metavar="X,Y", help="initial platform offset from the reference [m] (0,0)")
     c.add_argument("--output", help="output CSV (default: stdout)")
     c.set_defaults(func=_cmd_control)

@@ -13,7 +13,7 @@ import argparse
 import pathlib
 import sys
 
-from tpm_viz.cli.common import params_from_args, positive, positive_float, write_output
+from tpm_viz.cli.common import MAX_COUNT, params_from_args, positive, positive_float, within, write_output
 from tpm_viz.errors import InputError
 
 __all__ = ["REPLAY_COLUMNS", "register"]
@@ -40,8 +40,7 @@ def _cmd_crosscheck(args) -> int:
     from tpm_viz.multibody.crosscheck import Tolerances, crosscheck, format_table  # heavy layer
 
     params = params_from_args(args)
-    if args.random < 1:
-        raise InputError(f"--random must be at least 1, got {args.random}")
+    within(args.random, "--random", 1, MAX_COUNT)  # before any work (a billion states: out of memory)
     tol = Tolerances(
         rel=positive(args.rel_tol, "--rel-tol"),
         tracking=positive(args.tracking_tol, "--tracking-tol") * 1e-3,
@@ -65,8 +64,7 @@ def _cmd_figures(args) -> int:
     from tpm_viz.multibody.crosscheck import compare_forces  # the Pinocchio model
 
     params = params_from_args(args)
-    if args.samples < 2:
-        raise InputError(f"--samples must be at least 2, got {args.samples}")
+    within(args.samples, "--samples", 2, MAX_COUNT)
     durations = {
         "line": positive(args.duration_line, "--duration-line"),
         "circle": positive(args.duration_circle, "--duration-circle"),

@@ -8,19 +8,23 @@ loads matplotlib) is imported by the handler that runs. Handlers return the exit
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 
 import numpy as np
 
 from tpm_viz.app import paths
 from tpm_viz.app.sizing import format_sizing, size_trajectory, sizing_columns
-from tpm_viz.cli.common import check_output, params_from_args, positive
+from tpm_viz.cli.common import MAX_SECONDS, check_output, params_from_args, positive, within
 from tpm_viz.csvio import parse_columns, read_columns, read_text, write_columns
 from tpm_viz.errors import InputError
 from tpm_viz.paper.trajectories import trajectory_from_samples
 
-__all__ = ["PLAN_COLUMNS", "SIZE_INPUTS", "register"]
+__all__ = ["MAX_WAYPOINTS", "PLAN_COLUMNS", "SIZE_INPUTS", "register"]
+
+MAX_WAYPOINTS = 10_000
+"""Most waypoints in a ``plan --path FILE`` (each is a corner the planner must time; more is a sampled curve)."""
+MAX_CORNER_RADIUS = 1.0
+"""Largest ``--corner-radius`` [m] (the mechanism is a few hundred millimetres across)."""
 
 PLAN_COLUMNS = ["t", "p1", "p2", "dp1", "dp2", "ddp1", "ddp2", "tau1", "tau2"]
 """Columns of ``tpm-viz plan`` (SI units: s, m, m/s, m/s², N)."""
@@ -36,20 +40,22 @@ form; velocities and accelerations from the file when present, else from a natur
 
 
 def _cmd_plan(args) -> int:
+    dwell = within(0.0 if args.dwell is None else args.dwell, "--dwell", 0.0, MAX_SECONDS, " s")  # before any work
+    rate = positive(args.rate, "--rate")
+    if args.corner_radius is not None:
+        within(args.corner_radius, "--corner-radius", 0.0, MAX_CORNER_RADIUS, " m")
+    points = None
+    if args.path not in ("line", "circle", "pick"):
+        check_output(args.output, args.path)
+        cols = read_columns(args.path, ["p1", "p2"], max_rows=MAX_WAYPOINTS)  # refused while reading, before any work
+        points = np.stack([cols["p1"], cols["p2"]], -1)
     from tpm_viz.app import planner  # toppra, which loads matplotlib (1 s): only for this command
 
     params = params_from_args(args)
     limits = planner.Limits(args.force_limit, args.speed_limit, args.actuator_speed_limit)
-    dwell = 0.0 if args.dwell is None else args.dwell
-    if not math.isfinite(dwell) or dwell < 0:
-        raise InputError(f"--dwell must be zero or a positive number of seconds, got {dwell:g}")
-    rate = positive(args.rate, "--rate")
-    if args.path in ("line", "circle", "pick"):
+    if points is None:
         path = paths.path_for(params, args.path, corner_radius=args.corner_radius, pick=_pick_size(args.pick_size))
     else:
-        check_output(args.output, args.path)
-        cols = read_columns(args.path, ["p1", "p2"])
-        points = np.stack([cols["p1"], cols["p2"]], -1)
         path = paths.path_for(params, "waypoints", points, corner_radius=args.corner_radius)
     solve = planner.plan_cycle if args.path == "pick" else planner.plan_path
     plan = solve(params, path, limits, args.grid)
@@ -108,7 +114,9 @@ def _read_motion(path: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndar
 
 def _cmd_size(args) -> int:
     params = params_from_args(args)
-    dwell = 0.0 if args.dwell is None else args.dwell
+    dwell = within(0.0 if args.dwell is None else args.dwell, "--dwell", 0.0, MAX_SECONDS, " s")
+    if args.motor_constant is not None:
+        within(args.motor_constant, "--motor-constant", 1e-6, 1e6, " N/sqrt(W)")
     check_output(args.output, args.input)
     t, p, dp, ddp, tau = _read_motion(args.input)
     sizing = size_trajectory(params, t, p, dp, ddp, dwell, args.motor_constant, tau=tau)
