@@ -25,7 +25,7 @@ import numpy as np
 
 from tpm_viz.errors import InputError
 from tpm_viz.numbers import fixed
-from tpm_viz.paper.jacobians import classify
+from tpm_viz.paper.arrangement import Arrangement, classify
 from tpm_viz.paper.status import MOVE_LIMITS, STATUS_WORDS, PoseStatus, SingularityThresholds
 from tpm_viz.params import Params
 from tpm_viz.words import Phrase
@@ -269,16 +269,21 @@ def pick_and_place(start=(0.0, 0.0), size: PickSize = DEFAULT_PICK) -> Geometric
     return _polyline(PathKind.PICK, "pick", pts, r)
 
 
-def check_path(params: Params, path: GeometricPath, thresholds: SingularityThresholds = MOVE_LIMITS) -> None:
+def check_path(
+    params: Params,
+    path: GeometricPath,
+    thresholds: SingularityThresholds = MOVE_LIMITS,
+    arrangement: Arrangement = Arrangement.PERPENDICULAR,
+) -> None:
     """Raise :class:`InputError` at the first point (every :data:`CHECK_STEP`) outside the valid region.
 
     Valid: reachable (eq. 4), ``0 <= d_i <= Δd`` and ``min_i |cos θ_i|``, ``|cos(θ1 + θ2)|`` (eqs. 11-12) at least
-    the ``thresholds``.
+    the ``thresholds`` (for ``arrangement``: :func:`tpm_viz.paper.arrangement.classify`).
     """
     n = max(math.ceil(path.length / CHECK_STEP) + 1, 2)
     s = np.unique(np.concatenate([np.linspace(0.0, path.length, n), path.junctions]))
     p = path.evaluate(s)
-    status = classify(params, p, thresholds)
+    status = classify(arrangement, params, p, thresholds)
     bad = np.flatnonzero(status != PoseStatus.REGULAR)
     if bad.size:
         k = int(bad[0])
@@ -299,7 +304,7 @@ def _valid_centre(params: Params, thresholds: SingularityThresholds) -> np.ndarr
     """Centroid [m] of the valid region on a 81 x 81 grid over ``[-l_a, l_a]²`` (for placing default paths)."""
     xs = np.linspace(-params.l_a, params.l_a, 81)
     grid = np.stack(np.meshgrid(xs, xs), -1).reshape(-1, 2)
-    ok = classify(params, grid, thresholds) == PoseStatus.REGULAR
+    ok = classify(Arrangement.PERPENDICULAR, params, grid, thresholds) == PoseStatus.REGULAR
     if not np.any(ok):
         raise InputError(Phrase("the parameters leave no valid workspace: change the stroke or the lengths"))
     return grid[ok].mean(axis=0)

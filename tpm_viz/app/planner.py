@@ -36,8 +36,7 @@ from toppra.interpolator import AbstractGeometricPath
 
 from tpm_viz.app.paths import GeometricPath, check_path
 from tpm_viz.errors import InputError
-from tpm_viz.paper.dynamics import inverse_dynamics
-from tpm_viz.paper.jacobians import actuator_velocity
+from tpm_viz.paper.arrangement import Arrangement, actuator_velocity, inverse_dynamics
 from tpm_viz.params import Params
 from tpm_viz.words import Phrase, T
 
@@ -117,23 +116,29 @@ class _TimeLaw:
         return np.minimum(s, self.s_grid[-1]), self.sd[k] + self.u[k] * h, self.u[k]
 
 
-def _coefficients(params: Params, path: GeometricPath, s: np.ndarray, side: str = "right") -> tuple:
+def _coefficients(
+    params: Params, path: GeometricPath, s: np.ndarray, side: str = "right", arrangement=Arrangement.PERPENDICULAR
+) -> tuple:
     """``a(s) = τ(p, 0, p')`` and ``b(s) = τ(p, p', p'')`` [N s²/m], so that ``τ = a s̈ + b ṡ²`` (eqs. 29-31).
 
-    ``side`` picks the segment at a junction, where ``p''`` (hence ``b``) jumps.
+    ``side`` picks the segment at a junction, where ``p''`` (hence ``b``) jumps; ``arrangement`` picks the closed form
+    (:mod:`tpm_viz.paper.arrangement`).
     """
     p, ps, pss = path.evaluate(s), path.evaluate(s, 1), path.evaluate(s, 2, side)
     zero = np.zeros_like(p)
-    return inverse_dynamics(params, p, zero, ps), inverse_dynamics(params, p, ps, pss)
+    return inverse_dynamics(arrangement, params, p, zero, ps), inverse_dynamics(arrangement, params, p, ps, pss)
 
 
-def _speed_bound(params: Params, path: GeometricPath, s: np.ndarray, limits: Limits) -> np.ndarray:
+def _speed_bound(
+    params: Params, path: GeometricPath, s: np.ndarray, limits: Limits, arrangement=Arrangement.PERPENDICULAR
+) -> np.ndarray:
     """Upper bound on ``ṡ²`` [m²/s²] from the speed limits (``|p'| = 1``; ``ḋ = J p' ṡ``, eq. 9)."""
     bound = np.full(s.shape, np.inf)
     if limits.speed is not None:
         bound[:] = limits.speed**2
     if limits.actuator_speed is not None:
-        gain = np.max(np.abs(actuator_velocity(params, path.evaluate(s), path.evaluate(s, 1))), axis=-1)
+        velocity = actuator_velocity(arrangement, params, path.evaluate(s), path.evaluate(s, 1))
+        gain = np.max(np.abs(velocity), axis=-1)
         with np.errstate(divide="ignore"):
             bound = np.minimum(bound, (limits.actuator_speed / gain) ** 2)
     return bound
@@ -212,15 +217,17 @@ def _scale(a: np.ndarray) -> float:
     return 1.0 / float(np.median(np.max(np.abs(a), axis=1)))
 
 
-def _plan_one(params: Params, path: GeometricPath, limits: Limits, grid: int, rate: float) -> _TimeLaw:
+def _plan_one(
+    params: Params, path: GeometricPath, limits: Limits, grid: int, rate: float, arrangement=Arrangement.PERPENDICULAR
+) -> _TimeLaw:
     """The time law of one rest-to-rest motion, stretched if the ``rate`` check finds an overshoot."""
     s_grid = np.unique(np.concatenate([np.linspace(0.0, path.length, int(grid)), path.junctions]))
-    a, b = (x / limits.force for x in _coefficients(params, path, s_grid, "right"))
-    a_end, b_end = (x / limits.force for x in _coefficients(params, path, s_grid, "left"))
+    a, b = (x / limits.force for x in _coefficients(params, path, s_grid, "right", arrangement))
+    a_end, b_end = (x / limits.force for x in _coefficients(params, path, s_grid, "left", arrangement))
     # toppra's LP solver works with absolute tolerances: run it on σ = s / λ, where the coefficients are O(1)
     lam = _scale(a)
     start, end = (a * lam, b * lam**2), (a_end * lam, b_end * lam**2)
-    xmax = _speed_bound(params, path, s_grid, limits) / lam**2
+    xmax = _speed_bound(params, path, s_grid, limits, arrangement) / lam**2
     sd = lam * _toppra_speeds(_interpolation_rows(start, end, xmax, s_grid / lam), s_grid / lam)
     if not np.all(sd[1:-1] > 0):
         raise InputError(Phrase("no feasible timing within the limits along this path: raise the limits or the grid"))
@@ -234,18 +241,20 @@ def _plan_one(params: Params, path: GeometricPath, limits: Limits, grid: int, ra
             )
         )
     t = np.linspace(0.0, law.t_grid[-1], min(max(math.ceil(law.t_grid[-1] * rate) + 1, 2), MAX_CHECK))
-    peak = float(np.max(np.abs(_state(params, path, law, t)[-1]))) / limits.force
+    peak = float(np.max(np.abs(_state(params, path, law, t, arrangement)[-1]))) / limits.force
     return law.scaled(math.sqrt(peak)) if peak > 1.0 else law
 
 
-def _state(params: Params, path: GeometricPath, law: _TimeLaw, t: np.ndarray) -> tuple:
+def _state(
+    params: Params, path: GeometricPath, law: _TimeLaw, t: np.ndarray, arrangement=Arrangement.PERPENDICULAR
+) -> tuple:
     """``(s, ṡ, s̈, p, ṗ, p̈, τ)`` at local times ``t`` [s]: exact chain rule, closed-form ``τ`` (eqs. 29-31)."""
     s, ds, dds = law(t)
     ps, pss = path.evaluate(s, 1), path.evaluate(s, 2)
     p = path.evaluate(s)
     dp = ps * ds[..., None]
     ddp = ps * dds[..., None] + pss * (ds**2)[..., None]
-    return s, ds, dds, p, dp, ddp, inverse_dynamics(params, p, dp, ddp)
+    return s, ds, dds, p, dp, ddp, inverse_dynamics(arrangement, params, p, dp, ddp)
 
 
 @dataclass(frozen=True)
@@ -262,6 +271,7 @@ class Plan:
     paths: tuple[GeometricPath, ...]
     laws: tuple[_TimeLaw, ...] = field(repr=False)
     grid: int = DEFAULT_GRID
+    arrangement: Arrangement = Arrangement.PERPENDICULAR
 
     @property
     def starts(self) -> np.ndarray:
@@ -292,10 +302,11 @@ class Plan:
         out = [np.empty(t.shape) for _ in range(3)] + [np.empty((*t.shape, 2)) for _ in range(4)]
         for j, (path, law) in enumerate(zip(self.paths, self.laws, strict=True)):
             sel = k == j
-            for arr, val in zip(out, _state(self.params, path, law, t[sel] - starts[j]), strict=True):
+            state = _state(self.params, path, law, t[sel] - starts[j], self.arrangement)
+            for arr, val in zip(out, state, strict=True):
                 arr[sel] = val
         s, ds, dds, p, dp, ddp, tau = out
-        dd = actuator_velocity(self.params, p, dp)
+        dd = actuator_velocity(self.arrangement, self.params, p, dp)
         return PlanSamples(t, k, s, ds, dds, p, dp, ddp, tau, dd)
 
     def samples(self, rate: float = CHECK_RATE) -> PlanSamples:
@@ -343,26 +354,40 @@ def _check_grid(grid) -> int:
     return int(grid)
 
 
-def plan_path(params: Params, path: GeometricPath, limits: Limits, grid: int = DEFAULT_GRID) -> Plan:
+def plan_path(
+    params: Params,
+    path: GeometricPath,
+    limits: Limits,
+    grid: int = DEFAULT_GRID,
+    arrangement: Arrangement = Arrangement.PERPENDICULAR,
+) -> Plan:
     """The time-optimal rest-to-rest motion along ``path`` within ``limits``.
 
     The path is first checked against the valid region (:func:`~tpm_viz.app.paths.check_path`). ``grid`` points
     are spread evenly in arc length (the path's junctions are added). Minimum time is bang-bang in the force
-    limits: at almost every instant one actuator is at ``±F_max``.
+    limits: at almost every instant one actuator is at ``±F_max``. ``arrangement``: whose closed form (default the
+    paper's perpendicular one).
     """
     grid = _check_grid(grid)
-    check_path(params, path)
-    return Plan(path.name, params, limits, (path,), (_plan_one(params, path, limits, grid, CHECK_RATE),), grid)
+    check_path(params, path, arrangement=arrangement)
+    law = _plan_one(params, path, limits, grid, CHECK_RATE, arrangement)
+    return Plan(path.name, params, limits, (path,), (law,), grid, arrangement)
 
 
-def plan_cycle(params: Params, path: GeometricPath, limits: Limits, grid: int = DEFAULT_GRID) -> Plan:
+def plan_cycle(
+    params: Params,
+    path: GeometricPath,
+    limits: Limits,
+    grid: int = DEFAULT_GRID,
+    arrangement: Arrangement = Arrangement.PERPENDICULAR,
+) -> Plan:
     """There and back: ``path`` then :meth:`GeometricPath.reversed`, each rest-to-rest (a pick-and-place cycle).
 
     Both strokes are planned (without friction the back stroke is the forward one reversed in time, so both
     take the same time; the tests check it).
     """
     grid = _check_grid(grid)
-    check_path(params, path)
+    check_path(params, path, arrangement=arrangement)
     back = path.reversed()
-    laws = tuple(_plan_one(params, pth, limits, grid, CHECK_RATE) for pth in (path, back))
-    return Plan(path.name, params, limits, (path, back), laws, grid)
+    laws = tuple(_plan_one(params, pth, limits, grid, CHECK_RATE, arrangement) for pth in (path, back))
+    return Plan(path.name, params, limits, (path, back), laws, grid, arrangement)
