@@ -1,0 +1,95 @@
+"""Speed of the design atlas (a benchmark, not a test): per-design time, sweep throughput per worker, the 10,000-design
+atlas, and what a coarser planner grid costs in cycle-time accuracy.
+
+Target (issue 26): 10,000 designs with every index, cycle time included, within 10 minutes on the 2-core machine.
+
+Run: ``python benchmarks/bench_design.py`` (per-design times, throughput with 1 and 2 workers, planner grids);
+``python benchmarks/bench_design.py --full`` adds the 10,000-design atlas (``--planner-grid K`` for its grid).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # benchmarks/timing.py
+
+from timing import p95
+
+from tpm_viz.app.atlas import Vary, designs, sweep
+from tpm_viz.app.design import Settings, Task, evaluate
+from tpm_viz.paper.arrangement import Arrangement
+from tpm_viz.params import Params
+
+TASK = Task(-0.1, 0.1, -0.05, 0.05)
+TARGET_S = 600.0
+FULL = ["a=0.40:0.56:10", "b=0.06:0.12:10", "l_a=0.18:0.34:10", "stroke=0.2:0.4:10"]
+"""The 10,000-design grid (about half of it covers the task)."""
+SMALL = ["l_a=0.18:0.34:5", "stroke=0.2:0.4:4", "a=0.44:0.52:4"]
+"""An 80-design grid for the throughput per worker."""
+
+
+def per_design(grid_points: int, n: int = 20) -> list[float]:
+    rng = np.random.default_rng(1)
+    out = []
+    for _ in range(n):
+        params = Params.paper(l_a=float(rng.uniform(0.22, 0.32)), stroke=float(rng.uniform(0.28, 0.4)))
+        t0 = time.perf_counter()
+        evaluate(Arrangement.PERPENDICULAR, params, TASK, Settings(planner_grid=grid_points))
+        out.append(time.perf_counter() - t0)
+    return out
+
+
+def throughput(spec: list[str], workers: int, grid_points: int) -> tuple[float, int, int]:
+    grid = designs([Vary.parse(s) for s in spec])
+    t0 = time.perf_counter()
+    rows = sweep(Arrangement.PERPENDICULAR, Params.paper(), grid, TASK, Settings(planner_grid=grid_points), workers)
+    return time.perf_counter() - t0, len(grid), sum(bool(r["feasible"]) for r in rows)
+
+
+def accuracy(grids: tuple[int, ...] = (60, 100, 150, 300, 1000)) -> None:
+    rng = np.random.default_rng(2)
+    sets = [Params.paper(l_a=float(rng.uniform(0.22, 0.32)), stroke=float(rng.uniform(0.28, 0.4))) for _ in range(8)]
+    ref = [evaluate(Arrangement.PERPENDICULAR, p, TASK, Settings(planner_grid=2000)).cycle_time for p in sets]
+    for g in grids:
+        got = [evaluate(Arrangement.PERPENDICULAR, p, TASK, Settings(planner_grid=g)).cycle_time for p in sets]
+        err = [abs(a / b - 1) for a, b in zip(got, ref, strict=True)]
+        print(f"planner grid {g:5d}: cycle time vs grid 2000, largest relative error {max(err):.2e}")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--full", action="store_true", help="also run the 10,000-design atlas")
+    ap.add_argument("--planner-grid", type=int, default=300)
+    ap.add_argument("--workers", type=int, default=os.cpu_count() or 1)
+    args = ap.parse_args()
+    print(f"cores {os.cpu_count()}, task {TASK.text()} m, force limit 100 N")
+    for g in (300, 100):
+        t = per_design(g)
+        print(
+            f"one feasible design, planner grid {g}: "
+            f"median {statistics.median(t) * 1e3:.0f} ms, p95 {p95(t) * 1e3:.0f} ms"
+        )
+    for workers in (1, 2):
+        seconds, n, ok = throughput(SMALL, workers, args.planner_grid)
+        print(
+            f"sweep of {n} designs ({ok} feasible), {workers} worker(s), planner grid {args.planner_grid}: "
+            f"{seconds:.1f} s, {n / seconds:.1f} designs/s, {n / seconds / workers:.1f} designs/s per worker"
+        )
+    accuracy()
+    if args.full:
+        seconds, n, ok = throughput(FULL, args.workers, args.planner_grid)
+        print(
+            f"atlas of {n} designs ({ok} feasible), {args.workers} workers, planner grid {args.planner_grid}: "
+            f"{seconds:.0f} s ({seconds / 60:.1f} min; target {TARGET_S / 60:.0f} min, ratio {seconds / TARGET_S:.2f})"
+        )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,141 @@
+"""``tpm-viz design | compare | atlas``: the CSV columns, empty cells for an infeasible design, one-line refusals
+with status 2, the atlas's prototype and optimum rows; the comparison table of docs/design.md and the README comes
+from ``tpm-viz compare`` (run here)."""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import pathlib
+import re
+
+import pytest
+
+from tpm_viz.cli import main
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+COLUMNS = (
+    "arrangement,a,b,l_a,stroke,feasible,gci,cond_max,dyn_mean,dyn_max,peak_force,cycle_time,moving_mass,"
+    "footprint_x,footprint_y"
+).split(",")
+
+
+def _rows(path: pathlib.Path) -> list[dict[str, str]]:
+    return list(csv.DictReader(io.StringIO(path.read_text())))
+
+
+def test_design_writes_one_row_of_indices_in_si(tmp_path, capsys):
+    out = tmp_path / "d.csv"
+    assert main(["design", "--task=-0.1,0.1,-0.05,0.05", "--set", "m_p=3", "--output", str(out)]) == 0
+    (row,) = _rows(out)
+    assert list(row) == COLUMNS
+    assert row["arrangement"] == "perpendicular" and row["feasible"] == "1"
+    assert float(row["moving_mass"]) == pytest.approx(2 * 0.95 + 2 * 0.84 + 3.0)  # Table 2 with m_p = 3 kg
+    assert 0 < float(row["gci"]) <= 1 <= float(row["cond_max"])
+    assert float(row["dyn_mean"]) <= float(row["dyn_max"])
+    assert 0.1 < float(row["cycle_time"]) < 10 and float(row["footprint_x"]) > 0.2
+
+
+def test_an_infeasible_design_is_a_row_of_empty_cells_never_nan(tmp_path, capsys):
+    out = tmp_path / "d.csv"
+    argv = ["design", "--arrangement", "parallel", "--task=-0.1,0.1,-0.05,0.05", "--output", str(out)]
+    assert main(argv) == 0
+    (row,) = _rows(out)
+    assert row["feasible"] == "0" and row["l_a"] == "0.26000000000000001"
+    assert all(row[k] == "" for k in COLUMNS[6:])
+    assert "nan" not in out.read_text().lower()
+    assert "infeasible" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("argv", "match"),
+    [
+        (["design", "--task=0.1,-0.1,0,0.1"], "X0 < X1"),
+        (["design", "--task=0,1,2"], "four numbers"),
+        (["design", "--task=-0.1,0.1,-0.05,0.05", "--set", "l_a=-1"], "l_a"),
+        (["design", "--task=-0.1,0.1,-0.05,0.05", "--force-limit", "-5"], "force-limit"),
+        (["design", "--arrangement", "diagonal", "--task=0,1,0,1"], "invalid choice"),
+        (["atlas", "--vary", "q=1:2:3", "--task=-0.1,0.1,-0.05,0.05", "--output", "x.csv"], "NAME one of"),
+        (
+            ["atlas", "--vary", "a=1:2:3", "--task=-0.1,0.1,-0.05,0.05", "--output", "x.csv", "--workers", "0"],
+            "workers",
+        ),
+        (["atlas", "--vary", "a=1:2:3", "--task=-0.1,0.1,-0.05,0.05", "--output", "x.csv", "--footprint", "1"], "X,Y"),
+        (
+            ["atlas", "--vary", "a=0.4:0.5:2", "--task=-0.1,0.1,-0.05,0.05", "--output", "x.csv", "--scheduler", "x"],
+            "tcp://",
+        ),
+        (["compare", "--task=-0.1,0.1,-0.05,0.05", "--hold", "volume"], "invalid choice"),
+    ],
+)
+def test_bad_input_is_one_line_and_status_2(argv, match, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("tpm-viz: error:") and re.search(match, err)
+    assert not (tmp_path / "x.csv").exists()
+
+
+def test_atlas_marks_the_front_the_prototype_and_the_optimum(tmp_path, capsys):
+    out = tmp_path / "atlas.csv"
+    argv = ["atlas", "--vary", "l_a=0.18:0.34:3", "--vary", "stroke=0.2:0.4:3", "--task=-0.1,0.1,-0.05,0.05"]
+    argv += ["--grid", "60", "--workers", "1", "--footprint", "0.6,0.6", "--output", str(out)]
+    assert main(argv) == 0
+    rows = _rows(out)
+    assert list(rows[0])[: len(COLUMNS)] == COLUMNS and list(rows[0])[-2:] == ["pareto", "tag"]
+    grid, prototype, optimum = rows[:9], rows[9], rows[10]
+    firsts = [float(r[k]) for r in grid[:4] for k in ("l_a", "stroke")]
+    assert firsts == pytest.approx([0.18, 0.2, 0.18, 0.3, 0.18, 0.4, 0.26, 0.2])  # the last --vary fastest
+    assert prototype["tag"] == "prototype" and prototype["l_a"] == "0.26000000000000001"
+    assert optimum["tag"] == "optimum" and optimum["feasible"] == "1"
+    feasible = [r for r in grid if r["feasible"] == "1"]
+    assert feasible and len(feasible) < 9
+    assert all(all(r[k] == "" for k in COLUMNS[6:]) and r["pareto"] == "0" for r in grid if r["feasible"] == "0")
+    allowed = [r for r in feasible if float(r["footprint_x"]) <= 0.6 and float(r["footprint_y"]) <= 0.6]
+    assert float(optimum["cycle_time"]) <= min(float(r["cycle_time"]) for r in allowed)
+    assert float(optimum["footprint_x"]) <= 0.6 and float(optimum["footprint_y"]) <= 0.6
+    assert any(r["pareto"] == "1" for r in feasible)
+    err = capsys.readouterr().err
+    assert "9/9 designs" in err and f"{len(feasible)} feasible" in err
+
+
+def table_lines(rows: list[dict[str, str]], hold: str) -> list[str]:
+    """The comparison table as docs/design.md and the README print it (mm, N, ms; '—' for no design)."""
+    out = []
+    for r in rows:
+        if r["feasible"] != "1":
+            out.append(f"| {hold} | {r['case']} | {r['arrangement']} | none found within the hold | | | | | | |")
+            continue
+        f = {k: float(v) for k, v in r.items() if k not in ("case", "arrangement")}
+        out.append(
+            f"| {hold} | {r['case']} | {r['arrangement']} | {f['a'] * 1e3:.0f} / {f['l_a'] * 1e3:.0f} / "
+            f"{f['stroke'] * 1e3:.0f} | {f['gci']:.3f} | {f['cond_max']:.2f} | {f['dyn_max']:.2f} | "
+            f"{f['peak_force']:.0f} | {f['cycle_time'] * 1e3:.0f} | {f['footprint_x'] * 1e3:.0f} × "
+            f"{f['footprint_y'] * 1e3:.0f} |"
+        )
+    return out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("hold", ["link", "footprint"])
+def test_the_comparison_table_in_the_docs_is_what_compare_prints(hold, tmp_path):
+    out = tmp_path / f"compare_{hold}.csv"
+    assert main(["compare", "--task=-0.1,0.1,-0.05,0.05", "--hold", hold, "--output", str(out)]) == 0
+    rows = _rows(out)
+    assert [(r["case"], r["arrangement"]) for r in rows] == [
+        ("given", "perpendicular"),
+        ("given", "parallel"),
+        ("optimum", "perpendicular"),
+        ("optimum", "parallel"),
+    ]
+    lines = table_lines(rows, hold)
+    docs = (ROOT / "docs" / "design.md").read_text()
+    for line in lines:
+        assert line in docs, line
+    readme = (ROOT / "README.md").read_text()
+    if "| hold | case | arrangement |" in readme:  # the README's section quotes the same table
+        for line in lines:
+            assert line in readme, line
+    given = rows[0]
+    assert not math.isnan(float(given["gci"]))
