@@ -1,10 +1,11 @@
-"""``tpm-viz export --format mjcf|urdf --output FILE``: the mechanism as a model file for other tools.
+"""``tpm-viz export --format mjcf|urdf --output FILE`` and ``--format c --output DIR``: the mechanism for other tools.
 
 :func:`register` adds the subcommand to the ``tpm-viz`` parser (:mod:`tpm_viz.cli`). The text comes from
 :mod:`tpm_viz.exchange` (no MuJoCo or Pinocchio needed to write it). The file is written atomically: a
 temporary file in the same directory, then ``os.replace``, so a reader never sees half a model. ``--output -``
-prints to stdout. The handler returns the exit status and raises :class:`~tpm_viz.errors.TpmVizError` for bad
-input (``cli.main`` prints one line and exits with 2).
+prints to stdout. ``--format c`` writes ``tpm_2ppa.h`` and ``tpm_2ppa.c`` (:mod:`tpm_viz.exchange.c_code`) into
+the directory ``--output`` (created if missing), each file atomically. The handler returns the exit status and
+raises :class:`~tpm_viz.errors.TpmVizError` for bad input (``cli.main`` prints one line and exits with 2).
 """
 
 from __future__ import annotations
@@ -21,8 +22,8 @@ from tpm_viz.errors import InputError
 
 __all__ = ["FORMATS", "register", "write_atomically"]
 
-FORMATS = ("mjcf", "urdf")
-"""Export formats: MJCF (MuJoCo, Pinocchio's MJCF reader) and URDF."""
+FORMATS = ("mjcf", "urdf", "c")
+"""Export formats: MJCF (MuJoCo, Pinocchio's MJCF reader), URDF and C99 source (the closed form, issue 27)."""
 
 
 def _file_mode(path: str) -> int:
@@ -40,7 +41,10 @@ def write_atomically(path: str, text: str) -> None:
     directory = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(directory):
         raise InputError(f"cannot write --output {path!r}: directory {directory!r} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=".tpm-viz-export-", suffix=".tmp", dir=directory)
+    try:  # a failure names the user's path, never the temporary file
+        fd, tmp = tempfile.mkstemp(prefix=".tpm-viz-export-", suffix=".tmp", dir=directory)
+    except OSError as exc:
+        raise OSError(exc.errno, exc.strerror, path) from None
     try:
         os.fchmod(fd, _file_mode(path))  # mkstemp makes 0600; give the file the mode a plain open() would
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
@@ -48,10 +52,27 @@ def write_atomically(path: str, text: str) -> None:
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise OSError(exc.errno, exc.strerror, path) from None
         raise
+
+
+def _write_c(params, directory: str) -> None:
+    from tpm_viz.exchange.c_code import c_files
+
+    if directory == "-":
+        raise InputError("--format c writes two files: give a directory as --output, not '-'")
+    if os.path.exists(directory) and not os.path.isdir(directory):
+        raise InputError(f"--output {directory!r} is a file: --format c needs a directory (created if missing)")
+    try:
+        os.makedirs(directory, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"cannot create the directory --output {directory!r}: {exc.strerror}") from None
+    for name, text in c_files(params).items():
+        write_atomically(os.path.join(directory, name), text)
 
 
 def _cmd_export(args) -> int:
@@ -59,6 +80,11 @@ def _cmd_export(args) -> int:
     from tpm_viz.exchange.urdf import urdf_text
 
     params = params_from_args(args)
+    if args.format == "c":
+        if args.timestep is not None:
+            raise InputError("--timestep applies to --format mjcf only")
+        _write_c(params, args.output)
+        return 0
     if args.format == "mjcf":
         settings = DEFAULT_SETTINGS
         if args.timestep is not None:
@@ -81,14 +107,20 @@ def register(subparsers, common_parent: argparse.ArgumentParser) -> None:
     e = subparsers.add_parser(
         "export",
         parents=[common_parent],
-        help="write the mechanism as an MJCF (MuJoCo, Pinocchio) or URDF model file",
+        help="write the mechanism as an MJCF (MuJoCo, Pinocchio) or URDF model file, or its closed form as C",
         description="Write every body of the 2-PPa TPM with the paper's mass model. MJCF: loop closures as "
         "<equality><connect> with stiff solver settings and the recommended time step (read by MuJoCo and by "
         "pinocchio.buildModelsAndConstraintsFromMJCF). URDF: a tree, the parallelograms as mimic joints, the "
-        "leg closure documented in an XML comment.",
+        "leg closure documented in an XML comment. C: tpm_2ppa.h and tpm_2ppa.c, the closed-form kinematics, "
+        "dynamics and computed-torque law for a real-time controller (C99, libm only; docs/realtime.md).",
     )
-    e.add_argument("--format", required=True, choices=FORMATS, help="mjcf or urdf")
-    e.add_argument("--output", required=True, metavar="FILE", help="output file, replaced atomically ('-': stdout)")
+    e.add_argument("--format", required=True, choices=FORMATS, help="mjcf, urdf or c")
+    e.add_argument(
+        "--output",
+        required=True,
+        metavar="FILE",
+        help="output file, replaced atomically ('-': stdout); for --format c a directory (created if missing)",
+    )
     e.add_argument(
         "--timestep",
         type=float,
