@@ -27,12 +27,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from tpm_viz.errors import SingularConfigurationError
-from tpm_viz.paper.jacobians import actuator_velocity, eq14_row
+from tpm_viz.paper.jacobians import actuator_velocity
 from tpm_viz.paper.kinematics import as_xy, finite_result, inverse_kinematics, leg_components
 from tpm_viz.params import Params
 from tpm_viz.words import Phrase, T
 
-__all__ = ["DynamicsResult", "inverse_dynamics", "inverse_dynamics_detail", "kinetic_energy"]
+__all__ = ["SINGULAR_TOL", "DynamicsResult", "inverse_dynamics", "inverse_dynamics_detail", "kinetic_energy"]
 
 
 @dataclass(frozen=True)
@@ -52,7 +52,8 @@ class DynamicsResult:
 
 
 def _v_leg(mp, mb, pi, pj, dpi, dpj, ddpi, ci, cj, ddi, ddj, dddj):
-    """``v_i`` below eq. (29) [N]; ``j`` is the other leg. Floats or arrays."""
+    """``v_i`` below eq. (29) [N] as printed; ``j`` is the other leg. Floats or arrays. :func:`_procedure` computes
+    the same terms regrouped; this form is the tests' reference for the regrouping."""
     return (
         (mp + mb / 3.0) * ddpi
         - mb * pj * ddi * dpj / (2.0 * ci**2)
@@ -64,7 +65,7 @@ def _v_leg(mp, mb, pi, pj, dpi, dpj, ddpi, ci, cj, ddi, ddj, dddj):
 
 
 def _w_leg(ma, mb, pj, dpi, dpj, ddpj, ci, dddi):
-    """``w_i`` below eq. (31) [N]. Floats or arrays."""
+    """``w_i`` below eq. (31) [N] as printed. Floats or arrays (the tests' reference, see :func:`_v_leg`)."""
     return (
         (ma + mb) * dddi
         - mb * dpj**2 / (2.0 * ci)
@@ -76,56 +77,95 @@ def _w_leg(ma, mb, pj, dpi, dpj, ddpj, ci, dddi):
 def _procedure(params: Params, p1, p2, dp1, dp2, ddp1, ddp2, c1, c2, f1, f2) -> tuple:
     """Steps (b)-(e) on components (floats or equal-shape arrays); ``c_i = p_i - d_i + a - b``.
 
-    Returns ``(dd1, dd2, ddd1, ddd2, v1, v2, w1, w2, lam1, lam2, tau1, tau2)``.
+    Returns ``(dd1, dd2, ddd1, ddd2, v1, v2, w1, w2, lam1, lam2, tau1, tau2)``. The terms of ``v_i`` and ``w_i``
+    are those printed below eqs. (29) and (31) (:func:`_v_leg`, :func:`_w_leg`) regrouped with
+    ``t_i = tan θ_i = p_j / c_i`` (eq. 23), ``ω_i = θ̇_i = ṗ_j / c_i`` (eq. 24) and ``q_i = t_i ω_i`` so that
+    each appears once (~110 operations instead of ~190; ``tests/paper/test_dynamics_factored.py`` checks the
+    regrouping against the printed forms). The generated C (:mod:`tpm_viz.exchange.c_code`) is traced from here.
     """
-    dd1 = dp1 + p2 * dp2 / c1  # (b) eq. (9): ḋ_i = ṗ_i + tan θ_i ṗ_j
-    dd2 = dp2 + p1 * dp1 / c2
-    ddd1 = eq14_row(p1, p2, dp1, dp2, ddp1, ddp2, c1, dd1)  # (c) eq. (14)
-    ddd2 = eq14_row(p2, p1, dp2, dp1, ddp2, ddp1, c2, dd2)
+    u1, u2 = 1.0 / c1, 1.0 / c2
+    t1, t2 = p2 * u1, p1 * u2  # tan θ_i
+    o1, o2 = dp2 * u1, dp1 * u2  # θ̇_i
+    dd1 = dp1 + t1 * dp2  # (b) eq. (9): ḋ_i = ṗ_i + tan θ_i ṗ_j
+    dd2 = dp2 + t2 * dp1
+    q1, q2 = t1 * o1, t2 * o2
+    k1, k2 = q1 * dd1, q2 * dd2
+    ddd1 = o1 * (dp2 - t1 * dp1) + ddp1 + t1 * ddp2 + k1  # (c) eq. (14), corrected eq. (15): jacobians.eq14_row
+    ddd2 = o2 * (dp1 - t2 * dp2) + ddp2 + t2 * ddp1 + k2
     mp, ma, mb = params.m_p, params.m_a, params.m_b
-    v1 = _v_leg(mp, mb, p1, p2, dp1, dp2, ddp1, c1, c2, dd1, dd2, ddd2) - f1  # eq. (28): v - f
-    v2 = _v_leg(mp, mb, p2, p1, dp2, dp1, ddp2, c2, c1, dd2, dd1, ddd1) - f2
-    # (d) eq. (29): [[2c1, 2p1], [2p2, 2c2]] λ = v; determinant 4 (c1 c2 - p1 p2) = 4 l_a² det J_x.
-    det = 4.0 * (c1 * c2 - p1 * p2)
-    lam1 = (2.0 * c2 * v1 - 2.0 * p1 * v2) / det
-    lam2 = (2.0 * c1 * v2 - 2.0 * p2 * v1) / det
-    w1 = _w_leg(ma, mb, p2, dp1, dp2, ddp2, c1, ddd1)
-    w2 = _w_leg(ma, mb, p1, dp2, dp1, ddp1, c2, ddd2)
+    h, r, m0, m1 = 0.5 * mb, mb / 3.0, mp + mb / 3.0, ma + mb
+    e1, e2 = r * (q1 * q1 * c1), r * (q2 * q2 * c2)  # m_b p_j² ṗ_j² / (3 c_i³)
+    # with ḋ_i - ṗ_i = t_i ṗ_j (eq. 9): (ḋ_i ṗ_i - ḋ_i²) / c_i - d̈_i = -(k_i + d̈_i), 2 ṗ_j (ḋ_i - ṗ_i) / c_i = 2 q_i ṗ_j
+    n1, n2 = k1 + ddd1, k2 + ddd2
+    g1, g2 = q1 * dp2, q2 * dp1  # r g_i = m_b p_j ṗ_j² / (3 c_i²), a term of v_j
+    ht1, ht2 = h * t1, h * t2
+    v1 = m0 * ddp1 - h * k1 + e1 - ht2 * n2 + r * g2 + r * (t2 * t2) * (2.0 * g2 + ddp1) - f1
+    v2 = m0 * ddp2 - h * k2 + e2 - ht1 * n1 + r * g1 + r * (t1 * t1) * (2.0 * g1 + ddp2) - f2
+    # (d) eq. (29): [[2c1, 2p1], [2p2, 2c2]] λ = v - f (eq. 28); determinant 4 (c1 c2 - p1 p2) = 4 l_a² det J_x.
+    g = 0.5 / (c1 * c2 - p1 * p2)
+    lam1 = (c2 * v1 - p1 * v2) * g
+    lam2 = (c1 * v2 - p2 * v1) * g
+    w1 = m1 * ddd1 - h * o1 * dp2 - e1 + ht1 * (dp1 * o1 - ddp2)
+    w2 = m1 * ddd2 - h * o2 * dp1 - e2 + ht2 * (dp2 * o2 - ddp1)
     return dd1, dd2, ddd1, ddd2, v1, v2, w1, w2, lam1, lam2, w1 + 2.0 * lam1 * c1, w2 + 2.0 * lam2 * c2  # (e)
 
 
-_SINGULAR_TOL = 1e-12
+SINGULAR_TOL = 1e-12
+"""The closed form refuses a pose with ``|c_1 c_2| < SINGULAR_TOL l_a²`` (``|cos θ1 cos θ2|`` below it, eq. 11)
+or ``|c_1 c_2 - p_1 p_2| < SINGULAR_TOL l_a²`` (``|cos(θ1 + θ2)|`` below it, eq. 12); the generated C too."""
+
+
+_EQ11 = "cos θ1 cos θ2 = 0 (eq. 11)"
+_EQ12 = "cos(θ1 + θ2) = 0 (eq. 12)"
 
 
 def _check_regular(params: Params, c1, c2, p1, p2) -> None:
     l2 = params.l_a**2
-    if np.any(np.abs(c1 * c2) < _SINGULAR_TOL * l2):
-        raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq="cos θ1 cos θ2 = 0 (eq. 11)"))
-    if np.any(np.abs(c1 * c2 - p1 * p2) < _SINGULAR_TOL * l2):
-        raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq="cos(θ1 + θ2) = 0 (eq. 12)"))
+    if np.any(np.abs(c1 * c2) < SINGULAR_TOL * l2):
+        raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq=_EQ11))
+    if np.any(np.abs(c1 * c2 - p1 * p2) < SINGULAR_TOL * l2):
+        raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq=_EQ12))
 
 
-def _vectorised(params: Params, p, dp, ddp, f_ext, d) -> tuple:
+_BLOCK = 8192
+"""States per block of the vectorised path: its temporaries (64 KiB each) stay in the cache, below the allocator's
+mmap threshold; 2-3x faster than whole 10^5-state arrays, ~1.4x faster than blocks of 2048 where numpy's per-call
+overhead starts to count (benchmarks/bench_core.py)."""
+
+
+def _vectorised(params: Params, p, dp, ddp, f_ext, d, outputs: tuple[int, ...] = tuple(range(12))) -> tuple:
+    """Steps (a)-(e) on broadcast arrays: returns ``(p, dp, ddp, d, out)``; ``out[k]`` (shape ``(...)``) is the
+    ``outputs[k]``-th result of :func:`_procedure`; ``d`` is None unless every output is wanted."""
     p, dp, ddp = np.broadcast_arrays(as_xy(p), as_xy(dp, "dp"), as_xy(ddp, "ddp"))
-    d = inverse_kinematics(params, p) if d is None else np.broadcast_to(as_xy(d, "d"), p.shape)  # (a)
     f = np.zeros(2) if f_ext is None else as_xy(f_ext, "f_ext")
-    c, _ = leg_components(params, p, d)
-    _check_regular(params, c[..., 0], c[..., 1], p[..., 0], p[..., 1])
+    shape = p.shape[:-1]
+    n = math.prod(shape)
+    cols = np.empty((10, n))  # rows p1 p2 dp1 dp2 ddp1 ddp2 c1 c2 f1 f2, each contiguous
+    for k, arr in enumerate((p, dp, ddp)):
+        cols[2 * k : 2 * k + 2] = arr.reshape(n, 2).T
+    cols[8:10] = np.broadcast_to(f, p.shape).reshape(n, 2).T
+    working = d is None
+    if working:  # (a) eq. (4), working mode: c_i = sqrt(l_a² - p_j²) (in the loop), d_i = p_i + a - b - c_i
+        if n and not np.abs(cols[0:2]).max() < params.l_a:
+            inverse_kinematics(params, p)  # raises the precise error
+    else:
+        d = np.broadcast_to(as_xy(d, "d"), p.shape)
+        cols[6:8] = leg_components(params, p, d)[0].reshape(n, 2).T
+    la2 = params.l_a**2
+    out = np.empty((len(outputs), n))
     with np.errstate(over="ignore", invalid="ignore"):
-        out = _procedure(
-            params,
-            p[..., 0],
-            p[..., 1],
-            dp[..., 0],
-            dp[..., 1],
-            ddp[..., 0],
-            ddp[..., 1],
-            c[..., 0],
-            c[..., 1],
-            f[..., 0],
-            f[..., 1],
-        )
-    return p, dp, ddp, d, out
+        for start in range(0, n, _BLOCK):  # block by block: every pass over the states stays in the cache
+            blk = cols[:, start : start + _BLOCK]
+            if working:
+                np.sqrt(la2 - blk[1] ** 2, out=blk[6])
+                np.sqrt(la2 - blk[0] ** 2, out=blk[7])
+            _check_regular(params, blk[6], blk[7], blk[0], blk[1])
+            block = _procedure(params, *blk)
+            for row, k in enumerate(outputs):
+                out[row, start : start + _BLOCK] = block[k]
+    if working and len(outputs) == 12:
+        d = (cols[0:2] + params.offset - cols[6:8]).T.reshape(p.shape)
+    return p, dp, ddp, d, out.reshape(len(outputs), *shape)
 
 
 def inverse_dynamics_detail(params: Params, p, dp, ddp, f_ext=None, d=None) -> DynamicsResult:
@@ -142,49 +182,68 @@ def inverse_dynamics_detail(params: Params, p, dp, ddp, f_ext=None, d=None) -> D
     return DynamicsResult(p=p, dp=dp, ddp=ddp, d=d, dd=dd, ddd=ddd, v=v, w=w, lam=lam, tau=tau)
 
 
-def _inverse_dynamics_one(params: Params, p, dp, ddp, f_ext, d=None) -> np.ndarray | None:
-    """Fast path for one state given as length-2 sequences: pure ``math``, no temporaries.
-
-    Returns None when the input is not a plain single state (the caller then vectorises).
-    """
-    try:
-        p1, p2 = float(p[0]), float(p[1])
-        dp1, dp2 = float(dp[0]), float(dp[1])
-        ddp1, ddp2 = float(ddp[0]), float(ddp[1])
-        f1, f2 = (0.0, 0.0) if f_ext is None else (float(f_ext[0]), float(f_ext[1]))
-        d1, d2 = (0.0, 0.0) if d is None else (float(d[0]), float(d[1]))
-        if d is not None and len(d) != 2:
+def _pair(x) -> tuple[float, float] | None:
+    """``x`` as two floats if it is one 2-vector (a sequence or an array of shape ``(2,)``), else None."""
+    if isinstance(x, np.ndarray):
+        if x.shape != (2,):
             return None
-    except (TypeError, ValueError, IndexError):
+        x = x.tolist()
+    elif not isinstance(x, (list, tuple)) or len(x) != 2:
         return None
-    vals = (p1, p2, dp1, dp2, ddp1, ddp2, f1, f2, d1, d2)
-    if not all(map(math.isfinite, vals)) or not abs(p1) < params.l_a or not abs(p2) < params.l_a:
-        return None  # let the vectorised path raise the precise error
-    la2 = params.l_a**2
-    if d is None:
+    try:
+        return float(x[0]), float(x[1])
+    except (TypeError, ValueError):
+        return None
+
+
+def _inverse_dynamics_one(params: Params, p, dp, ddp, f_ext, d=None) -> np.ndarray | None:
+    """Fast path for one state given as 2-vectors: pure ``math``, no array temporaries (~5 µs).
+
+    Returns None when the input is not a plain single state, or not finite (the caller then vectorises,
+    which raises the precise error).
+    """
+    pp, vv, aa = _pair(p), _pair(dp), _pair(ddp)
+    ff = (0.0, 0.0) if f_ext is None else _pair(f_ext)
+    dd = None if d is None else _pair(d)
+    if pp is None or vv is None or aa is None or ff is None or (d is not None and dd is None):
+        return None
+    (p1, p2), (dp1, dp2), (ddp1, ddp2), (f1, f2) = pp, vv, aa, ff
+    la = params.l_a
+    isfinite = math.isfinite
+    if not (abs(p1) < la and abs(p2) < la and isfinite(dp1 + dp2) and isfinite(ddp1 + ddp2) and isfinite(f1 + f2)):
+        return None  # unreachable or not finite (a sum of two finite floats may overflow: then vectorise too)
+    la2 = la**2
+    if dd is None:
         c1, c2 = math.sqrt(la2 - p2 * p2), math.sqrt(la2 - p1 * p1)  # eq. (4): c_i = sqrt(l_a² - p_j²)
     else:
-        c1, c2 = p1 - d1 + params.offset, p2 - d2 + params.offset  # c_i = l_a cos θ_i on d's branch
-    _check_regular(params, c1, c2, p1, p2)
+        if not isfinite(dd[0] + dd[1]):
+            return None
+        c1, c2 = p1 - dd[0] + params.offset, p2 - dd[1] + params.offset  # c_i = l_a cos θ_i on d's branch
+    if abs(c1 * c2) < SINGULAR_TOL * la2:
+        raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq=_EQ11))
+    if abs(c1 * c2 - p1 * p2) < SINGULAR_TOL * la2:
+        raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq=_EQ12))
     try:
         out = _procedure(params, p1, p2, dp1, dp2, ddp1, ddp2, c1, c2, f1, f2)
+        tau1, tau2 = out[10], out[11]
     except OverflowError:
-        out = (math.inf,) * 12
-    return finite_result(np.array(out[10:12]), T("the actuator forces"))
+        tau1 = tau2 = math.inf
+    if not (isfinite(tau1) and isfinite(tau2)):
+        finite_result(np.array([tau1, tau2]), T("the actuator forces"))  # raises
+    return np.array((tau1, tau2))
 
 
 def inverse_dynamics(params: Params, p, dp, ddp, f_ext=None, d=None) -> np.ndarray:
     """Actuator forces ``τ`` [N], shape ``(..., 2)``, by the paper's closed form (eqs. 29, 31).
 
-    See :func:`inverse_dynamics_detail` for the arguments and the intermediates. One state of
-    shape ``(2,)`` (with or without ``d``) takes a scalar fast path (same formulas, ~10 µs).
+    See :func:`inverse_dynamics_detail` for the arguments and the intermediates. One state given as 2-vectors
+    (with or without ``d``) takes a scalar fast path (same formulas, same refusals, ~5 µs).
     """
-    if np.ndim(p) == 1 and np.ndim(dp) == 1 and np.ndim(ddp) == 1 and np.ndim(f_ext) <= 1 and np.ndim(d) <= 1:
-        if len(p) == 2 and len(dp) == 2 and len(ddp) == 2:
-            tau = _inverse_dynamics_one(params, p, dp, ddp, f_ext, d)
-            if tau is not None:
-                return tau
-    return finite_result(np.stack(_vectorised(params, p, dp, ddp, f_ext, d)[4][10:12], -1), T("the actuator forces"))
+    tau = _inverse_dynamics_one(params, p, dp, ddp, f_ext, d)
+    if tau is not None:
+        return tau
+    out = _vectorised(params, p, dp, ddp, f_ext, d, (10, 11))[4]
+    return finite_result(np.stack((out[0], out[1]), -1), T("the actuator forces"))
 
 
 def kinetic_energy(params: Params, p, dp, d=None) -> np.ndarray:
