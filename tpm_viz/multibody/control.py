@@ -10,9 +10,12 @@ Controller: one of the laws of :mod:`tpm_viz.paper.control` on the paper's close
 parameters (relative mass errors of ``m_a``, ``m_b``, ``m_p``), sampled at ``rate`` [Hz] with a
 zero-order hold: at ``t_k = k / rate`` it reads the platform state ``(p, ṗ)`` plus seeded Gaussian
 noise, computes ``τ_k`` and clips it to ``±force_limit`` [N]; the plant integrates with ``τ_k`` constant
-until ``t_{k+1}`` (RK4 sub-steps of at most :data:`MAX_PLANT_STEP`). Since ``τ`` is constant on each hold
-interval, the actuator work over it is exactly ``τ_k · (d(t_{k+1}) - d(t_k))`` (the tests use this for the
-energy balance). The plant starts at ``p_ref(0) + offset`` with ``ṗ = ṗ_ref(0)``.
+until ``t_{k+1}`` (RK4 sub-steps of at most :data:`MAX_PLANT_STEP`). The hold makes the error of an exact
+model proportional to the sample period (the force lags by half a period); with ``feedforward_at="mid"`` the
+reference's acceleration (``ctc``) or closed-form force (``pdff``) is taken at ``t_k + 1/(2 rate)``, the middle
+of the hold, which removes most of that lag (``tests/multibody/test_control_midpoint.py``). Since ``τ`` is
+constant on each hold interval, the actuator work over it is exactly ``τ_k · (d(t_{k+1}) - d(t_k))`` (the tests
+use this for the energy balance). The plant starts at ``p_ref(0) + offset`` with ``ṗ = ṗ_ref(0)``.
 
 This module does not import Pinocchio itself.
 """
@@ -21,6 +24,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import SupportsFloat
 
 import numpy as np
 
@@ -44,7 +48,7 @@ COLUMNS = ["t", "p1_ref", "p2_ref", "p1", "p2", "e1", "e2", "tau1", "tau2", "tau
 """CSV columns of :meth:`ControlRun.columns` (SI: s, m, N)."""
 
 
-def _number(value, name: str, low: float = 0.0) -> float:
+def _number(value: str | SupportsFloat, name: str, low: float = 0.0) -> float:
     try:
         value = float(value)
     except (TypeError, ValueError):
@@ -68,6 +72,7 @@ class ControlSetup:
     velocity_noise: float = 0.0  # standard deviation of the measured platform velocity, per axis [m/s]
     offset: tuple[float, float] = (0.0, 0.0)  # initial platform position minus the reference's [m]
     seed: int = 0  # seed of the measurement noise
+    feedforward_at: str = "sample"  # "sample": the reference's p̈ (and τ_ff) at t_k; "mid": at t_k + 1/(2 rate)
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -87,6 +92,8 @@ class ControlSetup:
             if limit <= 0:
                 raise InputError(f"force limit [N] must be positive, got {limit:g}")
             set_(self, "force_limit", limit)
+        if self.feedforward_at not in ("sample", "mid"):
+            raise InputError(f"feedforward_at must be 'sample' or 'mid', got {self.feedforward_at!r}")
         set_(self, "noise", _number(self.noise, "position noise [m]"))
         set_(self, "velocity_noise", _number(self.velocity_noise, "velocity noise [m/s]"))
         if len(self.offset) != 2:
@@ -162,7 +169,7 @@ class ControlRun:
         )
 
 
-def _horizon(reference, duration, horizon) -> tuple[str, float]:
+def _horizon(reference: str | Trajectory, duration: float | None, horizon: float | None) -> tuple[str, float]:
     if isinstance(reference, Trajectory):
         if duration is not None:
             raise InputError("a sampled trajectory has its own duration: give horizon for a longer run")
@@ -174,7 +181,7 @@ def _horizon(reference, duration, horizon) -> tuple[str, float]:
 
 def simulate(
     params: Params,
-    reference,
+    reference: str | Trajectory,
     setup: ControlSetup | None = None,
     duration: float | None = None,
     horizon: float | None = None,
@@ -203,6 +210,9 @@ def simulate(
     model_params = model_with_errors(params, *setup.mass_error)
     law = ControlLaw(setup.controller, model_params, setup.gains)
     rows = law.sample(t, p_ref, dp_ref, ddp_ref).rows()
+    if setup.feedforward_at == "mid":  # the hold's average force is the law's at mid-interval: feed that forward
+        mid = law.sample(t, *reference_state(reference, t + start + 0.5 / setup.rate, duration)).rows()
+        rows = [r[:4] + m[4:6] + r[6:10] + m[10:12] for r, m in zip(rows, mid, strict=True)]
     force = law.force_function()
     acc = PlatformPlant(model_for(plant_params)).acceleration
 

@@ -35,7 +35,7 @@ from tpm_viz.numbers import fixed
 
 # _procedure: the scalar steps (b)-(e) of eqs. (9)-(31); the public single-state inverse_dynamics adds numpy
 # checks that cost ~25 µs per call, too slow for a 1 kHz loop in Python (the checks are done here in floats).
-from tpm_viz.paper.dynamics import _procedure, inverse_dynamics
+from tpm_viz.paper.dynamics import SINGULAR_TOL, _procedure, inverse_dynamics
 from tpm_viz.paper.jacobians import actuator_velocity
 from tpm_viz.paper.kinematics import inverse_kinematics
 from tpm_viz.paper.trajectories import Trajectory, circle_state, line_state, paper_duration
@@ -43,6 +43,7 @@ from tpm_viz.params import Params
 from tpm_viz.words import Phrase
 
 __all__ = [
+    "CTC_DIRECT_TOL",
     "ControlLaw",
     "ControllerKind",
     "Gains",
@@ -50,6 +51,7 @@ __all__ = [
     "axis_masses",
     "model_with_errors",
     "reference_state",
+    "task_space_command",
 ]
 
 
@@ -208,6 +210,18 @@ class ReferenceSamples:
 
 
 # ----------------------------------------------------------------------------- the laws
+CTC_DIRECT_TOL = 1e-9
+"""The computed-torque law refuses a measured pose with ``|c_1 c_2 - p_1 p_2| < CTC_DIRECT_TOL l_a²``, i.e.
+``|cos(θ1 + θ2)|`` below it (eq. 12); at the inverse singularity it refuses where the closed form does
+(``SINGULAR_TOL``, eq. 11). The generated C (:mod:`tpm_viz.exchange.c_code`) reads both from here."""
+
+
+def task_space_command(p_ref, dp_ref, ddp_ref, p, dp, kp, kd):
+    """The computed-torque law's commanded acceleration on one axis [m/s²]:
+    ``p̈_ref + K_d (ṗ_ref - ṗ) + K_p (p_ref - p)`` (floats, arrays, or the C generator's symbols)."""
+    return ddp_ref + kd * (dp_ref - dp) + kp * (p_ref - p)
+
+
 @dataclass(frozen=True)
 class ControlLaw:
     """One controller: its ``kind``, its own model ``params`` (possibly wrong) and its ``gains``."""
@@ -251,8 +265,7 @@ class ControlLaw:
         m1, m2 = self.masses
 
         def legs(p1, p2):
-            r1, r2 = la * la - p2 * p2, la * la - p1 * p1
-            if not (r1 > 0.0 and r2 > 0.0):
+            if not (abs(p1) < la and abs(p2) < la):  # as inverse_dynamics refuses (eq. 4); also catches NaN
                 raise UnreachablePoseError(
                     Phrase(
                         "the measured platform position ({x}, {y}) mm is outside |p_j| < l_a",
@@ -260,8 +273,10 @@ class ControlLaw:
                         y=fixed(p2, ".1f", 1e3),
                     )
                 )
-            c1, c2 = math.sqrt(r1), math.sqrt(r2)
-            if abs(c1 * c2 - p1 * p2) < 1e-9 * la * la:
+            c1, c2 = math.sqrt(la * la - p2 * p2), math.sqrt(la * la - p1 * p1)
+            if abs(c1 * c2) < SINGULAR_TOL * (la * la):  # as inverse_dynamics refuses (eq. 11)
+                raise SingularConfigurationError(Phrase("the measured pose is at the inverse singularity (eq. 11)"))
+            if abs(c1 * c2 - p1 * p2) < CTC_DIRECT_TOL * (la * la):
                 raise SingularConfigurationError(Phrase("the measured pose is at the direct singularity (eq. 12)"))
             return c1, c2
 
@@ -280,8 +295,8 @@ class ControlLaw:
 
         def ctc(row, p1, p2, dp1, dp2):
             c1, c2 = legs(p1, p2)
-            a1 = row[4] + kd * (row[2] - dp1) + kp * (row[0] - p1)
-            a2 = row[5] + kd * (row[3] - dp2) + kp * (row[1] - p2)
+            a1 = task_space_command(row[0], row[2], row[4], p1, dp1, kp, kd)
+            a2 = task_space_command(row[1], row[3], row[5], p2, dp2, kp, kd)
             tau = _procedure(prm, p1, p2, dp1, dp2, a1, a2, c1, c2, 0.0, 0.0)  # eqs. (29)-(31) at the measurement
             ff = _procedure(prm, p1, p2, dp1, dp2, row[4], row[5], c1, c2, 0.0, 0.0)
             return tau[10], tau[11], ff[10], ff[11]
