@@ -11,8 +11,10 @@ Between samples ``τ`` and the mechanical power ``P_i = τ_i ḋ_i`` [W] are tak
 under that assumption (``∫τ² dt`` by Simpson's rule on a line, ``∫max(P, 0) dt`` split at the sign change):
 
 - RMS force ``sqrt(∫ τ_i² dt / T_cycle)`` [N]; peak force ``max |τ_i|`` [N];
-- peak power ``max |P_i|`` [W]; energy per cycle ``E_i = ∫ max(P_i, 0) dt`` [J] (driving work, nothing
-  recovered); braking energy ``∫ max(-P_i, 0) dt`` [J]; mean power ``E_i / T_cycle`` [W];
+- peak power ``max |P_i|`` [W] (driving or braking, whichever is larger), and separately the peak driving
+  power ``max P_i`` and the peak braking power ``max -P_i`` [W] (0 if never); energy per cycle
+  ``E_i = ∫ max(P_i, 0) dt`` [J] (driving work, nothing recovered); braking energy ``∫ max(-P_i, 0) dt`` [J];
+  mean power ``E_i / T_cycle`` [W];
 - peak actuator speed ``max |ḋ_i|`` [m/s] and peak platform speed ``max |ṗ|`` [m/s];
 - with a motor constant ``k_m`` [N/sqrt(W)]: copper loss ``τ_i² / k_m²`` [W], its mean over the cycle and its
   energy per cycle [J].
@@ -46,7 +48,9 @@ class Sizing:
     dwell: float  # [s]
     peak_force: np.ndarray  # [N]
     rms_force: np.ndarray  # [N] over the cycle, dwell included
-    peak_power: np.ndarray  # [W] max |τ_i ḋ_i|
+    peak_power: np.ndarray  # [W] max |τ_i ḋ_i|, driving or braking
+    peak_driving_power: np.ndarray  # [W] max(τ_i ḋ_i, 0): the motor delivers it
+    peak_braking_power: np.ndarray  # [W] max(-τ_i ḋ_i, 0): the motor absorbs it
     mean_power: np.ndarray  # [W] driving energy / cycle time
     energy: np.ndarray  # [J] driving work per cycle, ∫ max(τ_i ḋ_i, 0) dt
     braking_energy: np.ndarray  # [J] ∫ max(-τ_i ḋ_i, 0) dt
@@ -66,6 +70,8 @@ class Sizing:
             ("peak force", "N", *self.peak_force),
             ("RMS force", "N", *self.rms_force),
             ("peak mechanical power", "W", *self.peak_power),
+            ("peak driving power", "W", *self.peak_driving_power),
+            ("peak braking power", "W", *self.peak_braking_power),
             ("mean mechanical power", "W", *self.mean_power),
             ("energy per cycle", "J", *self.energy),
             ("braking energy per cycle", "J", *self.braking_energy),
@@ -157,6 +163,8 @@ def size_motion(t, tau, dd, dwell: float = 0.0, motor_constant: float | None = N
         peak_force=peak_force,
         rms_force=np.sqrt(sq / cycle),
         peak_power=np.max(np.abs(power), axis=0),
+        peak_driving_power=np.maximum(np.max(power, axis=0), 0.0),
+        peak_braking_power=np.maximum(np.max(-power, axis=0), 0.0),
         mean_power=energy / cycle,
         energy=energy,
         braking_energy=braking,

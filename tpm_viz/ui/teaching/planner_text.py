@@ -25,6 +25,8 @@ _QUANTITIES = {
         T("peak force"),
         T("RMS force"),
         T("peak mechanical power"),
+        T("peak driving power"),
+        T("peak braking power"),
         T("mean mechanical power"),
         T("energy per cycle"),
         T("braking energy per cycle"),
