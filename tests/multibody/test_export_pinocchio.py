@@ -15,7 +15,7 @@ import pytest
 import tpm_viz as tv
 from tests.support.strategies import random_states
 from tpm_viz.exchange.mjcf import mjcf_text
-from tpm_viz.exchange.topology import JOINT_NAMES, joint_motion
+from tpm_viz.exchange.topology import JOINT_NAMES, joint_motion, joint_positions
 from tpm_viz.multibody.rank import ranked_svd
 from tpm_viz.paper.dynamics import inverse_dynamics
 
@@ -107,7 +107,11 @@ def test_pinocchio_reads_the_topology_masses_and_closures(read_back):
     assert len(fm.constraints) == 3 and not fm.frame_constraints
     assert fm.visual.ngeoms == 2 + 2 + 4 + 1  # rails, sliders, links, platform (visual boxes)
     assert all(type(c).__name__ == "PointAnchorConstraintModel" for c in fm.constraints)
-    assert m.upperPositionLimit[fm.idx[0]] == pytest.approx(P.stroke)
+    # the sliders' ref (qpos0 is the assembled home pose, issue 27): Pinocchio 4.1's MJCF reader honours it in the
+    # kinematics (the tests below) but shifts the range by -ref; the stroke is the range's width
+    d_home = joint_positions(P, (0.0, 0.0))["d1"]
+    assert m.upperPositionLimit[fm.idx[0]] == pytest.approx(P.stroke - d_home)
+    assert m.upperPositionLimit[fm.idx[0]] - m.lowerPositionLimit[fm.idx[0]] == pytest.approx(P.stroke)
 
 
 @pytest.mark.parametrize("which", ["paper", "other"])

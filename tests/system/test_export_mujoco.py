@@ -19,7 +19,7 @@ mujoco = pytest.importorskip("mujoco")
 
 import tpm_viz as tv  # noqa: E402
 from tpm_viz.exchange.mjcf import DEFAULT_SETTINGS, MUJOCO_DEFAULTS, mjcf_text  # noqa: E402
-from tpm_viz.exchange.topology import JOINT_NAMES, joint_positions, topology  # noqa: E402
+from tpm_viz.exchange.topology import JOINT_NAMES, joint_motion, joint_positions, topology  # noqa: E402
 from tpm_viz.paper.dynamics import inverse_dynamics  # noqa: E402
 from tpm_viz.paper.trajectories import circle_state  # noqa: E402
 
@@ -78,16 +78,22 @@ def test_closed_form_joint_positions_close_every_loop(params):
     assert worst_gap <= 1e-9 and worst_efc <= 1e-9 and worst_p <= 1e-12
 
 
-def test_home_keyframe_is_assembled_and_qpos0_is_not():
-    model, data = load(P)
-    pairs = site_pairs(model, P)
-    mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
+@pytest.mark.parametrize("params", [P, OTHER], ids=["paper", "other"])
+def test_qpos0_is_the_assembled_home_pose(params):
+    """Issue 27: a model opened in MuJoCo's viewer starts assembled (bodies placed at home, joints' ref)."""
+    model, data = load(params)
+    pairs = site_pairs(model, params)
+    home = joint_motion(params, (0.0, 0.0))[0]
+    np.testing.assert_allclose(model.qpos0, home, atol=1e-15)
+    np.testing.assert_array_equal(model.key("home").qpos, model.qpos0)
+    mujoco.mj_resetData(model, data)  # qpos = qpos0
     mujoco.mj_forward(model, data)
-    assert closure_gap(model, data, pairs) < 1e-15
-    np.testing.assert_allclose(data.xpos[model.body("platform").id], 0.0, atol=1e-15)
-    mujoco.mj_resetData(model, data)
-    mujoco.mj_forward(model, data)
-    assert closure_gap(model, data, pairs) > 0.01  # documented in the file: start from 'home'
+    assert closure_gap(model, data, pairs) <= 1e-9
+    np.testing.assert_allclose(data.xpos[model.body("platform").id], 0.0, atol=1e-12)
+    a1 = data.xpos[model.body("slider1").id]  # A_1 = (d_1 - a) e_1: qpos keeps its meaning
+    assert a1[0] == pytest.approx(home[0] - params.a, abs=1e-15)
+    mujoco.mj_step(model, data)  # at rest, no force: nothing snaps
+    assert np.max(np.abs(data.qvel)) < 1e-9
 
 
 @pytest.mark.parametrize("params", [P, OTHER], ids=["paper", "other"])
