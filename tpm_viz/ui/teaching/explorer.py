@@ -25,6 +25,7 @@ import viser
 from tpm_viz import meshes
 from tpm_viz.app.overlays import MAP_KINDS, cached_map, colour_scale, ellipse_polylines, map_rgba
 from tpm_viz.app.readouts import reason
+from tpm_viz.errors import BusyError
 from tpm_viz.params import Params
 from tpm_viz.ui.guard import guarded
 from tpm_viz.ui.snapshot import Snapshot
@@ -56,19 +57,25 @@ class MapService:
         self.last_seconds = float("nan")
         """Wall time of the last map computation [s] (for the benchmark)."""
 
-    def get(self, params: Params) -> dict[str, np.ndarray] | None:
-        """The images of ``params`` (``kind -> (n, n, 4)`` uint8), or None while they are computed."""
+    def get(self, params: Params, tab=None) -> dict[str, np.ndarray] | None:
+        """The images of ``params`` (``kind -> (n, n, 4)`` uint8), or None while they are computed (as ``tab``'s
+        job in the worker's fair queue: a tab's newer map replaces its pending one)."""
         with self._lock:
             images = self._maps.get(params)
             if images is not None:
                 self._maps.move_to_end(params)
                 return images
-            if params not in self._pending and params not in self._failed:
-                self._pending.add(params)
-                self.worker.submit(
-                    ("map", params), lambda: self._compute(params), lambda r, e: self._done(params, r, e)
-                )
-            return None
+            if params in self._pending or params in self._failed:
+                return None
+            self._pending.add(params)
+        self.worker.submit(
+            "map" if tab is not None else ("map", params),
+            lambda: self._compute(params),
+            lambda r, e: self._done(params, r, e),
+            tab=tab,
+            dropped=lambda: self._dropped(params),
+        )
+        return None
 
     def failure(self, params: Params) -> Phrase | None:
         """Why the map of ``params`` could not be computed, or None."""
@@ -82,7 +89,19 @@ class MapService:
         self.last_seconds = time.perf_counter() - t0
         return images
 
+    def _dropped(self, params: Params) -> None:
+        """The job of ``params`` will never run (its tab left or asked for another map): a tab still showing
+        those parameters asks again."""
+        with self._lock:
+            self._pending.discard(params)
+        for view in list(self.subscribers):
+            view.map_ready(params)
+
     def _done(self, params: Params, images, error: Exception | None = None) -> None:
+        if isinstance(error, BusyError):  # the queue was full: asked again at the tab's next frame
+            with self._lock:
+                self._pending.discard(params)
+            return
         with self._lock:
             self._pending.discard(params)
             if images is None:
@@ -221,7 +240,7 @@ class ExplorerView:
             if self._image is not None and self._image.visible:
                 self._image.visible = False
             return
-        images = self.maps.get(params)
+        images = self.maps.get(params, self.view)
         if images is None:
             failure = self.maps.failure(params)
             lang = self.view.lang

@@ -131,7 +131,8 @@ class RunHub:
                 if on_done is not None:
                     on_done(run)
 
-        self.worker.submit(("run", id(session)), lambda: build_run(params, source, reference), done)
+        # the session takes turns in the worker's fair queue (it outlives its tabs: its run is never dropped)
+        self.worker.submit(("run", id(session)), lambda: build_run(params, source, reference), done, tab=session)
 
     def follow_params(self, session: Session) -> None:
         """After a parameter change: recompute the run for the new mechanism (called under the lock by views)."""
@@ -158,7 +159,7 @@ class RunHub:
                     ps.run, ps.status = new, ""
                 self._refresh(session)
 
-        self.worker.submit(("run", id(session)), lambda: build_run(params, source, reference), done)
+        self.worker.submit(("run", id(session)), lambda: build_run(params, source, reference), done, tab=session)
 
     def unload(self, session: Session, origin=None) -> None:
         """No trajectory any more (the pose stays)."""
