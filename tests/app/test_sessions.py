@@ -85,3 +85,27 @@ def test_write_is_atomic_and_leaves_no_temporary_file(tmp_path):
     assert path.read_text() == "two" and [p.name for p in path.parent.iterdir()] == ["session.json"]
     with pytest.raises(InputError, match="session file"):
         sessions.read_file(tmp_path / "missing.json")
+
+
+@pytest.mark.parametrize(
+    ("data", "message"),
+    [
+        (b"[" * 200_000, "nested deeper"),  # RecursionError in json before
+        (b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\xff\xfe" * 50, "not UTF-8"),  # a picture chosen by mistake
+        (b'{"format": "tpm-viz-session", "version": 1, "shared": ' + b"{" * 5000, "nested deeper|not valid JSON"),
+    ],
+)
+def test_open_session_refuses_deep_or_binary_files_in_one_plain_line(data, message):
+    with pytest.raises(InputError, match=message) as info:
+        sessions.loads(data)
+    text = str(info.value)
+    assert text.startswith("session file") and "\n" not in text and "codec" not in text and "\\x" not in text
+
+
+def test_open_session_checks_the_lesson_step_against_the_lessons():
+    raw = json.loads(sessions.dumps(Document(Saved(_state()), lesson_step=3)))
+    assert sessions.loads(json.dumps(raw), steps=4).lesson_step == 3
+    for bad in (999, 4, -1, 2.5, True, "2"):
+        raw["lesson_step"] = bad
+        with pytest.raises(InputError, match="lesson step"):
+            sessions.loads(json.dumps(raw), steps=4)

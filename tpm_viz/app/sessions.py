@@ -27,6 +27,7 @@ from tpm_viz.app.readouts import Load, reason
 from tpm_viz.app.runs import Source
 from tpm_viz.app.state import AppState, TrajectorySample
 from tpm_viz.errors import InputError, TpmVizError
+from tpm_viz.files import loads_json, read_bytes
 from tpm_viz.paper.trajectories import Trajectory
 from tpm_viz.params import PARAM_INFO, Params
 from tpm_viz.words import Lang, Phrase
@@ -37,7 +38,9 @@ __all__ = [
     "VERSION",
     "Document",
     "Saved",
+    "decode_saved",
     "dumps",
+    "encode_saved",
     "loads",
     "read_file",
     "write_atomic",
@@ -219,15 +222,37 @@ def _read_saved(raw: Any, where: str) -> Saved:
     return Saved(state, _read_source(raw.get("trajectory")), max(0.0, player_t), show, lang)
 
 
-def loads(text: str | bytes, now: float | None = None) -> Document:
+def encode_saved(saved: Saved) -> dict[str, Any]:
+    """The JSON-ready form of one mechanism, as in a document (a record of the classroom store)."""
+    return _saved(saved)
+
+
+def decode_saved(raw: Any) -> Saved:
+    """:func:`encode_saved`'s form read back through the library's checks; one-line :class:`~tpm_viz.InputError`."""
+    return _checked(lambda: _read_saved(raw, ""))
+
+
+def _checked(read: Any) -> Any:
+    """``read()``, any problem turned into one ``session file: ...`` :class:`~tpm_viz.InputError`."""
+    try:
+        return read()
+    except TpmVizError as exc:
+        why = reason(exc)
+        raise InputError(
+            why if str(why).startswith("session file") else Phrase("session file: {why}", why=why)
+        ) from None
+    except (TypeError, ValueError, AttributeError, RecursionError) as exc:
+        raise InputError(Phrase("session file: malformed ({kind})", kind=type(exc).__name__)) from None
+
+
+def loads(text: str | bytes, now: float | None = None, steps: int | None = None) -> Document:
     """Read a session document; raises one-line :class:`~tpm_viz.InputError` if it is not a valid one of this
-    version. Away tabs older than :data:`KEEP_SECONDS` (at ``now``, wall clock) are dropped."""
+    version (not UTF-8, not JSON, nested too deep: :func:`tpm_viz.files.loads_json`). Away tabs older than
+    :data:`KEEP_SECONDS` (at ``now``, wall clock) are dropped. ``steps``: the number of lesson steps; a lesson step
+    out of range is refused (None: one out of range reads as 0)."""
     if len(text) > MAX_DOCUMENT_BYTES:
         raise InputError(Phrase("session file: larger than {limit} MiB", limit=MAX_DOCUMENT_BYTES >> 20))
-    try:
-        raw = json.loads(text)
-    except (ValueError, UnicodeDecodeError) as exc:
-        raise InputError(Phrase("session file: not JSON ({why})", why=str(exc)[:80])) from None
+    raw = loads_json(text, "session file")
     if not isinstance(raw, dict) or raw.get("format") != FORMAT:
         raise InputError(Phrase("session file: not a tpm-viz session"))
     if raw.get("version") != VERSION:
@@ -238,41 +263,40 @@ def loads(text: str | bytes, now: float | None = None) -> Document:
                 ours=VERSION,
             )
         )
-    try:
-        shared = _read_saved(raw.get("shared"), "shared.")
-        step = raw.get("lesson_step", 0)
-        step = step if isinstance(step, int) and not isinstance(step, bool) and 0 <= step < 1000 else 0
-        now = time.time() if now is None else now
-        tabs: dict[str, list[dict[str, Any]]] = {}
-        tabs_raw = raw.get("tabs", {})
-        for key, records in list(tabs_raw.items() if isinstance(tabs_raw, dict) else [])[:MAX_TABS]:
-            kept = []
-            for r in records if isinstance(records, list) else []:
-                left_at = _number(r, "left_at", "tabs.")
-                if now - left_at > KEEP_SECONDS:
-                    continue
-                saved = None if r.get("saved") is None else _read_saved(r["saved"], "tabs.")
-                record = {"private": bool(r.get("private")), "saved": saved, "left_at": left_at}
-                kept.append(dict(record, presenter=r.get("presenter") is True))
-            if kept:
-                tabs[str(key)[:200]] = kept
-    except TpmVizError as exc:
-        why = reason(exc)
+    step = raw.get("lesson_step", 0)
+    valid = isinstance(step, int) and not isinstance(step, bool) and 0 <= step < (1000 if steps is None else steps)
+    if steps is not None and not valid:
         raise InputError(
-            why if str(why).startswith("session file") else Phrase("session file: {why}", why=why)
-        ) from None
-    except (TypeError, ValueError, AttributeError) as exc:
-        raise InputError(Phrase("session file: malformed ({kind})", kind=type(exc).__name__)) from None
+            Phrase("session file: lesson step {step} is not one of the {n} steps", step=repr(step)[:20], n=steps)
+        )
+    return _checked(lambda: _document(raw, step if valid else 0, time.time() if now is None else now))
+
+
+def _document(raw: dict[str, Any], step: int, now: float) -> Document:
+    """The document of a checked header (may raise anything: see :func:`_checked`)."""
+    shared = _read_saved(raw.get("shared"), "shared.")
+    tabs: dict[str, list[dict[str, Any]]] = {}
+    tabs_raw = raw.get("tabs", {})
+    for key, records in list(tabs_raw.items() if isinstance(tabs_raw, dict) else [])[:MAX_TABS]:
+        kept = []
+        for r in records if isinstance(records, list) else []:
+            left_at = _number(r, "left_at", "tabs.")
+            if now - left_at > KEEP_SECONDS:
+                continue
+            saved = None if r.get("saved") is None else _read_saved(r["saved"], "tabs.")
+            record = {"private": bool(r.get("private")), "saved": saved, "left_at": left_at}
+            kept.append(dict(record, presenter=r.get("presenter") is True))
+        if kept:
+            tabs[str(key)[:200]] = kept
     return Document(shared, step, tabs)
 
 
 def read_file(path: Path) -> Document:
     """:func:`loads` of a file; a missing, unreadable or invalid file is one :class:`~tpm_viz.InputError`."""
     try:
-        with open(path, "rb") as handle:
-            data = handle.read(MAX_DOCUMENT_BYTES + 1)
-    except OSError as exc:
-        raise InputError(Phrase("session file {path}: {why}", path=str(path), why=exc.strerror or str(exc))) from None
+        data = read_bytes(path, MAX_DOCUMENT_BYTES)
+    except InputError as exc:
+        raise InputError(Phrase("session file {why}", why=reason(exc))) from None
     return loads(data)
 
 

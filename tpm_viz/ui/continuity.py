@@ -1,195 +1,148 @@
-"""Nothing is lost on a blip or a restart: tabs that left (:class:`Away`) and the session file (:class:`Store`).
+"""Nothing is lost on a blip or a restart: the classroom's store as the app uses it (:class:`Store`), and one tab's
+state taken (:func:`saved_of`) and given back (:func:`restore`).
 
-viser gives every websocket connection a new client id, and its page sends nothing that identifies the tab when
-it reconnects (no URL parameters, no storage of its own on reconnect). What does survive is the browser's cookie
-(:mod:`.classroom`): a tab is recognised by its browser, and when the browser has several tabs, by the camera it
-sends first (a reconnecting page keeps its camera). :class:`Away` keeps each tab that left (its own copy or
-not, parameters, pose, load, trajectory and player time, view options and presentation mode, language) for
-:data:`~tpm_viz.app.sessions.KEEP_SECONDS`; the app restores it when it can tell which tab is back, and otherwise
-offers *Restore my own copy from before the drop* in that tab (it never puts a student on the shared mechanism
-without saying so).
+Tabs that left are kept by :class:`tpm_viz.classroom.away.Away`; the app restores one when it can tell which tab is
+back, and otherwise offers *Restore my own copy from before the drop* in that tab (it never puts a student on the
+shared mechanism without saying so).
 
-:class:`Store` writes the shared mechanism and the away tabs to the session file (``platformdirs`` user data
-folder, or ``--session FILE``) every :data:`SAVE_SECONDS` when something changed, atomically, and reads it back at
-start: an unreadable or old file is one warning line and the defaults.
+:class:`Store` is the SQLite store of :mod:`tpm_viz.classroom.store` (``platformdirs`` user data folder, or
+``--session FILE``), read once at start and saved every :data:`SAVE_SECONDS` when something changed by a
+:class:`~tpm_viz.classroom.saver.Saver`. ``--session FILE`` naming a JSON session file (a *Save session* download,
+or the file of an older tpm-viz) imports it once into a store beside it (``FILE.sqlite3``) and never writes it. The
+old ``session.json`` of the data folder is imported the same way. The cookie secret is kept beside the store.
 """
 
 from __future__ import annotations
 
+import hashlib
 import sys
-import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import platformdirs
 
-from tpm_viz.app import sessions
-from tpm_viz.app.sessions import KEEP_SECONDS, Document, Saved
+from tpm_viz.app.sessions import MAX_DOCUMENT_BYTES, Document, Saved
+from tpm_viz.classroom.identity import Keys
+from tpm_viz.classroom.records import Records, import_json
+from tpm_viz.classroom.saver import SAVE_SECONDS, Saver
+from tpm_viz.classroom.store import Limits, SqliteStore, is_sqlite, open_store
 from tpm_viz.errors import TpmVizError
+from tpm_viz.files import read_bytes
 from tpm_viz.ui._viser import widget_value
-from tpm_viz.ui.guard import report
+from tpm_viz.ui.classroom import DEFAULT_KEYS
 from tpm_viz.ui.session import Session
 from tpm_viz.ui.teaching.playing import RunHub, following
 from tpm_viz.words import Lang
 
-__all__ = ["PRESENTATION", "SAVE_SECONDS", "Away", "Store", "default_path", "reload", "restore", "saved_of"]
+__all__ = ["PRESENTATION", "SAVE_SECONDS", "Store", "default_path", "reload", "restore", "saved_of"]
 
 PRESENTATION = "presentation"
 """The key of presentation mode (:mod:`.look`) among a saved tab's view options."""
 
-SAVE_SECONDS = 2.0
-"""Longest time a change to the shared mechanism waits before it is on disk."""
-MAX_PER_BROWSER = 8
-MAX_AWAY = 2000
-
 
 def default_path() -> Path:
-    """The session file in the user's data folder (e.g. ``~/.local/share/tpm-viz/session.json``)."""
-    return Path(platformdirs.user_data_dir("tpm-viz", appauthor=False)) / "session.json"
+    """The store in the user's data folder (e.g. ``~/.local/share/tpm-viz/classroom.sqlite3``)."""
+    return Path(platformdirs.user_data_dir("tpm-viz", appauthor=False)) / "classroom.sqlite3"
 
 
-def _close(a: Any, b: Any) -> bool:
-    if a is None or b is None:
-        return False
-    x, y = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
-    return x.shape == y.shape and bool(np.allclose(x, y, atol=1e-6))
-
-
-class Away:
-    """Tabs that left, per browser identity, newest last; each for :data:`KEEP_SECONDS`. Thread-safe."""
-
-    def __init__(self, clock: Callable[[], float] = time.time) -> None:
-        self._clock = clock
-        self._lock = threading.Lock()
-        self._tabs: dict[str, list[dict[str, Any]]] = {}
-
-    def _prune(self) -> None:
-        now = self._clock()
-        for key in list(self._tabs):
-            kept = [r for r in self._tabs[key] if now - r["left_at"] <= KEEP_SECONDS][-MAX_PER_BROWSER:]
-            if kept:
-                self._tabs[key] = kept
-            else:
-                del self._tabs[key]
-        while len(self._tabs) > MAX_AWAY:
-            del self._tabs[next(iter(self._tabs))]
-
-    def park(self, key: str, private: bool, saved: Saved | None, camera: Any = None, presenter: bool = False) -> None:
-        """A tab of browser ``key`` left: keep what it had (and whether it was the presenter's)."""
-        with self._lock:
-            record = {"private": private, "saved": saved, "left_at": self._clock(), "camera": camera}
-            record["presenter"] = presenter
-            self._tabs.setdefault(key, []).append(record)
-            self._prune()
-
-    def take(self, key: str, camera: Any = None) -> dict[str, Any] | None:
-        """The record of the tab of browser ``key`` that is back (removed), if it can be told apart: the only one
-        of that browser, or the one whose camera it sends; else None (see :meth:`offer`)."""
-        with self._lock:
-            self._prune()
-            records = self._tabs.get(key, [])
-            matched = [r for r in records if _close(r.get("camera"), camera)]
-            chosen = matched[-1] if len(matched) == 1 else records[0] if len(records) == 1 else None
-            if chosen is not None:
-                records.remove(chosen)
-                if not records:
-                    self._tabs.pop(key, None)
-            return chosen
-
-    def offer(self, key: str) -> dict[str, Any] | None:
-        """The newest own copy of browser ``key`` that nobody took back yet (for the *Restore* button), or None."""
-        with self._lock:
-            self._prune()
-            private = [r for r in self._tabs.get(key, []) if r["private"] and r["saved"] is not None]
-            return private[-1] if private else None
-
-    def claim(self, key: str, record: dict[str, Any]) -> bool:
-        """Take ``record`` (offered earlier) if it is still there."""
-        with self._lock:
-            records = self._tabs.get(key, [])
-            if not any(r is record for r in records):
-                return False
-            records[:] = [r for r in records if r is not record]
-            if not records:
-                self._tabs.pop(key, None)
-            return True
-
-    def snapshot(self) -> dict[str, list[dict[str, Any]]]:
-        """Everything kept, for the session file."""
-        with self._lock:
-            self._prune()
-            return {k: [dict(r) for r in v] for k, v in self._tabs.items()}
-
-    def restore(self, tabs: dict[str, list[dict[str, Any]]]) -> None:
-        """Keep the tabs of a session file (their camera is not saved)."""
-        with self._lock:
-            for key, records in tabs.items():
-                self._tabs.setdefault(key, []).extend(dict(r, camera=None) for r in records)
-            self._prune()
+def _places(path: Path) -> tuple[Path, Path | None]:
+    """``(store, JSON file to import or None)`` for ``--session path``."""
+    if path.exists() and path.is_file() and path.stat().st_size > 0 and not is_sqlite(path):
+        with open(path, "rb") as handle:
+            start = handle.read(64).lstrip(b"\xef\xbb\xbf \t\r\n")
+        if start.startswith(b"{") or path.suffix.lower() == ".json":
+            return path.with_name(path.name + ".sqlite3"), path
+    old = path.with_name("session.json")
+    return path, old if path == default_path() and old.is_file() else None
 
 
 class Store:
-    """The session file: read once at start, written atomically when the session changed."""
+    """The classroom's store for one app: :meth:`open` (notices on stderr), :meth:`load`, :meth:`start`,
+    :meth:`stop`. ``path`` None: nothing is kept (in-memory cookie keys of the process)."""
 
-    def __init__(self, path: Path | None, fresh: bool = False) -> None:
-        self.path = path
-        self.fresh = fresh
-        self._written = ""
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
-        self._lock = threading.Lock()
+    def __init__(self, path: Path | None, fresh: bool = False, limits: Limits = Limits()) -> None:
+        self.path = None if path is None else Path(path)
+        self.fresh, self.limits = fresh, limits
+        self.keys = DEFAULT_KEYS
+        """Mints and checks the browsers' cookies (:mod:`tpm_viz.classroom.identity`)."""
+        self.notices: list[str] = []
+        """One-line notices of the start (a store set aside, a file imported, records skipped)."""
+        self.store: SqliteStore | None = None
+        self.records: Records | None = None
+        self.where = "" if path is None else str(path)
+        self._saver: Saver | None = None
+        self._opened = False
 
-    def load(self) -> Document | None:
-        """The saved session, or None (no file, ``--fresh``, or one warning line on stderr if it is unusable)."""
-        if self.path is None or self.fresh or not self.path.exists():
-            return None
-        try:
-            return sessions.read_file(self.path)
-        except TpmVizError as exc:
-            print(f"warning: {exc}; starting with the defaults", file=sys.stderr, flush=True)
-            return None
+    def _notice(self, line: str | None) -> None:
+        if line:
+            self.notices.append(line)
+            print(f"warning: {line}", file=sys.stderr, flush=True)
 
-    def save(self, document: Callable[[], Document]) -> bool:
-        """Write the session if it changed since the last write; True if written."""
-        if self.path is None:
-            return False
-        with self._lock:
-            doc = document()
-            text = sessions.dumps(doc, saved_at=0.0)
-            if text == self._written:
-                return False
-            sessions.write_atomic(self.path, sessions.dumps(doc))
-            self._written = text
-            return True
-
-    def start(self, document: Callable[[], Document]) -> None:
-        """Save every :data:`SAVE_SECONDS` in a daemon thread (a failed save is logged, the next one retried)."""
-        if self.path is None or self._thread is not None:
+    def open(self) -> None:
+        """Open (or make) the store, move an unreadable one aside, import a JSON session file once; idempotent.
+        Problems are notices: the app starts with the defaults rather than not at all."""
+        if self._opened or self.path is None:
             return
-
-        def loop() -> None:
-            while not self._stop.wait(SAVE_SECONDS):
-                try:
-                    self.save(document)
-                except Exception as exc:  # a full disk must not stop the lesson
-                    report(exc, f"saving the session to {self.path}")
-
-        self._thread = threading.Thread(target=loop, name="tpm-viz-save", daemon=True)
-        self._thread.start()
-
-    def stop(self, document: Callable[[], Document] | None = None) -> None:
-        """Stop saving; write a last time if ``document`` is given."""
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join(timeout=5.0)
-        if document is not None:
+        self._opened = True
+        target, source = _places(self.path)
+        self.where = str(target)
+        try:
+            self.store, notice = open_store(target, self.limits, fresh=self.fresh)
+        except Exception as exc:  # e.g. an unwritable folder or a locked file: the lesson goes on unsaved
+            self._notice(f"cannot open the session store {target} ({str(exc)[:160]}); nothing will be saved")
+            return
+        self._notice(notice)
+        self.records = Records(self.store)
+        self.keys, notice = Keys.in_folder(target.parent)
+        self._notice(notice)
+        if source is not None:
             try:
-                self.save(document)
-            except Exception as exc:
-                report(exc, f"saving the session to {self.path}")
+                if self.fresh:
+                    self.store.mark_imported(_digest(source), str(source))
+                else:
+                    self._notice(import_json(self.store, source, self.records))
+            except Exception as exc:  # the import is a bonus: never a reason not to start
+                self._notice(f"{source} not imported ({str(exc)[:160]})")
+
+    def load(self, steps: int | None = None) -> tuple[Document | None, dict[str, list[dict[str, Any]]]]:
+        """The lecture (None: none kept, or unreadable: one notice) and the remembered tabs (keyed by hashed
+        identity, each record with its address). An unreadable record is skipped with one notice."""
+        self.open()
+        if self.store is None or self.records is None:
+            return None, {}
+        contents = self.store.load()
+        skipped = contents.skipped
+        doc = None
+        if contents.lecture is not None:
+            try:
+                shared, step = self.records.read_lecture(contents.lecture, steps)
+                doc = Document(shared, step)
+            except TpmVizError as exc:
+                self._notice(f"the lecture in {self.where} could not be read ({exc}); the defaults instead")
+        tabs, bad = self.records.read_copies(contents.copies, time.time())
+        if skipped + bad:
+            self._notice(f"{skipped + bad} record(s) of {self.where} could not be read and were skipped")
+        return doc, tabs
+
+    def start(self, document: Callable[[], Document], say: Callable[[str, bool], None]) -> None:
+        """Save ``document()`` from now on; ``say(line, problem)`` tells the terminal and the lecturer."""
+        if self.records is None or self._saver is not None:
+            return
+        self._saver = Saver(self.records, document, say, self.where)
+        self._saver.start()
+
+    def stop(self) -> None:
+        """Stop saving after a last save; close the store."""
+        if self._saver is not None:
+            self._saver.stop(final=True)
+        if self.store is not None:
+            self.store.close()
+
+
+def _digest(path: Path) -> str:
+    return hashlib.sha256(read_bytes(path, MAX_DOCUMENT_BYTES)).hexdigest()
 
 
 # -- one tab ---------------------------------------------------------------------------------------------------------
