@@ -4,6 +4,7 @@ by the first one."""
 
 from __future__ import annotations
 
+import socket
 import threading
 
 import msgspec
@@ -25,8 +26,14 @@ class Page:
     """A protocol-level tab that knows its widgets by label (uuid and current value)."""
 
     def __init__(
-        self, port: int, origin: str | None = None, cookie: str | None = None, accept_language: str | None = None
+        self,
+        port: int,
+        origin: str | None = None,
+        cookie: str | None = None,
+        accept_language: str | None = None,
+        source: str | None = None,
     ) -> None:
+        """``source``: the loopback address to connect from (e.g. ``127.0.0.2``: another device)."""
         headers = {}
         if cookie:
             headers["Cookie"] = cookie
@@ -39,6 +46,7 @@ class Page:
             compression=None,
             origin=origin,
             additional_headers=headers or None,
+            sock=None if source is None else socket.create_connection(("127.0.0.1", port), 10, (source, 0)),
         )
         self.uuids: dict[str, str] = {}
         self.values: dict[str, object] = {}

@@ -14,10 +14,13 @@ import pytest
 
 from tests.support.pages import Page, classroom_app, views_of
 from tests.support.protocol import ServerProcess, wait_for
+from tests.support.stores import page_cookie, stored_tabs
 from tpm_viz.app import sessions
 from tpm_viz.app.sessions import Document, Saved
 from tpm_viz.app.state import AppState
 from tpm_viz.words import Lang, catalogue, preferred
+
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
 __all__ = ["classroom_app"]  # the fixture, imported
 
@@ -119,7 +122,7 @@ def test_a_refusal_is_told_in_the_tabs_language(classroom_app):
 
 def test_a_tab_that_comes_back_after_a_drop_has_its_language_back(classroom_app):
     app = classroom_app
-    cookie = "tpmviz_id=" + "7e" * 16
+    cookie = page_cookie(app.port)  # the page's, signed by the server
     page = Shown(app.port, cookie=cookie, accept_language="en-US,en")
     (view,) = views_of(app, 1)
     page.set("Language", "한국어")
@@ -132,24 +135,24 @@ def test_a_tab_that_comes_back_after_a_drop_has_its_language_back(classroom_app)
     assert bv.lang is Lang.KO and back.shown("언어")["value"] == "한국어"
     back.close()
     wait_for(lambda: not app.views, what="gone again")
-    other = Shown(app.port, cookie="tpmviz_id=" + "7f" * 16)  # another browser: its own (English)
+    other = Shown(app.port, cookie=page_cookie(app.port))  # another browser: its own (English)
     (ov,) = views_of(app, 1)
     assert ov.lang is Lang.EN
     other.close()
 
 
 def test_a_restart_brings_a_tab_back_in_its_language(tmp_path):
-    path = tmp_path / "session.json"
-    cookie = "tpmviz_id=" + "3c" * 16
+    path = tmp_path / "classroom.sqlite3"
     first = ServerProcess(session=path)
     try:
+        cookie = page_cookie(first.port)  # signed with the secret kept beside the store: valid after a restart
         page = Shown(first.port, cookie=cookie)
         page.set("Language", "한국어")
         wait_for(lambda: page.uuid("파라미터 적용"), what="Korean")
         deadline = time.monotonic() + 15
         while time.monotonic() < deadline:  # the live tab is saved within SAVE_SECONDS
-            text = path.read_text() if path.exists() else "{}"
-            if any(r["saved"]["lang"] == "ko" for r in json.loads(text).get("tabs", {}).get(f"c:{'3c' * 16}", [])):
+            tabs = stored_tabs(path, time.time())
+            if any(r["saved"].lang == "ko" for records in tabs.values() for r in records):
                 break
             time.sleep(0.2)
         page.close()

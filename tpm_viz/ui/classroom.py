@@ -7,20 +7,22 @@
 - :class:`Handshakes` sees every HTTP request and websocket handshake (:func:`~._viser.hook_handshakes`): a
   websocket whose ``Origin`` is not the host the page was served under is refused with 403 (the same-origin check
   Jupyter's server makes: any page open in the lecturer's browser could otherwise drive the mechanism on
-  127.0.0.1); a client without ``Origin`` (not a browser) may connect. The page's response sets a random
-  ``tpmviz_id`` cookie, which the browser sends back with every websocket handshake, reconnections included: it is
+  127.0.0.1); a client without ``Origin`` (not a browser) may connect. The page's response sets a
+  ``tpmviz_id`` cookie the server minted and signed (:mod:`tpm_viz.classroom.identity`; one it did not sign is
+  replaced), which the browser sends back with every websocket handshake, reconnections included: it is
   how a tab that comes back after a wifi blip or a restart is recognised (:func:`identity`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import http
 import io
 import ipaddress
 import logging
-import re
 import secrets
 import socket
+import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from http.cookies import SimpleCookie
@@ -28,6 +30,9 @@ from typing import Any
 from urllib.parse import urlsplit
 
 import segno
+
+from tpm_viz.app.network import PROXIED, HostRules, client_address, header_problem, host_name
+from tpm_viz.classroom.identity import Keys, hashed
 
 __all__ = [
     "COOKIE",
@@ -46,7 +51,8 @@ log = logging.getLogger("tpm_viz.ui")
 
 COOKIE = "tpmviz_id"
 COOKIE_MAX_AGE = 7 * 24 * 3600
-_COOKIE_VALUE = re.compile(r"^[0-9a-f]{32}$")
+DEFAULT_KEYS = Keys()
+"""The cookie keys of a server built without its own (a secret of this process: in-process servers and tests)."""
 _PAGES = ("/", "/index.html")
 
 
@@ -130,7 +136,8 @@ def same_origin(headers: Any) -> bool:
     return host in candidates
 
 
-def _cookie(headers: Any) -> str | None:
+def _cookie(headers: Any, keys: Keys) -> str | None:
+    """The id of the identity cookie if this server signed it (:meth:`Keys.verify`), else None."""
     raw = headers.get("Cookie")
     if not raw:
         return None
@@ -140,31 +147,74 @@ def _cookie(headers: Any) -> str | None:
     except Exception:  # a malformed Cookie header: no identity
         return None
     morsel = jar.get(COOKIE)
-    return morsel.value if morsel is not None and _COOKIE_VALUE.match(morsel.value) else None
+    return None if morsel is None else keys.verify(morsel.value)
 
 
-def identity(remote: Any, headers: Any) -> str | None:
-    """Who a tab is across reconnections: ``c:<cookie>`` (a browser with the page's cookie), else ``a:<address and
-    user agent>`` for a browser that blocks cookies (weaker: its copy is only offered back, never restored by
-    itself), else None (not a browser: no ``Origin``, no cookie; nothing is kept for it)."""
-    cookie = None if headers is None else _cookie(headers)
+def identity(remote: Any, headers: Any, keys: Keys = DEFAULT_KEYS) -> str | None:
+    """Who a tab is across reconnections, hashed (:func:`~tpm_viz.classroom.identity.hashed`): ``c:...`` for a
+    browser with a cookie this server signed, else ``a:...`` of its address and user agent for a browser without
+    one (cookies blocked, or a self-made or unknown cookie: a new identity that owns nothing of a cookie's; its copy
+    is only offered back, never restored by itself), else None (not a browser: no ``Origin``; nothing is kept)."""
+    cookie = None if headers is None else _cookie(headers, keys)
     if cookie is not None:
-        return f"c:{cookie}"
+        return hashed("c", cookie)
     if headers is None or headers.get("Origin") is None:
         return None
     host = remote[0] if isinstance(remote, (tuple, list)) and remote else str(remote)
     agent = "" if headers is None else str(headers.get("User-Agent", ""))[:200]
-    return f"a:{host}|{agent}"
+    return hashed("a", f"{host}|{agent}")
 
 
 class Handshakes:
     """The hook of :func:`~._viser.hook_handshakes`: refuse cross-origin websockets, give pages an identity."""
 
-    def __init__(self) -> None:
+    def __init__(self, hosts: HostRules | None = None, keys: Keys | None = None) -> None:
         self.refused = 0
+        self.keys = keys if keys is not None else DEFAULT_KEYS
+        """Mints the page's identity cookie (:mod:`tpm_viz.classroom.identity`)."""
+        self.hosts = hosts if hosts is not None else HostRules()
+        """The ``Host`` names served and the trusted proxies (:mod:`tpm_viz.app.network`)."""
+        self._warned_proxy = False
+        self._logged = 0.0
+
+    def _refusal(self, connection: Any, headers: Any) -> Any:
+        """400 for malformed or duplicated headers, 403 for a ``Host`` not of this server (DNS rebinding), else
+        None, with the client's address (read through a trusted proxy) kept on ``connection``."""
+        problem = header_problem(headers.get_all)
+        status, text = http.HTTPStatus.BAD_REQUEST, f"{problem}\n"
+        if problem is None:
+            name = host_name(headers.get_all("Host")[0]) or ""
+            if self.hosts.allows(name):
+                self._client(connection, headers)
+                return None
+            status, text, problem = http.HTTPStatus.FORBIDDEN, "unknown host name\n", f"unknown Host {name[:80]!r}"
+        self.refused += 1
+        if time.monotonic() - self._logged >= 1.0:  # a flood is one line a second, not one per request
+            self._logged = time.monotonic()
+            log.warning("refused a request (%s); serve with --allowed-host NAME if it is this server's name", problem)
+        return connection.respond(status, text)
+
+    def _client(self, connection: Any, headers: Any) -> None:
+        remote = getattr(connection, "remote_address", None)
+        peer = remote[0] if isinstance(remote, (tuple, list)) and remote else str(remote)
+        client = client_address(
+            peer, headers.get_all("X-Forwarded-For"), headers.get_all("Forwarded"), self.hosts.network
+        )
+        with contextlib.suppress(AttributeError):
+            connection.tpm_viz_client = client
+        if client.startswith(PROXIED) and not self._warned_proxy:
+            self._warned_proxy = True
+            log.warning(
+                "a connection from this computer carries X-Forwarded-For or Forwarded: a reverse proxy? Its tabs are "
+                "not treated as local; serve with --trusted-proxy %s to read the students' own addresses",
+                peer,
+            )
 
     def __call__(self, connection: Any, request: Any, viser_response: Callable[[], Any]) -> Any:
         headers = request.headers
+        refusal = self._refusal(connection, headers)
+        if refusal is not None:
+            return refusal
         if headers.get("Upgrade", "").lower() == "websocket":
             if same_origin(headers):
                 return None
@@ -173,8 +223,13 @@ class Handshakes:
             return connection.respond(http.HTTPStatus.FORBIDDEN, "cross-origin websocket refused\n")
         response = viser_response()
         path = request.path.partition("?")[0]
-        if response is not None and response.status_code == 200 and path in _PAGES and _cookie(headers) is None:
+        if (
+            response is not None
+            and response.status_code == 200
+            and path in _PAGES
+            and _cookie(headers, self.keys) is None
+        ):
             response.headers["Set-Cookie"] = (
-                f"{COOKIE}={secrets.token_hex(16)}; Path=/; Max-Age={COOKIE_MAX_AGE}; HttpOnly; SameSite=Strict"
+                f"{COOKIE}={self.keys.mint()}; Path=/; Max-Age={COOKIE_MAX_AGE}; HttpOnly; SameSite=Strict"
             )
         return response

@@ -15,10 +15,11 @@ from typing import Any
 
 from tpm_viz.app import sessions
 from tpm_viz.app.sessions import Document, Saved
+from tpm_viz.classroom.away import Away
 from tpm_viz.errors import TpmVizError
 from tpm_viz.ui._viser import connection_request
 from tpm_viz.ui.classroom import Classroom, identity, student_urls
-from tpm_viz.ui.continuity import Away, Store, reload, restore, saved_of
+from tpm_viz.ui.continuity import Store, reload, restore, saved_of
 from tpm_viz.ui.guard import guarded, log
 from tpm_viz.ui.lecturer import LecturerPanel
 
@@ -42,6 +43,8 @@ class Room:
         self.away = Away()
         self.lesson_step = 0
         self.urls: list[str] | None = None
+        self.notice = ""
+        """The last line about the store (set aside, not saving, saving again): in every lecturer's panel."""
         self._keys: weakref.WeakKeyDictionary[Any, str] = weakref.WeakKeyDictionary()
         self._lecturers: weakref.WeakKeyDictionary[Any, LecturerPanel] = weakref.WeakKeyDictionary()
         self.ready: weakref.WeakSet[Any] = weakref.WeakSet()
@@ -49,20 +52,31 @@ class Room:
 
     # -- start and stop ---------------------------------------------------------------------------------------------
     def start(self) -> None:
-        """Read the session file (the shared mechanism and the tabs that were away) and save from now on."""
+        """Read the store (the lecture and the tabs that were away; its notices go to the lecturer's panel) and save
+        from now on."""
         if self.classroom is not None:
             self.urls = student_urls("0.0.0.0", self.app.port, self.classroom.addresses())
-        doc = self.store.load()
+        doc, tabs = self.store.load()
         if doc is not None:
             try:
                 self._apply_shared(doc, origin=None)
-                self.away.restore(doc.tabs)
             except TpmVizError as exc:
-                print(f"warning: session file: {exc}; starting with the defaults", file=sys.stderr, flush=True)
-        self.store.start(self.document)
+                self.store.notices.append(f"the saved lecture: {exc}; starting with the defaults")
+                print(f"warning: {self.store.notices[-1]}", file=sys.stderr, flush=True)
+        self.away.restore(tabs)
+        self.notice = self.store.notices[-1] if self.store.notices else ""
+        self.store.start(self.document, self.say)
 
     def stop(self) -> None:
-        self.store.stop(self.document)
+        self.store.stop()
+
+    def say(self, line: str, problem: bool) -> None:
+        """A line about saving: on the terminal once, and in every lecturer's panel until the next one."""
+        print(f"warning: {line}" if problem else line, file=sys.stderr, flush=True)
+        self.notice = line
+        with self.app.hub.lock:
+            for panel in list(self._lecturers.values()):
+                panel.show_notice(line)
 
     # -- tabs -------------------------------------------------------------------------------------------------------
     def identify(self, client: Any) -> tuple[str | None, str, Any]:
@@ -74,7 +88,7 @@ class Room:
             camera = tuple(client.camera.position) + tuple(client.camera.wxyz)
         except Exception:  # no camera yet
             camera = None
-        return identity(remote, headers), str(host), camera
+        return identity(remote, headers, self.store.keys), str(host), camera
 
     def source(self, view: Any) -> str | None:
         """The address a tab connected from (the key of the presenter-login limits)."""
@@ -91,7 +105,8 @@ class Room:
         with hub.lock:
             record = self.away.take(key, camera) if key is not None and key.startswith("c:") else None
             here = self.classroom is not None and self.classroom.presenter_address(host)
-            if self.app.access.enabled and (here or (record is not None and record.get("presenter"))):
+            back = self.away.presenter(record, host)  # same address, within 2 minutes: never the cookie alone
+            if self.app.access.enabled and (here or back):
                 self.app.access.grant(view)  # this computer, or the presenter's device back after a drop
                 if view.login is not None:
                     view.login.show("**You are the presenter**" + (" (this computer)." if here else ": welcome back."))
@@ -123,7 +138,7 @@ class Room:
                 camera = None
             private = not view.session.shared
             presenter = self.app.access.is_presenter_tab(view)
-            self.away.park(key, private, saved_of(view), camera, presenter=presenter)
+            self.away.park(key, private, saved_of(view), camera, presenter=presenter, address=view.address)
 
     @guarded
     def _on_restore(self, event, view: Any) -> None:
@@ -147,11 +162,14 @@ class Room:
 
     def promoted(self, view: Any) -> None:
         """``view`` logged in as the presenter."""
+        self.away.end_presenters()  # a new presenter: no dropped tab comes back as one
         if view not in self._lecturers:
             self._add_lecturer(view)
 
     def _add_lecturer(self, view: Any) -> None:
-        self._lecturers[view] = LecturerPanel(view.client.gui, self, view, self.urls, presenter=self.app.access.enabled)
+        panel = LecturerPanel(view.client.gui, self, view, self.urls, presenter=self.app.access.enabled)
+        panel.show_notice(self.notice)
+        self._lecturers[view] = panel
 
     def hand_to_class(self, view: Any, open_: bool) -> None:
         """The presenter lets the class change the shared mechanism, or takes it back."""
@@ -190,6 +208,7 @@ class Room:
                         "saved": saved_of(view),
                         "left_at": now,
                         "presenter": app.access.is_presenter_tab(view),
+                        "address": getattr(view, "address", ""),
                     }
                     tabs.setdefault(key, []).append(record)
         return Document(shared, self.lesson_step, tabs)
@@ -205,7 +224,8 @@ class Room:
         with hub.lock:
             try:
                 hub.authorize(view, hub.shared)
-                doc = sessions.loads(data)
+                choice = getattr(getattr(view.teaching, "demos", None), "choice", None)
+                doc = sessions.loads(data, steps=None if choice is None else len(choice.options))
                 self._apply_shared(doc, origin=view)
             except TpmVizError as exc:
                 view.refuse(exc, resync=False)

@@ -1,0 +1,182 @@
+"""Tabs that left (:class:`Away`): kept per browser identity, bounded per browser, per source address and in total.
+
+viser gives every websocket connection a new client id and its page sends nothing that identifies the tab when it
+reconnects; what survives is the browser's cookie (:mod:`.identity`). A tab is recognised by its browser, and when
+the browser has several tabs, by the camera it sends first (a reconnecting page keeps its camera). Each tab that
+left is kept for :data:`~tpm_viz.app.sessions.KEEP_SECONDS`.
+
+Bounds: :data:`MAX_PER_BROWSER` tabs per browser, :data:`MAX_PER_ADDRESS` browsers per source address and
+:data:`MAX_AWAY` browsers in all. A new browser of an address that has its share pushes out that address's own
+oldest; when all are full, the oldest browser of the address holding the most goes (never another address's while
+this one has any). Every eviction is logged.
+
+The presenter's right is never restored from a cookie alone: :meth:`Away.presenter` is true only for a record of a
+presenter's tab coming back from the same address within :data:`PRESENTER_SECONDS`; :meth:`Away.end_presenters`
+(another tab logged in, or the presenter logged out) ends it for every record.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+from tpm_viz.app.sessions import KEEP_SECONDS, Saved
+
+__all__ = ["MAX_AWAY", "MAX_PER_ADDRESS", "MAX_PER_BROWSER", "PRESENTER_SECONDS", "Away"]
+
+log = logging.getLogger("tpm_viz.classroom")
+
+MAX_PER_BROWSER = 8
+MAX_PER_ADDRESS = 150
+"""Remembered browsers per source address (a class behind one address still fits)."""
+MAX_AWAY = 2000
+PRESENTER_SECONDS = 120.0
+"""How long [s] a presenter's tab that dropped may come back as the presenter (from the same address only)."""
+
+
+def _close(a: Any, b: Any) -> bool:
+    """Whether two cameras (tuples of numbers) are the same within 1e-6 (numpy's ``allclose``: rtol 1e-5)."""
+    if a is None or b is None:
+        return False
+    try:
+        x, y = [float(v) for v in a], [float(v) for v in b]
+    except (TypeError, ValueError):
+        return False
+    return len(x) == len(y) and all(abs(p - q) <= 1e-6 + 1e-5 * abs(q) for p, q in zip(x, y, strict=True))
+
+
+class Away:
+    """Tabs that left, per browser identity (oldest browser first); each for :data:`KEEP_SECONDS`. Thread-safe.
+
+    A record is ``{"private", "saved", "left_at", "camera", "presenter", "address"}``."""
+
+    def __init__(self, clock: Callable[[], float] = time.time) -> None:
+        self._clock = clock
+        self._lock = threading.Lock()
+        self._tabs: dict[str, list[dict[str, Any]]] = {}
+        self._address: dict[str, str] = {}
+        self.changed = 0
+        """Counts changes (the saver writes only when it moved)."""
+
+    def _prune(self) -> None:
+        now = self._clock()
+        for key in list(self._tabs):
+            kept = [r for r in self._tabs[key] if now - r["left_at"] <= KEEP_SECONDS][-MAX_PER_BROWSER:]
+            if kept != self._tabs[key]:
+                self.changed += 1
+            if kept:
+                self._tabs[key] = kept
+            else:
+                self._forget(key)
+
+    def _forget(self, key: str) -> None:
+        self._tabs.pop(key, None)
+        self._address.pop(key, None)
+        self.changed += 1
+
+    def _make_room(self, address: str) -> None:
+        """Before a new browser of ``address``: evict that address's oldest if it has its share, or (all full) the
+        oldest browser of the address with the most."""
+        mine = [k for k, a in self._address.items() if a == address]
+        if len(mine) >= MAX_PER_ADDRESS:
+            victim, why = mine[0], f"over its {MAX_PER_ADDRESS} remembered browsers"
+        elif len(self._tabs) >= MAX_AWAY:
+            counts: dict[str, int] = {}
+            for a in self._address.values():
+                counts[a] = counts.get(a, 0) + 1
+            top = max(counts, key=lambda a: (counts[a], a == address))
+            victim = next(k for k, a in self._address.items() if a == top)
+            why = f"{MAX_AWAY} browsers remembered in all"
+        else:
+            return
+        log.warning("forgot the oldest remembered tabs of a browser at %s (%s)", self._address.get(victim), why)
+        self._forget(victim)
+
+    def park(
+        self, key: str, private: bool, saved: Saved | None, camera: Any = None, presenter: bool = False, address=""
+    ) -> None:
+        """A tab of browser ``key`` left from ``address``: keep what it had (and whether it was the presenter's)."""
+        with self._lock:
+            self._prune()
+            if key not in self._tabs:
+                self._make_room(str(address))
+            record = {"private": private, "saved": saved, "left_at": self._clock(), "camera": camera}
+            record.update(presenter=presenter, address=str(address))
+            self._tabs.setdefault(key, []).append(record)
+            self._address[key] = str(address)
+            self._prune()
+            self.changed += 1
+
+    def take(self, key: str, camera: Any = None) -> dict[str, Any] | None:
+        """The record of the tab of browser ``key`` that is back (removed), if it can be told apart: the only one
+        of that browser, or the one whose camera it sends; else None (see :meth:`offer`)."""
+        with self._lock:
+            self._prune()
+            records = self._tabs.get(key, [])
+            matched = [r for r in records if _close(r.get("camera"), camera)]
+            chosen = matched[-1] if len(matched) == 1 else records[0] if len(records) == 1 else None
+            if chosen is not None:
+                records.remove(chosen)
+                self.changed += 1
+                if not records:
+                    self._forget(key)
+            return chosen
+
+    def presenter(self, record: dict[str, Any] | None, address: str) -> bool:
+        """Whether ``record`` (taken back) makes its tab the presenter again: a presenter's tab, from the same
+        address, within :data:`PRESENTER_SECONDS` of leaving."""
+        if record is None or record.get("presenter") is not True or record.get("address") != address:
+            return False
+        return 0.0 <= self._clock() - float(record["left_at"]) <= PRESENTER_SECONDS
+
+    def end_presenters(self) -> None:
+        """No record brings the presenter's right back any more (a new login, a logout)."""
+        with self._lock:
+            for records in self._tabs.values():
+                for r in records:
+                    if r.get("presenter"):
+                        r["presenter"] = False
+                        self.changed += 1
+
+    def offer(self, key: str) -> dict[str, Any] | None:
+        """The newest own copy of browser ``key`` that nobody took back yet (for the *Restore* button), or None."""
+        with self._lock:
+            self._prune()
+            private = [r for r in self._tabs.get(key, []) if r["private"] and r["saved"] is not None]
+            return private[-1] if private else None
+
+    def claim(self, key: str, record: dict[str, Any]) -> bool:
+        """Take ``record`` (offered earlier) if it is still there."""
+        with self._lock:
+            records = self._tabs.get(key, [])
+            if not any(r is record for r in records):
+                return False
+            records[:] = [r for r in records if r is not record]
+            self.changed += 1
+            if not records:
+                self._forget(key)
+            return True
+
+    def snapshot(self) -> dict[str, list[dict[str, Any]]]:
+        """Everything kept (oldest browser first), for the store."""
+        with self._lock:
+            self._prune()
+            return {k: [dict(r) for r in v] for k, v in self._tabs.items()}
+
+    def restore(self, tabs: dict[str, list[dict[str, Any]]]) -> None:
+        """Keep the tabs of the store (oldest first; their camera is not saved), within the same bounds."""
+        with self._lock:
+            for key, records in tabs.items():
+                address = str(records[0].get("address", "")) if records else ""
+                if key not in self._tabs:
+                    self._make_room(address)
+                self._tabs.setdefault(key, []).extend(dict(r, camera=None, address=address) for r in records)
+                self._address[key] = address
+            self._prune()
+
+    def __len__(self) -> int:
+        with self._lock:
+            return len(self._tabs)
