@@ -53,6 +53,8 @@ class LecturerPanel:
         with gui.add_folder("Lecturer", expand_by_default=urls is not None):
             self.join = gui.add_html(join_html(urls) if urls is not None else "")
             self.join.visible = urls is not None
+            self.notice = gui.add_markdown("")
+            self.notice.visible = False
             self.open_to_class = gui.add_checkbox(
                 "Let the class change the shared mechanism",
                 False,
@@ -66,6 +68,11 @@ class LecturerPanel:
         self.open_to_class.on_update(self._on_open_to_class)
         self.save.on_click(self._on_save)
         self.open.on_upload(self._on_open)
+
+    def show_notice(self, line: str) -> None:
+        """One line about the session store (set aside, not saving, saving again); empty: hidden."""
+        self.notice.content = f"**Session store**: {html.escape(line)}" if line else ""
+        self.notice.visible = bool(line)
 
     @guarded
     def _on_open_to_class(self, event) -> None:
