@@ -12,6 +12,8 @@ root ``/own``). What one tab sees of them (its gizmo, its view options) is :mod:
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import viser
 
@@ -54,6 +56,12 @@ LINE_SCALE = 2.0
 """Presentation mode: the lines (loci, leg circles) are this many times thicker."""
 LABEL_SCALE = 1.6
 """Presentation mode: the 3D labels are this many times larger."""
+
+
+@functools.lru_cache(maxsize=128)
+def _made(make, params: Params, *args):
+    """``make(params, *args)`` of :mod:`tpm_viz.meshes`, made once per mechanism (a reconnect storm: 100 own copies)."""
+    return make(params, *args)
 
 
 def _mesh(scene: viser.SceneApi, name: str, mesh, color, **kwargs):
@@ -153,7 +161,7 @@ class MechanismScene:
         self.params = params
         self._sent.clear()
         lo, hi = meshes.base_extent(params)
-        _mesh(s, f"{r}/base", meshes.base_plate(params), COLORS["base"])
+        _mesh(s, f"{r}/base", _made(meshes.base_plate, params), COLORS["base"])
         size = hi - lo
         s.add_grid(
             f"{r}/grid",
@@ -168,9 +176,10 @@ class MechanismScene:
             shadow_opacity=0.0,
         )
         for i in range(2):
-            _mesh(s, f"{r}/rail{i + 1}", meshes.rail(params, i), COLORS["rail"])
-            _mesh(s, f"{r}/stops{i + 1}", meshes.end_stops(params, i), COLORS["stop"])
-            self.slider_bodies[i] = _mesh(s, f"{r}/slider{i + 1}/body", meshes.slider(params, i), COLORS["slider"])
+            _mesh(s, f"{r}/rail{i + 1}", _made(meshes.rail, params, i), COLORS["rail"])
+            _mesh(s, f"{r}/stops{i + 1}", _made(meshes.end_stops, params, i), COLORS["stop"])
+            body = _made(meshes.slider, params, i)
+            self.slider_bodies[i] = _mesh(s, f"{r}/slider{i + 1}/body", body, COLORS["slider"])
             offsets = meshes.slider_pin_offsets(params, i)
             self._pins(f"{r}/slider{i + 1}/pins", offsets)
             centre = np.zeros(3)
@@ -186,7 +195,7 @@ class MechanismScene:
             self.labels[1 + 2 * i].position = (0.0, 0.0, meshes.SLIDER_Z[1])
             b_label = meshes.platform_pin_offsets(params)[2 * i] + (0.0, 0.0, meshes.PLATFORM_Z[1])
             self.labels[2 + 2 * i].position = tuple(b_label)
-        link = meshes.link(params)
+        link = _made(meshes.link, params)
         self.links = s.add_batched_meshes_simple(
             f"{r}/links",
             link.vertices,
@@ -198,11 +207,11 @@ class MechanismScene:
             cast_shadow=False,
             receive_shadow=False,
         )
-        self.platform_body = _mesh(s, f"{r}/platform/body", meshes.platform(params), COLORS["platform"])
+        self.platform_body = _mesh(s, f"{r}/platform/body", _made(meshes.platform, params), COLORS["platform"])
         _mesh(s, f"{r}/platform/marker", meshes.tool_marker(), COLORS["marker"])
         self._pins(f"{r}/platform/pins", meshes.platform_pin_offsets(params))
         self.label_p.position = (0.0, 0.0, meshes.PLATFORM_Z[1] + 0.01)
-        _mesh(s, f"{r}/ghost/body", meshes.platform(params), COLORS["circle"], opacity=0.22)
+        _mesh(s, f"{r}/ghost/body", _made(meshes.platform, params), COLORS["circle"], opacity=0.22)
         self.ghost_label.position = (0.0, 0.0, meshes.PLATFORM_Z[1])
         self._loci(params)
 
