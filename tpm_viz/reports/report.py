@@ -1,4 +1,4 @@
-"""The lab report of a run: one self-contained HTML file (issue 28).
+"""The lab report of a run: one self-contained HTML file.
 
 Nothing in it needs the network: the style is inline CSS, the path an inline SVG polyline, the force plot the
 inline SVG of :func:`tpm_viz.figures.force_plot_svg` (the style of the paper's Figs. 4-5: closed form solid,
@@ -27,16 +27,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tpm_viz.app.equations import ERRATA_HTML, procedure_html
+from tpm_viz.app.equations import errata_html, procedure_html
+from tpm_viz.app.run_names import label_words
 from tpm_viz.app.runs import Run
 from tpm_viz.csvio import format_columns
 from tpm_viz.figures import force_plot_svg
 from tpm_viz.paper.dynamics import inverse_dynamics_detail
 from tpm_viz.paper.jacobians import jacobians
 from tpm_viz.params import Params
-from tpm_viz.words import Lang, Phrase, T, say, shown_html
+from tpm_viz.words import Lang, Phrase, T, say
 
-__all__ = ["Section", "peak_instant", "report_html", "version"]
+__all__ = ["PARAM_WORDS", "Section", "peak_instant", "report_html", "version"]
 
 MAX_SECTION_ROWS = 40
 """Most rows of one extra section (control lab, planner)."""
@@ -88,6 +89,19 @@ def _number(value: float, fmt: str, unit: str = "") -> str:
     return f'<td class="num" data-value="{value!r}">{_esc(shown)}</td><td>{_esc(unit)}</td>'
 
 
+PARAM_WORDS = {
+    "a": T("total size a (Table 1): rail i starts at -a e_i"),
+    "b": T("platform offset b (Table 1): B_i = P - b e_i"),
+    "l_a": T("link length l_a (Table 1)"),
+    "m_a": T("slider mass m_a (Table 2)"),
+    "m_b": T("mass of both links of one parallelogram m_b (Table 2)"),
+    "m_p": T("platform mass m_p (Table 2)"),
+    "stroke": T("actuator stroke Δd (Table 1): 0 <= d_i <= Δd"),
+    "pivot_spacing": T("pivot spacing of the two parallelogram links"),
+}
+"""Each parameter's description (its ``doc`` in :class:`~tpm_viz.params.Params`) as a phrase, for the table."""
+
+
 def _parameters(params: Params, lang: Lang) -> str:
     rows = []
     for f in dataclasses.fields(params):
@@ -95,7 +109,7 @@ def _parameters(params: Params, lang: Lang) -> str:
         rows.append(
             f'<tr data-key="{f.name}"><td>{_esc(f.name)}</td>'
             + _number(getattr(params, f.name) * meta["ui_scale"], ".4g", meta["ui_unit"])
-            + f"<td>{_esc(meta['doc'])}</td></tr>"
+            + f"<td>{_esc(say(lang, PARAM_WORDS.get(f.name, meta['doc'])))}</td></tr>"
         )
     head = f"<tr><th>{say(lang, T('name'))}</th><th colspan=2>{say(lang, T('value'))}</th><th></th></tr>"
     return "<table>" + head + "".join(rows) + "</table>"
@@ -175,10 +189,10 @@ def _section(section: Section, lang: Lang) -> str:
     return f"<h2>{_esc(say(lang, section.title))}</h2><table>" + "".join(rows) + "</table>"
 
 
-def _procedure(run: Run, k: int) -> str:
+def _procedure(run: Run, k: int, lang: Lang) -> str:
     res = inverse_dynamics_detail(run.params, run.p[k], run.dp[k], run.ddp[k], d=run.d[k])
     jac = jacobians(run.params, run.p[k], run.d[k])
-    return procedure_html(run.params, res, jac)
+    return procedure_html(run.params, res, jac, lang=lang)
 
 
 def report_html(
@@ -191,8 +205,9 @@ def report_html(
     lang = Lang.parse(lang) if not isinstance(lang, Lang) else lang
     date = date or datetime.datetime.now(datetime.UTC).date()
     k = peak_instant(run)
-    title = say(lang, Phrase("Lab report: {run}", run=run.source.label))
-    figure = force_plot_svg(run.t, run.tau, run.tau_ref, title=f"Actuator forces: {run.source.label}")
+    label = label_words(run.source.label)
+    title = say(lang, Phrase("Lab report: {run}", run=label))
+    figure = force_plot_svg(run.t, run.tau, run.tau_ref, title=f"Actuator forces: {run.source.label}")  # no Hangul font
     csv_text = format_columns(run.columns())
     csv_link = "data:text/csv;charset=utf-8;base64," + base64.b64encode(csv_text.encode("utf-8")).decode("ascii")
     name = f"tpm-run-{run.source.kind}-T{run.duration:g}s.csv"
@@ -209,7 +224,7 @@ def report_html(
         f"<h2>{say(lang, T('Parameters'))}</h2>",
         _parameters(run.params, lang),
         f"<h2>{say(lang, T('The path'))}</h2><figure>{_path_svg(run, lang)}<figcaption>",
-        _esc(say(lang, Phrase("{label}: {n} samples, uniform in time", label=run.source.label, n=len(run.t)))),
+        _esc(say(lang, Phrase("{label}: {n} samples, uniform in time", label=label, n=len(run.t)))),
         f"</figcaption></figure><h2>{say(lang, T('Actuator forces'))}</h2>",
         f'<figure id="forces">{_inline_svg(figure)}<figcaption>',
         _esc(say(lang, T("The paper's closed form (solid) and the Pinocchio model (dotted), as in Figs. 4-5"))),
@@ -217,10 +232,10 @@ def report_html(
         f'<section id="results">{_results(run, k, lang)}</section>',
         f"<h2>{_esc(say(lang, Phrase('The procedure (a)-(e) at the peak force, t = {t} s', t=f'{run.t[k]:.4f}')))}"
         "</h2>",
-        f'<section id="procedure" data-t="{float(run.t[k])!r}">{shown_html(lang, _procedure(run, k))}</section>',
+        f'<section id="procedure" data-t="{float(run.t[k])!r}">{_procedure(run, k, lang)}</section>',
         *(_section(s, lang) for s in sections),
         f"<h2>{say(lang, T('Errata the numbers depend on'))}</h2>",
-        shown_html(lang, ERRATA_HTML),
+        errata_html(lang),
         f"<h2>{say(lang, T('Data'))}</h2><p>",
         f'<a id="csv" download="{_esc(name)}" href="{csv_link}">{_esc(say(lang, T("Download the run (CSV)")))}</a> ',
         _esc(say(lang, Phrase("({rows} rows; columns in SI units: s, m, m/s, m/s², N)", rows=len(run.t)))),

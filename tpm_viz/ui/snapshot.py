@@ -14,7 +14,7 @@ from functools import cached_property
 import numpy as np
 
 from tpm_viz import meshes
-from tpm_viz.app.equations import ERRATA_HTML, procedure_html
+from tpm_viz.app.equations import errata_html, procedure_html
 from tpm_viz.app.readouts import Readout
 from tpm_viz.app.state import AppState
 from tpm_viz.errors import TpmVizError
@@ -22,7 +22,7 @@ from tpm_viz.paper.dynamics import inverse_dynamics_detail
 from tpm_viz.paper.jacobians import jacobians
 from tpm_viz.paper.kinematics import MechanismPose, mechanism_pose
 from tpm_viz.ui.text import dashboard_html
-from tpm_viz.words import Lang
+from tpm_viz.words import Lang, say
 
 __all__ = ["Snapshot"]
 
@@ -41,6 +41,7 @@ class Snapshot:
         self.complete_readout: Callable[[], Readout] | None = None
         """For a live frame whose ``readout`` lacks the reference forces: computes the readout with them."""
         self._dashboards: dict[Lang, str] = {}
+        self._equations: dict[Lang, str] = {}
         self.made_at = time.monotonic()
         self.numbers: Snapshot = self
         """The frame whose numbers the dashboard shows: this one, or mid-drag a recent one (:meth:`follow`)."""
@@ -70,18 +71,25 @@ class Snapshot:
         positions, wxyzs = meshes.link_instances(self.mechanism)
         return positions.astype(np.float32), wxyzs.astype(np.float32)
 
-    @cached_property
+    @property
     def equations(self) -> str:
-        """The paper's procedure (a)-(e) with this state's numbers (MathML), and the errata."""
-        state = self.state
-        dp, ddp, f_ext = state.load.motion()
-        try:
-            res = inverse_dynamics_detail(state.params, state.pose.p, dp, ddp, f_ext, d=state.pose.d)
-            jac = jacobians(state.params, state.pose.p, state.pose.d)
-            body = procedure_html(state.params, res, jac, f_ext)
-        except TpmVizError as exc:
-            body = f"<p>{html.escape(str(exc))}</p>"
-        return body + ERRATA_HTML
+        """The paper's procedure (a)-(e) with this state's numbers (MathML), and the errata, in English."""
+        return self.equations_in(Lang.EN)
+
+    def equations_in(self, lang: Lang) -> str:
+        """The paper's procedure (a)-(e) with this state's numbers (MathML), and the errata, their words in ``lang``
+        (built once per language)."""
+        if lang not in self._equations:
+            state = self.state
+            dp, ddp, f_ext = state.load.motion()
+            try:
+                res = inverse_dynamics_detail(state.params, state.pose.p, dp, ddp, f_ext, d=state.pose.d)
+                jac = jacobians(state.params, state.pose.p, state.pose.d)
+                body = procedure_html(state.params, res, jac, f_ext, lang)
+            except TpmVizError as exc:
+                body = f"<p>{html.escape(say(lang, exc))}</p>"
+            self._equations[lang] = body + errata_html(lang)
+        return self._equations[lang]
 
     @cached_property
     def dashboard(self) -> str:

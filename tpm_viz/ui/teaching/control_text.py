@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import html
 
+from tpm_viz.app.run_names import reference_words
 from tpm_viz.multibody.control import ControlRun
 from tpm_viz.paper.control import ControllerKind, Gains
 from tpm_viz.ui.text import num
@@ -62,7 +63,7 @@ def setup_phrase(run: ControlRun) -> Phrase:
     return Phrase(
         "{name}, ω_n {wn:g} Hz, ζ {zeta:g}, payload {payload:g} kg, mass error {error} %, {limit}, {rate:g} Hz, "
         "noise {noise:g} µm",
-        name=run.name,
+        name=reference_words(run.name),
         wn=s.gains.wn,
         zeta=s.gains.zeta,
         payload=s.payload,
@@ -95,7 +96,7 @@ def run_html(
         head = Phrase(
             "<b>{controller}</b> on {name}, {t} s at {rate} Hz",
             controller=esc(say(lang, label_of(s.controller))),
-            name=esc(run.name),
+            name=esc(say(lang, reference_words(run.name))),
             t=num(run.t[-1], ".3f"),
             rate=num(s.rate, ".0f"),
         )

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import html
 
+from tpm_viz.app.run_names import label_words
 from tpm_viz.ui.text import num
 from tpm_viz.words import Lang, Phrase, T, say
 
@@ -24,7 +25,7 @@ def summary_html(ps, run, t, lang: Lang = Lang.EN) -> str:
     esc = html.escape
     lines = []
     if ps.loading is not None:
-        computing = Phrase("Computing {name} (closed form and Pinocchio)…", name=ps.loading.label)
+        computing = Phrase("Computing {name} (closed form and Pinocchio)…", name=label_words(ps.loading.label))
         lines.append(f"<i>{esc(say(lang, computing))}</i>")
     if ps.status:
         lines.append(f'<span style="color:#991b1b">{esc(say(lang, ps.status))}</span>')
@@ -34,7 +35,7 @@ def summary_html(ps, run, t, lang: Lang = Lang.EN) -> str:
     else:
         diff = run.max_diff
         peak = f"<span data-q='run-peak'>{num(run.peak, '.1f')}</span>"
-        name = f"<b>{esc(run.source.label)}</b>"
+        name = f"<b>{esc(say(lang, label_words(run.source.label)))}</b>"
         lines.append(say(lang, Phrase("{name}: peak |τ_i| = {peak} N (closed form)", name=name, peak=peak)))
         gap = (
             f"<span data-q='run-diff'>{num(diff, '.1e')}</span> N" if diff is not None else esc(say(lang, run.ref_note))
@@ -42,7 +43,9 @@ def summary_html(ps, run, t, lang: Lang = Lang.EN) -> str:
         lines.append(say(lang, Phrase("Pinocchio − paper: max |Δτ_i| = {gap}", gap=gap)))
         if ps.previous is not None:
             label, before = ps.previous
-            previous = Phrase("Previous run: {name}, peak {peak} N", name=esc(label), peak=num(before, ".1f"))
+            previous = Phrase(
+                "Previous run: {name}, peak {peak} N", name=esc(say(lang, label_words(label))), peak=num(before, ".1f")
+            )
             text = say(lang, previous)
             if before > 0:
                 text += say(lang, Phrase(" (this / previous = {ratio})", ratio=num(run.peak / before, ".3f")))
