@@ -47,6 +47,6 @@ WORKER_LOG_JS = """
 
 
 def text_input(page, handle):
-    """The ``<input>`` of a viser text field (``add_text``, e.g. a typed number of ``tpm_viz.ui.fields``): it has no
-    id of its own, so it is found by its label's ``for`` (the handle's uuid)."""
-    return page.locator(f'div:has(> div > p > label[for="{handle._impl.uuid}"]) input')
+    """The ``<input>`` of a viser text field (``add_text``; the ``<textarea>`` of a multi-line one, e.g. a typed number
+    of ``tpm_viz.ui.fields``): it has no id of its own, so it is found by its label's ``for`` (the handle's uuid)."""
+    return page.locator(f'div:has(> div > p > label[for="{handle._impl.uuid}"]) :is(input, textarea)')

@@ -4,14 +4,21 @@ viser's number inputs drop what they cannot show (``1e9`` became ``19``) and sen
 input sends every keystroke too, with no blur event. So a typed number is an ``add_text`` field read through a
 :class:`~tpm_viz.app.typed.TypedGroup`:
 
-- :class:`TypedBox`: the text fields of one group inside a viser form (``add_form(None)``: pressing Enter in one of
-  them submits the form, a real event), and the :class:`Note` under them: why a text is refused, the value in use
-  whenever a field's text is not it, the group's refusal, plausibility notes.
+- :class:`TypedBox`: the text fields of one group inside a viser form, and the :class:`Note` under them: why a text
+  is refused, the value in use whenever a field's text is not it, the group's refusal, plausibility notes. Enter is
+  part of the text: the fields are viser's multi-line text inputs (a textarea, drawn as one line by
+  :data:`ONE_LINE_CSS`), so Enter adds a line break to the field's text and that whole text is the last message the
+  page sends. viser's page sends every GUI message through one 50 ms throttle that keeps only the latest message:
+  a form's submit (Enter in a one-line input) replaced the keystrokes still held, and ``60`` typed with Enter in
+  one burst arrived as ``6`` then Enter. A text that holds a line break is entered: it is written back without it
+  and its group is settled (the form's submit still settles it too).
 - :class:`Typing`: the boxes of one tab and their behaviour. A keystroke is recorded (every field's text is read
   again, so a merged or lost event loses nothing); Enter, the box's Apply button, or the quiet time after the last
   keystroke (groups with one) settles the group: its values are applied together, or it is refused next to its
   fields. The quiet time is watched by one :class:`Waker` per tab (one timer thread at most, re-armed, never one
-  per keystroke).
+  per keystroke). The same throttle can still drop a box's last keys when keys for another box follow within
+  50 ms (Tab and keys in one burst); the server cannot tell, so a settled group's typed texts are written back
+  into the page as the server has them (:meth:`TypedBox.resend`): a box always shows what was applied.
 - :class:`Note`: a few lines under a control, in the tab's language. ``view.refuse(what, where=note)`` puts a
   refusal there instead of the top of the panel; the next success of the same control clears it.
 
@@ -32,7 +39,22 @@ from tpm_viz.errors import TpmVizError
 from tpm_viz.ui.guard import guarded
 from tpm_viz.words import Lang, Phrase, say
 
-__all__ = ["Note", "Place", "TypedBox", "Typing", "Waker", "as_phrase", "control", "note_html"]
+__all__ = ["ONE_LINE_CSS", "Note", "Place", "TypedBox", "Typing", "Waker", "as_phrase", "control", "note_html"]
+
+ONE_LINE_CSS = """<style>
+textarea.mantine-Textarea-input { max-height: 1.625rem !important; resize: none !important;
+  overflow: hidden !important; white-space: pre !important; line-height: 1.5rem !important; }
+</style>"""
+"""The typed fields (viser's multi-line text inputs, autosized to two rows) drawn as one line, like viser's one-line
+text input: every textarea of the panel is a typed field's. Added once per tab (by :class:`Typing`)."""
+
+
+def one_line(text: object) -> object:
+    """``text`` without its line breaks (a field's Enter, wherever the caret was; pasted lines are joined)."""
+    if isinstance(text, str) and ("\n" in text or "\r" in text):
+        return text.replace("\r", "").replace("\n", "")
+    return text
+
 
 Apply = Callable[[Mapping[str, float]], None]
 """What a settled group does with its values (raises :class:`~tpm_viz.TpmVizError` to refuse them)."""
@@ -94,7 +116,7 @@ class TypedBox:
 
     ``labels`` by key (fixed English texts, translated on the wire); ``hints`` by key (optional). The note is
     created right under the fields unless ``note=False`` (then the caller places it with :meth:`add_note`, e.g.
-    under an Apply button)."""
+    under an Apply button). ``form``: a form made by the caller (e.g. holding a slider before the fields)."""
 
     def __init__(
         self,
@@ -103,12 +125,13 @@ class TypedBox:
         labels: Mapping[str, str],
         hints: Mapping[str, str] | None = None,
         note: bool = True,
+        form: Any = None,
     ) -> None:
         self.group = group
-        self.form = gui.add_form(None)
+        self.form = gui.add_form(None) if form is None else form
         with self.form:
             self.inputs = {
-                key: gui.add_text(labels[key], group.fields[key].text, hint=(hints or {}).get(key))
+                key: gui.add_text(labels[key], group.fields[key].text, hint=(hints or {}).get(key), multiline=True)
                 for key in group.fields
             }
         self.note: Note | None = Note(gui) if note else None
@@ -121,14 +144,35 @@ class TypedBox:
         return self.note
 
     def texts(self) -> dict[str, object]:
-        """What each field holds now (as the browser last sent it, or the app wrote it)."""
-        return {key: handle.value for key, handle in self.inputs.items()}
+        """What each field holds now (as the browser last sent it, or the app wrote it), without line breaks."""
+        return {key: one_line(handle.value) for key, handle in self.inputs.items()}
+
+    def entered(self) -> bool:
+        """Whether Enter reached a field as part of its text (a line break): that field's text is written back
+        without it (the group is then to be settled)."""
+        hit = False
+        for handle in self.inputs.values():
+            text = one_line(handle.value)
+            if text != handle.value:
+                handle.value, hit = text, True
+        return hit
+
+    def resend(self) -> None:
+        """Write the text of each field the user typed in into the browser again, as the server has it: a keystroke
+        lost in viser's throttle (keys typed in this box, then within 50 ms in another one) leaves the browser
+        showing more than arrived; now the box shows what is applied. Nothing is pending when a group settles (the
+        entered text was the latest message; the quiet time is longer than the throttle), so nothing is lost."""
+        for key, handle in self.inputs.items():
+            if self.group.fields[key].own:
+                text = str(one_line(handle.value))
+                handle.value = text + " "  # viser sends only a changed value: change it, then back
+                handle.value = text
 
     def show(self, values: Mapping[str, float], force: bool = False) -> None:
         """The values in use (by key): written into the fields that show them (see ``TypedGroup.show``). A keystroke
         viser has stored but the tab's callback has not seen yet (the field's text is not the group's) is never
         written over, unless ``force``: the callback takes it next (another tab's move in between must not)."""
-        arrived = {key: self.inputs[key].value for key in values}
+        arrived = {key: one_line(self.inputs[key].value) for key in values}
         known = {key: self.group.fields[key].text for key in values}
         for key, text in self.group.show(values, force).items():
             if force or arrived[key] == known[key]:
@@ -248,9 +292,11 @@ class Typing:
         self.view = view
         self.boxes: list[tuple[TypedBox, Apply]] = []
         self.waker = Waker(self._tick)
+        self.style = view.client.gui.add_html(ONE_LINE_CSS)
+        """The tab's :data:`ONE_LINE_CSS` (in the panel's root: a tab's contents are drawn only while it is open)."""
 
     def add(self, box: TypedBox, apply: Apply) -> None:
-        """Wire ``box``: its keystrokes, its form's Enter; ``apply(values)`` when it settles."""
+        """Wire ``box``: its keystrokes (Enter among them), its form's submit; ``apply(values)`` when it settles."""
         self.boxes.append((box, apply))
         for handle in box.inputs.values():
             handle.on_update(self._on_key)
@@ -266,6 +312,9 @@ class Typing:
         with self.view.hub.lock:
             if not self.view.closed:
                 self._sync(time.monotonic())
+                for box, _apply in self.boxes:
+                    if box.entered():  # Enter, as a line break of the text: the whole text is here
+                        self.settle(box)
                 self.view.client.flush()
 
     @guarded(on_error=_internal_error)
@@ -303,6 +352,7 @@ class Typing:
         to its fields. A group in which nothing was typed, with nothing refused, has nothing to apply."""
         now = time.monotonic() if now is None else now
         box.group.sync(box.texts(), now)
+        box.resend()
         apply = next(a for b, a in self.boxes if b is box)
         group = box.group
         if any(f.own for f in group.fields.values()) or group.refusal is not None:
