@@ -1,4 +1,4 @@
-"""The *Control* tab of one browser tab (issue 14): simulate a controller tracking a reference on the Pinocchio
+"""The *Control* tab of one browser tab: simulate a controller tracking a reference on the Pinocchio
 plant, play the run, compare the controllers.
 
 Widgets: controller (PD, PD + feedforward, computed torque), ω_n and ζ (gains shown), mismatch (payload, mass
@@ -49,7 +49,9 @@ from tpm_viz.ui.teaching.control_text import (
 from tpm_viz.ui.teaching.motion import MotionPlayer, TimeChart
 from tpm_viz.ui.teaching.player import SPEEDS
 from tpm_viz.ui.teaching.playing import RunHub
+from tpm_viz.ui.teaching.settings import CONTROL_SETTINGS
 from tpm_viz.ui.teaching.trace import TRACE_Z, segments
+from tpm_viz.ui.typed_sliders import TypedSlider, add_sliders
 from tpm_viz.ui.worker import Worker
 from tpm_viz.words import Phrase, T, say
 
@@ -104,19 +106,14 @@ class ControlView:
             "mechanism you are on (shared with the class unless you work on your own copy)."
         )
         self.controller = gui.add_dropdown("Controller", tuple(CONTROLLERS), initial_value=LABELS[ControllerKind.CTC])
-        self.wn = gui.add_slider("ω_n (Hz)", 1.0, 60.0, 0.5, 20.0)
-        self.zeta = gui.add_slider("ζ", 0.1, 2.0, 0.05, 1.0)
+        self.typed: dict[str, TypedSlider] = {}  # each slider with a typed number beside it (ui/typed_sliders.py)
+        self.wn, self.zeta = add_sliders(self.view, CONTROL_SETTINGS, ("wn", "zeta"), self._show_gains, self.typed)
         self.gains = gui.add_html("")
         with gui.add_folder("Mismatch and limits"):
-            self.payload = gui.add_slider(
-                "Payload (kg)", 0.0, 5.0, 0.1, 0.0, hint="On the platform, unknown to the controller"
+            limits = ("payload", "mass_error", "force_limit", "rate", "noise")
+            self.payload, self.mass_error, self.force_limit, self.rate, self.noise = add_sliders(
+                self.view, CONTROL_SETTINGS, limits, self._show_gains, self.typed
             )
-            self.mass_error = gui.add_slider(
-                "Mass error (%)", -50.0, 50.0, 1.0, 0.0, hint="Of m_a, m_b, m_p in the model"
-            )
-            self.force_limit = gui.add_slider("Force limit (N, 0 = none)", 0.0, 1000.0, 10.0, 0.0)
-            self.rate = gui.add_slider("Controller rate (Hz)", 100.0, 5000.0, 100.0, 1000.0)
-            self.noise = gui.add_slider("Position noise (µm)", 0.0, 50.0, 1.0, 0.0)
         self.reference = gui.add_dropdown("Reference", tuple(PAPER), initial_value="line (Fig. 4)")
         self.simulate = gui.add_button("Simulate", icon=viser.Icon.PLAYER_TRACK_NEXT)
         self.lesson = gui.add_button("Why computed torque? (run all three)", icon=viser.Icon.SCHOOL, color="teal")
@@ -227,7 +224,10 @@ class ControlView:
         else:
             job = lambda: {setup.controller: timed(params, reference, setup)}  # noqa: E731
         self.worker.submit(
-            ("control", id(self)), job, lambda result, error: self._done(request, params, setup, lesson, result, error)
+            "control",
+            job,
+            lambda result, error: self._done(request, params, setup, lesson, result, error),
+            tab=self.view,  # the tab takes turns in the fair queue; its pending run is dropped when it closes
         )
 
     def _done(self, request: int, params: Params, setup: ControlSetup, lesson: bool, result, error) -> None:

@@ -1,4 +1,4 @@
-"""The *Planner* tab of one browser tab (issue 15): the time-optimal cycle of a path within the motors' limits.
+"""The *Planner* tab of one browser tab: the time-optimal cycle of a path within the motors' limits.
 
 Widgets: path (pick-and-place, the paper's line or circle, waypoints typed as ``x,y; x,y`` in mm or added by
 Shift+clicking the floor, viser's scene click events), force limit and
@@ -27,7 +27,9 @@ from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.teaching.motion import MotionPlayer, TimeChart
 from tpm_viz.ui.teaching.planner_text import industry_html, result_html, sizing_html
 from tpm_viz.ui.teaching.player import SPEEDS
+from tpm_viz.ui.teaching.settings import PLANNER_SETTINGS
 from tpm_viz.ui.teaching.trace import TRACE_Z, segments
+from tpm_viz.ui.typed_sliders import TypedSlider, add_sliders
 from tpm_viz.ui.worker import Worker
 from tpm_viz.words import Phrase, T
 
@@ -128,8 +130,8 @@ class PlannerView:
             hint="Or Shift+click points on the floor; Clear starts a new list",
         )
         self.clear = gui.add_button("Clear waypoints", color="gray", visible=False)
-        self.force = gui.add_slider("Force limit F_max (N)", 20.0, 1000.0, 5.0, 200.0)
-        self.speed = gui.add_slider("Speed limit (m/s, 0 = none)", 0.0, 5.0, 0.05, 0.0)
+        self.typed: dict[str, TypedSlider] = {}  # each slider with a typed number beside it (ui/typed_sliders.py)
+        self.force, self.speed = add_sliders(self.view, PLANNER_SETTINGS, ("force", "speed"), self.request, self.typed)
         self.result_html = gui.add_html(result_html(None, 200.0, None, False, lang=self.view.lang))
         self.controls = gui.add_button_group("Playback", ("Play", "Pause", "To start"))
         self.play_speed = gui.add_dropdown("Speed", tuple(SPEEDS), initial_value="0.1×")
@@ -179,9 +181,10 @@ class PlannerView:
             self._request += 1
             request = self._request
         self.worker.submit(
-            ("plan", id(self)),
+            "plan",
             lambda: solve(params, kind, force, speed if speed > 0 else None, text),
             lambda result, error: self._done(request, params, result, error),
+            tab=self.view,  # the tab takes turns in the fair queue (latest wins per tab)
         )
 
     def _done(self, request: int, params: Params, result, error) -> None:
