@@ -72,7 +72,7 @@ def decode_text(data: bytes, source: str = "input") -> str:
     return "".join(binary_lines(io.BufferedReader(io.BytesIO(data)), source, len(data) + 1))
 
 
-def binary_lines(raw, source: str, max_bytes: int) -> Iterator[str]:
+def binary_lines(raw: io.BufferedReader, source: str, max_bytes: int) -> Iterator[str]:
     """Decoded lines of a binary stream ``raw`` (see :func:`decode_text`; each keeps its line end), refused past
     ``max_bytes`` characters in all, at a NUL byte or at a line over :data:`MAX_LINE`."""
     head = raw.peek(4)[:4]

@@ -23,9 +23,10 @@ import os
 import sys
 import tempfile
 from collections.abc import Iterable, Iterator, Mapping, Sequence
-from typing import IO
+from typing import IO, Protocol, cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tpm_viz.csvdialect import (
     DELIMITERS,
@@ -61,6 +62,17 @@ _CELLS = T("{source}: row {row} has {cells} cells, the header has {width}")
 _TOO_MANY = T("{source} has more than {limit} data rows (the limit); split the file")
 
 
+class Rows(Protocol):
+    """A :func:`csv.reader`: rows of cells, and the number of the line it has read up to."""
+
+    @property
+    def line_num(self) -> int: ...
+
+    def __iter__(self) -> Iterator[list[str]]: ...
+
+    def __next__(self) -> list[str]: ...
+
+
 class Table(dict):
     """``{column: float array}`` in SI units, plus ``units``: the unit each column had in the file (``""``: none)."""
 
@@ -70,7 +82,7 @@ class Table(dict):
 def _open_lines(path: str, max_bytes: int) -> tuple[Iterator[str], IO[bytes] | None]:
     """Lines of the file at ``path`` (``-``: stdin), refused at once if a regular file is over ``max_bytes``."""
     if path == "-":
-        raw = sys.stdin.buffer
+        raw = cast(io.BufferedReader, sys.stdin.buffer)  # typed BinaryIO; binary_lines needs its peek
         fh = None
     else:
         raw = fh = open(path, "rb")
@@ -135,7 +147,9 @@ def parse_lines(
         raise InputError(Phrase(_NOT_CSV.template, source=source, line=at, why=str(exc))) from None
 
 
-def _read_records(reader, required, source, max_rows, offset, header_line) -> Table:
+def _read_records(
+    reader: Rows, required: Sequence[str], source: str | Phrase, max_rows: int, offset: int, header_line: str
+) -> Table:
     raw_header = next(reader)
     while raw_header and not raw_header[-1].strip():
         raw_header.pop()  # trailing empty columns (spreadsheets)
@@ -198,7 +212,9 @@ def _read_records(reader, required, source, max_rows, offset, header_line) -> Ta
     return table
 
 
-def _numbers(rows: list[list[str]], where: list[int], used, idx, source: str | Phrase) -> np.ndarray:
+def _numbers(
+    rows: list[list[str]], where: list[int], used: Sequence[str], idx: Sequence[int], source: str | Phrase
+) -> np.ndarray:
     """The used cells of ``rows`` as floats ``(len(rows), len(used))``; one-line errors name row and column."""
     data = np.empty((len(rows), len(used)))
     for k, (c, j) in enumerate(zip(used, idx, strict=True)):
@@ -240,7 +256,7 @@ def format_columns(columns: Mapping[str, np.ndarray]) -> str:
     return out.getvalue()
 
 
-def _strings(col) -> list[str]:
+def _strings(col: ArrayLike) -> list[str]:
     arr = np.asarray(col)
     if arr.dtype.kind in "biu":
         return list(map(str, arr.astype(np.int64).tolist()))
@@ -253,7 +269,7 @@ def _strings(col) -> list[str]:
     return [str(x) for x in arr.tolist()]
 
 
-def write_csv(fh, columns: Mapping[str, np.ndarray]) -> None:
+def write_csv(fh: IO[str], columns: Mapping[str, np.ndarray]) -> None:
     """Write equal-length columns as CSV to the text file object ``fh`` (in chunks of rows)."""
     names = list(columns)
     n = len(next(iter(columns.values())))

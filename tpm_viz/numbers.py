@@ -93,14 +93,14 @@ DASH = "—"
 """What :func:`fixed` shows for a number that is missing or not finite."""
 
 
-def fixed(x, fmt: str = ".1f", scale: float = 1.0) -> str:
+def fixed(x: object, fmt: str = ".1f", scale: float = 1.0) -> str:
     """``x * scale`` formatted with ``fmt`` (a :func:`format` spec: ``".1f"``, ``"+.2f"``, ``".3e"``, ``"g"``)
     as a number is shown to people: :data:`DASH` for None, NaN, infinity or a non-number, and never a negative
     zero (``fixed(-1e-12, ".1f")`` is ``"0.0"``, ``fixed(-0.04, "+.1f")`` is ``"+0.0"``)."""
     if x is None or isinstance(x, bool):
         return DASH
     try:
-        v = float(x) * float(scale)
+        v = float(x) * float(scale)  # type: ignore[arg-type]  # anything: not a number shows DASH
     except (TypeError, ValueError, OverflowError):
         return DASH
     if not math.isfinite(v):
@@ -112,7 +112,7 @@ def fixed(x, fmt: str = ".1f", scale: float = 1.0) -> str:
     return text
 
 
-def shorten(text, limit: int = QUOTE) -> str:
+def shorten(text: object, limit: int = QUOTE) -> str:
     """``repr`` of ``text`` cut to about ``limit`` characters (``'123...'``), for messages."""
     text = str(text)
     if len(text) <= limit:
@@ -127,7 +127,7 @@ def _label(name: str | Phrase, unit: str) -> str | Phrase:
     return Phrase("{name} [{unit}]", name=named, unit=unit) if unit else named
 
 
-def parse_number(text, name: str | Phrase = "value", unit: str = "") -> float:
+def parse_number(text: object, name: str | Phrase = "value", unit: str = "") -> float:
     """The finite float that ``text`` spells (rules in the module docstring), else a one-line InputError.
 
     ``name`` names the field in messages (a plain name, or a phrase such as ``T("duration")``, shown in a tab's

@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
+from typing import Protocol
 
 from tpm_viz.errors import InvalidParametersError
 from tpm_viz.numbers import fixed
@@ -22,7 +23,7 @@ _RANGES = {"m": (1e-6, 100.0), "kg": (1e-9, 1e4)}
 """Supported magnitudes per unit: keeps every derived quantity (l_a², c_i³, ...) finite in float64."""
 
 
-def _f(doc: str, unit: str, ui_unit: str, ui_scale: float, default: float):
+def _f(doc: str, unit: str, ui_unit: str, ui_scale: float, default: float) -> float:
     return field(default=default, metadata={"doc": doc, "unit": unit, "ui_unit": ui_unit, "ui_scale": ui_scale})
 
 
@@ -193,6 +194,12 @@ def _behind_start(a: float, b: float, l_a: float, stroke: float) -> bool:
     return (a - b) + l_a <= 0.0
 
 
+class _Rule(Protocol):
+    """A geometric rule of :func:`geometry_problem`: whether lengths ``a, b, l_a, stroke`` [m] break it."""
+
+    def __call__(self, a: float, b: float, l_a: float, stroke: float) -> bool: ...
+
+
 # (rule, field) -> whether the fix is a lower bound, and the exact bound [m] from (a, b, l_a, stroke)
 _FIXES = {
     (_beyond_reach, "l_a"): (True, lambda a, b, la, s: (a - b - s) / math.sqrt(2.0)),
@@ -210,7 +217,7 @@ def _fits(values: dict[str, float], spacing: float) -> bool:
     return not (_beyond_reach(**values) or _behind_start(**values)) and spacing < values["l_a"]
 
 
-def _shown_bound(rule, name: str, values: dict[str, float], spacing: float) -> str | None:
+def _shown_bound(rule: _Rule, name: str, values: dict[str, float], spacing: float) -> str | None:
     """The fix's bound in mm, rounded to 0.1 mm on the accepted side: with that value (as typed, in mm) every
     geometric rule holds, and with the one 0.1 mm further back ``rule`` fails (the exact bound lies between them).
     None if changing ``name`` alone cannot make the set valid."""
@@ -226,7 +233,7 @@ def _shown_bound(rule, name: str, values: dict[str, float], spacing: float) -> s
     return None
 
 
-def _fix(rule, name: str, bound: str, values: dict[str, float]) -> Phrase:
+def _fix(rule: _Rule, name: str, bound: str, values: dict[str, float]) -> Phrase:
     """The fix of one field, as a whole clause with the other values."""
     mm = {k: _ui(k, v) for k, v in values.items()}
     a, b, l_a, stroke = mm["a"], mm["b"], mm["l_a"], mm["stroke"]
@@ -269,7 +276,7 @@ def _fix(rule, name: str, bound: str, values: dict[str, float]) -> Phrase:
     return Phrase("b must be at most {bound} mm with a = {a} mm and l_a = {l_a} mm", bound=bound, a=a, l_a=l_a)
 
 
-def _alternative(rule, name: str, bound: str) -> Phrase:
+def _alternative(rule: _Rule, name: str, bound: str) -> Phrase:
     """The fix of one field, short (the second choice offered)."""
     lower = _FIXES[(rule, name)][0]
     if name == "l_a":
@@ -284,7 +291,7 @@ def _alternative(rule, name: str, bound: str) -> Phrase:
 
 
 def geometry_problem(
-    a: float, b: float, l_a: float, stroke: float, pivot_spacing: float = 0.0, prefer=()
+    a: float, b: float, l_a: float, stroke: float, pivot_spacing: float = 0.0, prefer: Iterable[str] = ()
 ) -> Phrase | None:
     """Why no pose of ``a, b, l_a, stroke`` [m] fits in the stroke, phrased as the fix (None if one does).
 

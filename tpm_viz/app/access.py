@@ -7,7 +7,7 @@ password input, so the token goes through a text field that the server clears at
 sees the shared mechanism and may do anything on its own copy (*Work on my own copy*), but a change it makes to
 the shared one is refused with a message to that tab only.
 
-No viser in :class:`Access` (tested without a server); :class:`LoginPanel` is the small widget group.
+No viser in :class:`Access` (tested without a server); :class:`tpm_viz.ui.login.LoginPanel` is the small widget group.
 Tokens are compared in constant time. Wrong attempts are counted per *source address* (a tab that reconnects
 does not start again) and server-wide: :data:`MAX_FAILURES` per address per :data:`LOCKOUT_SECONDS`, after which
 each new lockout of that address lasts twice as long (up to :data:`MAX_LOCKOUT_SECONDS`), and at most
@@ -15,7 +15,7 @@ each new lockout of that address lasts twice as long (up to :data:`MAX_LOCKOUT_S
 
 Classroom mode (``tpm-viz serve --classroom``): a tab opened on the serving machine itself is a presenter
 (:meth:`Access.grant`), and the presenter can hand the shared mechanism to the class and take it back
-(:attr:`Access.open_to_class`).
+(``Access.open_to_class``).
 """
 
 from __future__ import annotations
@@ -24,6 +24,8 @@ import hmac
 import threading
 import time
 import weakref
+from collections.abc import Callable
+from typing import Protocol
 
 from tpm_viz.errors import InputError
 from tpm_viz.words import Phrase
@@ -42,6 +44,19 @@ DENIED = Phrase(
 )
 
 
+class Tab(Protocol):
+    """A browser tab as :class:`Access` sees it: only its identity counts (kept in a weak set, so hashable)."""
+
+    def __hash__(self) -> int: ...
+
+
+class Committed(Protocol):
+    """A session as :class:`Access` sees it: the class's shared mechanism or a tab's private copy."""
+
+    @property
+    def shared(self) -> bool: ...
+
+
 class AccessDenied(InputError):
     """A change to the shared mechanism from a tab that is not the presenter's (presenter mode only)."""
 
@@ -58,7 +73,7 @@ def check_token(token: str | None) -> str | None:
 class Access:
     """The presenter token (or None) and the set of tabs that proved it. Thread-safe."""
 
-    def __init__(self, token: str | None = None, clock=time.monotonic) -> None:
+    def __init__(self, token: str | None = None, clock: Callable[[], float] = time.monotonic) -> None:
         checked = None if token is None else check_token(token)
         self._token = None if checked is None else checked.encode()
         self._presenters: weakref.WeakSet = weakref.WeakSet()
@@ -75,33 +90,33 @@ class Access:
         """Whether presenter mode is on (a token was given)."""
         return self._token is not None
 
-    def is_presenter(self, view) -> bool:
+    def is_presenter(self, view: Tab) -> bool:
         """Whether ``view`` may change the shared mechanism (always True without presenter mode)."""
         if self._token is None:
             return True
         with self._lock:
             return view in self._presenters
 
-    def is_presenter_tab(self, view) -> bool:
+    def is_presenter_tab(self, view: Tab) -> bool:
         """Whether ``view`` logged in (or was granted): presenter mode only; False without a token."""
         with self._lock:
             return self._token is not None and view in self._presenters
 
-    def grant(self, view) -> None:
+    def grant(self, view: Tab) -> None:
         """Make ``view`` a presenter tab without a token (a tab opened on the serving machine, classroom mode)."""
         with self._lock:
             self._presenters.add(view)
 
-    def may_change(self, view, session) -> bool:
+    def may_change(self, view: Tab, session: Committed) -> bool:
         """Whether ``view`` may commit to ``session`` (private copies: always)."""
         return not getattr(session, "shared", False) or self.open_to_class or self.is_presenter(view)
 
-    def check(self, view, session) -> None:
+    def check(self, view: Tab, session: Committed) -> None:
         """Raise :class:`AccessDenied` unless ``view`` may commit to ``session``."""
         if not self.may_change(view, session):
             raise AccessDenied(DENIED)
 
-    def login(self, view, attempt, source: str | None = None) -> bool:
+    def login(self, view: Tab, attempt: object, source: str | None = None) -> bool:
         """Make ``view`` a presenter tab if ``attempt`` is the token; raises after too many wrong attempts from
         ``source`` (the tab's address; default: the tab itself) or from everybody (see the module docstring)."""
         if self._token is None:
@@ -140,7 +155,7 @@ class Access:
                     del self._failures[old]
             return False
 
-    def logout(self, view) -> None:
+    def logout(self, view: Tab) -> None:
         """``view`` is no longer a presenter tab (it closed or logged out)."""
         with self._lock:
             self._presenters.discard(view)

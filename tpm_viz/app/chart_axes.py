@@ -21,9 +21,11 @@ Pure: numbers in, numbers and strings out (display units: the caller scales SI v
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 __all__ = ["MINUS", "Ticks", "nice_step", "text_width", "tick_labels", "time_ticks", "value_ticks"]
 
@@ -84,7 +86,7 @@ def _exponent(x: float) -> int:
     return math.floor(math.log10(x) + 1e-9)
 
 
-def tick_labels(values, k: int) -> tuple[str, ...]:
+def tick_labels(values: Iterable[float], k: int) -> tuple[str, ...]:
     """Labels of ticks on multiples of ``m × 10^k``: written out with ``max(0, -k)`` decimals (thousands
     separated by commas), or as ``a.b×10ⁿ`` (one exponent for the axis) when a tick reaches 10⁶, or when
     ``k < -4`` on an axis whose ticks all lie below 1 (``5×10⁻⁶`` rather than ``0.000005``)."""
@@ -162,7 +164,7 @@ def time_ticks(
         m, k = _next(m, k)
 
 
-def value_ticks(data, most: int = 5, resolution: float = 1e-9) -> Ticks:
+def value_ticks(data: ArrayLike, most: int = 5, resolution: float = 1e-9) -> Ticks:
     """Ticks around the finite values of ``data`` (display units): the range is the smallest span of whole
     steps holding every value, at most ``most`` ticks (``most >= 3``), all of them inside it. Values within
     ``resolution`` of each other are one flat line, shown over ``c ± 10 %`` of their level ``c`` (``[-1, 1]``

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import enum
 import itertools
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -96,7 +97,7 @@ def _start(
     task: Task,
     settings: Settings,
     limits: Limits,
-    adjust,
+    adjust: Callable[[dict[str, float]], dict[str, float]],
     count: int,
 ) -> dict[str, float] | None:
     """The fastest feasible point of a ``count``-per-variable grid over ``bounds`` (None if none)."""

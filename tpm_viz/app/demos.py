@@ -124,7 +124,7 @@ def demo_source(demo: Demo, duration: float | None = None) -> Source | None:
         return None
     T = m.duration if duration is None else duration
     label = demo.title.split(". ", 1)[-1].lower()
-    if m.kind == "segment":
+    if m.kind == "segment" and m.start is not None and m.end is not None:
         return Source.segment(m.start, m.end, T, label=f"{label}, T = {T:g} s")
     if m.kind == "csv":
         if m.trajectory is None:

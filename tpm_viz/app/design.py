@@ -26,11 +26,12 @@ two successive means agree to ``rtol`` (1e-3; the finer one is returned). An inf
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from tpm_viz.app.paths import PickSize, pick_and_place
+from tpm_viz.app.paths import GeometricPath, PickSize, pick_and_place
 from tpm_viz.app.planner import DEFAULT_GRID, Limits, plan_path
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.paper import arrangement as arr
@@ -222,7 +223,7 @@ def _gauss_rule(task: Task, panels: int, order: int = GAUSS_ORDER) -> tuple[np.n
     return nodes, np.outer(wu, wu).ravel()
 
 
-def area_means(f, task: Task, rtol: float = 1e-3) -> tuple[np.ndarray, int]:
+def area_means(f: Callable[[np.ndarray], np.ndarray], task: Task, rtol: float = 1e-3) -> tuple[np.ndarray, int]:
     """Area means over ``task`` of the columns of ``f(points) -> (n, k)``, and the panels per side used.
 
     Composite Gauss-Legendre (:data:`GAUSS_ORDER`² nodes per panel), panels per side 1, 2, 4, ... until every
@@ -241,7 +242,9 @@ def area_means(f, task: Task, rtol: float = 1e-3) -> tuple[np.ndarray, int]:
     raise InputError(f"the area means did not converge to {rtol:g} with {panels} panels")
 
 
-def _refined_max(g, task: Task, grid: np.ndarray, values: np.ndarray, levels: int = 2) -> float:
+def _refined_max(
+    g: Callable[[np.ndarray], np.ndarray], task: Task, grid: np.ndarray, values: np.ndarray, levels: int = 2
+) -> float:
     """The maximum of ``g(points) -> (n,)`` over the task: the grid's best point, then two zooms of a 21 x 21 grid
     over the neighbouring cells (each 10 times finer)."""
     best = int(np.argmax(values))
@@ -286,7 +289,7 @@ def footprint(arrangement: Arrangement, params: Params, grid: np.ndarray) -> tup
     return float(size[0]), float(size[1])
 
 
-def pick_path(task: Task):
+def pick_path(task: Task) -> GeometricPath:
     """The standard pick: from ``(x0, y_c - h/2)`` up ``h``, across the task's width, down ``h`` (``h`` =
     :data:`PICK_RISE`, or the task's height if smaller; corners :data:`PICK_CORNER` or less), centred in height."""
     h = min(PICK_RISE, task.height)
@@ -305,7 +308,7 @@ def _cubic_inverse(fraction: np.ndarray) -> np.ndarray:
     return (lo + hi) / 2
 
 
-def _peak_cubic(arrangement: Arrangement, params: Params, path, duration: float, n: int = 1001) -> float:
+def _peak_cubic(arrangement: Arrangement, params: Params, path: GeometricPath, duration: float, n: int = 1001) -> float:
     """Peak ``|τ_i|`` [N] along ``path`` under the cubic law ``s = L (3u² - 2u³)``, ``u = t / duration``, at ``n``
     even instants and at the junctions, both sides (the return stroke has the same peak: ``τ`` is even in ``ṗ``)."""
     big = path.length

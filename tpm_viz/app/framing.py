@@ -30,6 +30,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 __all__ = [
     "FULL",
@@ -81,7 +82,7 @@ class Framing:
         return float(np.linalg.norm(self.look_at - self.position))
 
 
-def box_corners(lo, hi) -> np.ndarray:
+def box_corners(lo: ArrayLike, hi: ArrayLike) -> np.ndarray:
     """The 8 corners (8 x 3) [m] of the axis-aligned box with opposite corners ``lo`` and ``hi`` (3-vectors)."""
     lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
     pick = np.array([[(k >> axis) & 1 for axis in range(3)] for k in range(8)], dtype=bool)
@@ -96,13 +97,13 @@ def _unit(v: np.ndarray, what: str) -> np.ndarray:
 
 
 def frame_points(
-    points,
-    view_from,
+    points: ArrayLike,
+    view_from: ArrayLike,
     fov: float,
     aspect: float,
     free: Region = FULL,
     margin: float = 0.05,
-    up=(0.0, 0.0, 1.0),
+    up: ArrayLike = (0.0, 0.0, 1.0),
     near: float = 0.01,
 ) -> Framing:
     """The closest camera, looking along ``-view_from``, that shows every point inside ``free`` less ``margin``.
@@ -175,12 +176,12 @@ def free_region(presentation: bool = False) -> Region:
 
 
 def frame_box(
-    lo,
-    hi,
+    lo: ArrayLike,
+    hi: ArrayLike,
     fov: float,
     aspect: float,
     presentation: bool = False,
-    view_from=VIEW_FROM,
+    view_from: ArrayLike = VIEW_FROM,
 ) -> Framing:
     """The closest camera, looking along ``-view_from``, that shows the whole axis-aligned box ``lo``-``hi`` [m]
     (the mechanism's extreme points) inside :func:`free_region` less :data:`MARGIN`, on a canvas of ``aspect``

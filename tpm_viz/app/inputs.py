@@ -60,7 +60,7 @@ TOO_LARGE = T("the file is too large ({size} bytes; at most {most} bytes)")
 the transport's, ``tpm_viz.ui.transport``, which refuses it before any byte is buffered)."""
 
 
-def value_problem(current, value, max_text: int = MAX_TEXT) -> str | None:
+def value_problem(current: object, value: object, max_text: int = MAX_TEXT) -> str | None:
     """Why ``value`` is not a value of the same kind as a widget's ``current`` value (None if it is): a finite
     number (not a boolean, not text) for a number, a boolean for a boolean, text of at most ``max_text`` characters
     for text, a sequence of the same length, item by item, for a tuple."""
@@ -88,12 +88,14 @@ def value_problem(current, value, max_text: int = MAX_TEXT) -> str | None:
     return f"a value of the wrong type for this widget ({type(value).__name__})"
 
 
-def read_number(value, name: str | Phrase, scale: float = 1.0, lo: float = -math.inf, hi: float = math.inf) -> float:
+def read_number(
+    value: object, name: str | Phrase, scale: float = 1.0, lo: float = -math.inf, hi: float = math.inf
+) -> float:
     """A finite number from a widget, times ``scale`` (UI unit -> SI), clipped to ``[lo, hi]`` (SI)."""
     if isinstance(value, bool):
         raise InputError(Phrase("{name} must be a number, got {got}", name=name, got=_show(value)))
     try:
-        x = float(value)
+        x = float(value)  # type: ignore[arg-type]  # anything a browser sent: TypeError is caught
     except (TypeError, ValueError, OverflowError):
         raise InputError(Phrase("{name} must be a number, got {got}", name=name, got=_show(value))) from None
     if not math.isfinite(x):
@@ -104,13 +106,13 @@ def read_number(value, name: str | Phrase, scale: float = 1.0, lo: float = -math
     return float(np.clip(scaled, lo, hi))
 
 
-def read_vec2(value, name: str | Phrase, scale: float = 1.0, bound: float = math.inf) -> np.ndarray:
+def read_vec2(value: object, name: str | Phrase, scale: float = 1.0, bound: float = math.inf) -> np.ndarray:
     """Two finite numbers from a widget, times ``scale`` (UI unit -> SI), each clipped to ``[-bound, bound]``."""
     two = Phrase("{name} must be two numbers, got {got}", name=name, got=_show(value))
     if isinstance(value, (str, bytes, Mapping)):
         raise InputError(two)
     try:
-        items = list(value)
+        items = list(value)  # type: ignore[call-overload]  # anything a browser sent: TypeError is caught
     except TypeError:
         raise InputError(two) from None
     if len(items) != 2:
@@ -118,7 +120,7 @@ def read_vec2(value, name: str | Phrase, scale: float = 1.0, bound: float = math
     return np.array([read_number(v, name, scale, -bound, bound) for v in items])
 
 
-def read_choice(value, name: str | Phrase, choices: Iterable[str]) -> str:
+def read_choice(value: object, name: str | Phrase, choices: Iterable[str]) -> str:
     """One of ``choices`` (a dropdown value), else :class:`~tpm_viz.InputError`."""
     choices = tuple(choices)
     if not isinstance(value, str) or value not in choices:
@@ -130,7 +132,7 @@ def read_choice(value, name: str | Phrase, choices: Iterable[str]) -> str:
     return value
 
 
-def read_flag(value, name: str | Phrase) -> bool:
+def read_flag(value: object, name: str | Phrase) -> bool:
     """A checkbox value: a real boolean (``0``/``1`` accepted), else :class:`~tpm_viz.InputError`."""
     if isinstance(value, bool):
         return value
@@ -149,7 +151,7 @@ def read_params(params: Params, raw: Mapping[str, object]) -> Params:
     return params.replace(**changes)
 
 
-def read_upload(content, filename: str = "upload.csv", max_bytes: int = MAX_UPLOAD_BYTES) -> Trajectory:
+def read_upload(content: object, filename: str = "upload.csv", max_bytes: int = MAX_UPLOAD_BYTES) -> Trajectory:
     """A trajectory from an uploaded CSV file (columns ``t,p1,p2`` in s, m, m), checked from the bytes up.
 
     Refused with a one-line :class:`~tpm_viz.InputError`: not bytes, larger than ``max_bytes``, not UTF-8,
@@ -194,7 +196,7 @@ def read_upload(content, filename: str = "upload.csv", max_bytes: int = MAX_UPLO
     return traj
 
 
-def _clean_name(filename) -> str:
+def _clean_name(filename: object) -> str:
     """A short printable trajectory name from an uploaded file name (never a path)."""
     text = filename if isinstance(filename, str) else "upload.csv"
     text = text.replace("\\", "/").rsplit("/", 1)[-1]
@@ -202,7 +204,7 @@ def _clean_name(filename) -> str:
     return text or "upload.csv"
 
 
-def _show(value) -> str:
+def _show(value: object) -> str:
     """A short, printable rendering of an untrusted value for a message (never the whole of a huge string)."""
     text = repr(value)
     return text if len(text) <= 40 else text[:37] + "..."

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import importlib.util
 import math
+import os
 import pathlib
 import re
 
@@ -164,7 +165,7 @@ def _key_of(path: pathlib.Path) -> str:
     return re.sub(r"^[0-9]+[-_ .]*", "", path.stem) or path.stem
 
 
-def load_lesson(path, root=None) -> Demo:
+def load_lesson(path: str | os.PathLike[str], root: str | os.PathLike[str] | None = None) -> Demo:
     """One lesson file (raises :class:`LessonError`; its ``line`` says where). It and the CSV file it names must be
     regular files inside ``root`` (default: the lesson's own folder), read by :mod:`tpm_viz.files`."""
     path = pathlib.Path(path)
@@ -247,7 +248,7 @@ def _check_scene(r: Reader, demo: Demo) -> None:
         )
 
 
-def load_lessons(directory) -> tuple[tuple[Demo, ...], tuple[Problem, ...]]:
+def load_lessons(directory: str | os.PathLike[str]) -> tuple[tuple[Demo, ...], tuple[Problem, ...]]:
     """Every ``*.toml`` lesson of ``directory`` (or the one lesson file it names) in file-name order, and one line
     ``file:line: what is wrong`` per file refused (the others still load). A key or a title used by an earlier file
     is refused too."""
@@ -285,7 +286,7 @@ def load_lessons(directory) -> tuple[tuple[Demo, ...], tuple[Problem, ...]]:
     return tuple(lessons), tuple(problems)
 
 
-def load_preset(path) -> Params:
+def load_preset(path: str | os.PathLike[str]) -> Params:
     """A parameter preset (``assets/presets/*.toml``): ``name``, ``description`` and a ``[params]`` table of
     overrides of the paper's prototype in SI units; raises :class:`LessonError` (with the line) if refused."""
     path = pathlib.Path(path)

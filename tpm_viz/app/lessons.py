@@ -18,13 +18,14 @@ import numpy as np
 
 from tpm_viz.app.demos import CHECK_NAMES, Camera, Check, Demo, Motion, demo_params, demo_pose, demo_source
 from tpm_viz.app.lesson_files import assets_dir, load_lesson, load_lessons, load_preset
+from tpm_viz.app.moves import Pose
 from tpm_viz.app.overlays import cached_map
 from tpm_viz.app.readouts import Reference
 from tpm_viz.app.runs import Run, build_run
 from tpm_viz.errors import InputError
 from tpm_viz.numbers import fixed
-from tpm_viz.paper.ellipses import manipulability_ellipses
-from tpm_viz.paper.jacobians import condition_number, jacobians
+from tpm_viz.paper.ellipses import ManipulabilityEllipses, manipulability_ellipses
+from tpm_viz.paper.jacobians import Jacobians, condition_number, jacobians
 from tpm_viz.paper.kinematics import forward_kinematics_both
 from tpm_viz.paper.workspace import workspace_area
 from tpm_viz.params import Params
@@ -67,7 +68,7 @@ class _Scene:
         self.reference = reference
 
     @cached_property
-    def pose(self):
+    def pose(self) -> Pose:
         return demo_pose(self.demo, self.params)
 
     @cached_property
@@ -85,11 +86,11 @@ class _Scene:
         return build_run(self.params, source).peak
 
     @cached_property
-    def jac(self):
+    def jac(self) -> Jacobians:
         return jacobians(self.params, self.pose.p, self.pose.d)
 
     @cached_property
-    def ellipses(self):
+    def ellipses(self) -> ManipulabilityEllipses:
         return manipulability_ellipses(self.params, self.pose.p)
 
     @cached_property

@@ -1,5 +1,5 @@
 """Share links: one mechanism's state (parameters, pose, load, trajectory, player time, view options, language) as
-a short, versioned, checksummed token for a URL (issue 28), written and read without viser.
+a short, versioned, checksummed token for a URL, written and read without viser.
 
 A token is ``<version>.<payload>.<checksum>``: the payload is the state in the session file's form
 (:func:`tpm_viz.app.sessions.encode_saved`), as compact JSON, deflated and base64url-encoded; the checksum is the

@@ -21,10 +21,12 @@ singularity) are in :mod:`tpm_viz.app.poses`.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal, NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tpm_viz.errors import InputError
 from tpm_viz.numbers import fixed
@@ -51,6 +53,9 @@ __all__ = [
 _STROKE_TOL = 1e-9  # m
 _SAMPLES = 48  # samples per refinement round of a segment
 _ROUNDS = 3  # resolution 1 / 48**3 of the segment
+
+ArrayMap = Callable[[np.ndarray], np.ndarray]
+"""A function of points ``(..., 2)`` [m]: validity codes ``(...)`` or margins ``(..., 5)`` (see :func:`margins`)."""
 
 
 @dataclass(frozen=True)
@@ -82,9 +87,9 @@ class Pose:
         return 1 if c[0] * c[1] - self.p[0] * self.p[1] >= 0.0 else -1
 
     @classmethod
-    def working(cls, params: Params, p) -> Pose:
+    def working(cls, params: Params, p: ArrayLike) -> Pose:
         """The working-mode pose at ``p`` (eq. 4); raises :class:`~tpm_viz.UnreachablePoseError`."""
-        return cls(p, inverse_kinematics(params, p))
+        return cls(np.asarray(p, dtype=float), inverse_kinematics(params, p))
 
 
 class Move(NamedTuple):
@@ -96,7 +101,7 @@ class Move(NamedTuple):
     reason: str | Phrase = ""
 
 
-def ik_branch(params: Params, p, branch) -> np.ndarray:
+def ik_branch(params: Params, p: ArrayLike, branch: ArrayLike) -> np.ndarray:
     """Inverse kinematics on a given branch: ``d_i = p_i + a - b - σ_i sqrt(l_a² - p_j²)`` [m] (eq. 3).
 
     ``σ_i = +1`` is eq. (4). NaN where ``|p_j| > l_a``. Shapes ``(..., 2)``.
@@ -107,7 +112,9 @@ def ik_branch(params: Params, p, branch) -> np.ndarray:
     return p + params.offset - np.asarray(branch, dtype=float) * root
 
 
-def margins(params: Params, p, d, mode: int, limits: SingularityThresholds = MOVE_LIMITS) -> np.ndarray:
+def margins(
+    params: Params, p: ArrayLike, d: ArrayLike, mode: int, limits: SingularityThresholds = MOVE_LIMITS
+) -> np.ndarray:
     """Signed distances to the edges of the valid set, shape ``(..., 5)``; the pose is valid iff all are >= 0.
 
     Columns: the stroke of each actuator ``min(d_i, Δd - d_i)`` [m] (2 columns), ``|cos θ_i| - min_cos``
@@ -125,7 +132,14 @@ def margins(params: Params, p, d, mode: int, limits: SingularityThresholds = MOV
 _CODE_OF_COLUMN = np.array([PoseStatus.OUT_OF_STROKE] * 2 + [PoseStatus.NEAR_INVERSE] * 2 + [PoseStatus.NEAR_DIRECT])
 
 
-def pose_codes(params: Params, p, d, mode: int, branch=None, limits: SingularityThresholds = MOVE_LIMITS) -> np.ndarray:
+def pose_codes(
+    params: Params,
+    p: ArrayLike,
+    d: ArrayLike,
+    mode: int,
+    branch: ArrayLike | None = None,
+    limits: SingularityThresholds = MOVE_LIMITS,
+) -> np.ndarray:
     """Validity per pose, shape ``(...)``: ``PoseStatus.REGULAR`` or the first failing rule (stroke, inverse, direct).
 
     ``mode`` is the required sign of ``det J_x``; ``branch`` (optional) the required sign of each ``c_i``.
@@ -152,7 +166,7 @@ Cause = Literal["drag", "drive", "path"]
 """What led to a pose: a drag of the platform, a drive of the actuators, or a sample of a given path."""
 
 
-def why_not(params: Params, status: int, p, d, cause: Cause = "path") -> Phrase:
+def why_not(params: Params, status: int, p: ArrayLike, d: ArrayLike, cause: Cause = "path") -> Phrase:
     """One line saying why the pose ``(p, d)`` [m] is not valid, for a status of :class:`PoseStatus` other than
     ``REGULAR``: the one describer of refusals (moves, trajectories, presets, lessons). What happens physically
     first (which actuator and which end, which leg, what the platform does), then the number and the equation.
@@ -214,7 +228,7 @@ def why_not(params: Params, status: int, p, d, cause: Cause = "path") -> Phrase:
     )
 
 
-def _clamp(codes_of, x0: np.ndarray, x1: np.ndarray) -> tuple[np.ndarray, int]:
+def _clamp(codes_of: ArrayMap, x0: np.ndarray, x1: np.ndarray) -> tuple[np.ndarray, int]:
     """Last valid point of the segment ``x0 -> x1`` and the code that stopped it (``PoseStatus.REGULAR`` if none)."""
     t_ok, t_end = 0.0, 1.0
     stop: int = PoseStatus.REGULAR
@@ -230,7 +244,7 @@ def _clamp(codes_of, x0: np.ndarray, x1: np.ndarray) -> tuple[np.ndarray, int]:
     return x0 + t_ok * (x1 - x0), stop
 
 
-def _drag_codes(params: Params, branch: np.ndarray, mode: int, limits: SingularityThresholds):
+def _drag_codes(params: Params, branch: np.ndarray, mode: int, limits: SingularityThresholds) -> ArrayMap:
     def codes_of(p: np.ndarray) -> np.ndarray:
         d = ik_branch(params, p, branch)
         return pose_codes(params, p, d, mode, branch, limits)
@@ -238,7 +252,7 @@ def _drag_codes(params: Params, branch: np.ndarray, mode: int, limits: Singulari
     return codes_of
 
 
-def drag_to(params: Params, pose: Pose, p_req, limits: SingularityThresholds = MOVE_LIMITS) -> Move:
+def drag_to(params: Params, pose: Pose, p_req: ArrayLike, limits: SingularityThresholds = MOVE_LIMITS) -> Move:
     """Move the platform towards ``p_req`` [m] by inverse kinematics, in the pose's branch and mode.
 
     Stops at the last valid pose on the way (see the module docstring). When stopped, it then slides along
@@ -268,7 +282,7 @@ def drag_to(params: Params, pose: Pose, p_req, limits: SingularityThresholds = M
     return Move(new, True, Phrase("stopped: {why}", why=why))
 
 
-def _project_on_edge(margins_of, start: np.ndarray, blocked: np.ndarray) -> np.ndarray | None:
+def _project_on_edge(margins_of: ArrayMap, start: np.ndarray, blocked: np.ndarray) -> np.ndarray | None:
     """The point of the edge that stopped a drag (the margin most violated just past the stop, at ``blocked``)
     nearest ``start`` (the request), by Gauss-Newton projection; slightly inside the valid set. None if it fails."""
     m_blocked = margins_of(blocked[None])[0]
@@ -294,7 +308,7 @@ def _project_on_edge(margins_of, start: np.ndarray, blocked: np.ndarray) -> np.n
     return x
 
 
-def _first_bad(codes_of, x0: np.ndarray, x1: np.ndarray) -> np.ndarray:
+def _first_bad(codes_of: ArrayMap, x0: np.ndarray, x1: np.ndarray) -> np.ndarray:
     """A point just past the last valid one on ``x0 -> x1`` (for the wording of the reason)."""
     ts = np.linspace(0.0, 1.0, 4 * _SAMPLES + 1)[1:]
     pts = x0 + ts[:, None] * (x1 - x0)
@@ -309,7 +323,7 @@ def _fk(params: Params, d: np.ndarray, mode: int) -> np.ndarray:
     return np.where(sol.exists[..., None], p, np.nan)
 
 
-def drive_to(params: Params, pose: Pose, d_req, limits: SingularityThresholds = MOVE_LIMITS) -> Move:
+def drive_to(params: Params, pose: Pose, d_req: ArrayLike, limits: SingularityThresholds = MOVE_LIMITS) -> Move:
     """Move the actuators towards ``d_req`` [m]; the platform follows by forward kinematics in the pose's mode.
 
     Stops at the last valid pose on the way: at a stroke end, before an inverse singularity, or before the
@@ -350,7 +364,7 @@ def switch_mode(params: Params, pose: Pose, limits: SingularityThresholds = MOVE
     return Move(Pose(other, pose.d))
 
 
-def place(params: Params, pose: Pose, p, limits: SingularityThresholds = MOVE_LIMITS) -> Move:
+def place(params: Params, pose: Pose, p: ArrayLike, limits: SingularityThresholds = MOVE_LIMITS) -> Move:
     """Jump to ``p`` [m] in the working mode (eq. 4), e.g. a trajectory sample; refused if not valid there."""
     p = np.asarray(p, dtype=float).reshape(-1)
     if p.shape != (2,) or not np.all(np.isfinite(p)):

@@ -1,4 +1,4 @@
-"""Who a connection really comes from, and which ``Host`` names this server answers to (issue 23).
+"""Who a connection really comes from, and which ``Host`` names this server answers to.
 
 - **Trusted proxies** (``tpm-viz serve --trusted-proxy ADDR``, an address or a network such as ``10.0.0.0/24``):
   only a connection whose peer is one of them may say who the client is, in ``X-Forwarded-For`` (read first) or

@@ -20,9 +20,11 @@
 from __future__ import annotations
 
 import functools
+from collections.abc import Sequence
 from typing import NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.paper.ellipses import ellipse_outline, manipulability_ellipses
@@ -85,7 +87,7 @@ class ColourScale(NamedTuple):
     note: Phrase | None
 
 
-def _hex(rgb) -> str:
+def _hex(rgb: tuple[int, int, int]) -> str:
     return "#{:02x}{:02x}{:02x}".format(*rgb)
 
 
@@ -114,7 +116,7 @@ def colour_scale(kind: str) -> ColourScale:
     raise InputError(f"map kind must be one of {', '.join(MAP_KINDS)}, got {kind!r}")
 
 
-def _interpolate(values: np.ndarray, stops) -> np.ndarray:
+def _interpolate(values: np.ndarray, stops: Sequence[tuple[float, tuple[int, int, int]]]) -> np.ndarray:
     xs = np.array([s[0] for s in stops], dtype=float)
     cs = np.array([s[1] for s in stops], dtype=float)
     v = np.clip(np.nan_to_num(values, nan=xs[0]), xs[0], xs[-1])
@@ -163,7 +165,9 @@ class EllipseDrawing(NamedTuple):
     clipped: bool  # some radius was longer than the drawing cap
 
 
-def ellipse_polylines(params: Params, p, scale: float, cap: float = 3.0, n: int = 49) -> EllipseDrawing | None:
+def ellipse_polylines(
+    params: Params, p: ArrayLike, scale: float, cap: float = 3.0, n: int = 49
+) -> EllipseDrawing | None:
     """Both manipulability ellipses at ``p`` [m], centred on the origin (the platform frame), each radius
     ``min(r, cap) * scale`` [m]; None where ``J`` is singular or ill-conditioned (``cond > 1e6``)."""
     try:
@@ -192,7 +196,7 @@ def arrow_reach(params: Params) -> float:
     return ARROW_REACH * (params.a + params.l_a)
 
 
-def arrow_length(force, params: Params):
+def arrow_length(force: ArrayLike, params: Params) -> float | NDArray[np.float64]:
     """Length [m] of the arrow of a force of magnitude ``|force|`` [N] (scalar or array): ``L u / (1 + u)`` with
     ``u = ln(1 + |force| / ARROW_FORCE)`` and ``L`` = :func:`arrow_reach`. Strictly increasing in ``|force|``, below
     ``L`` for every finite force; 0 for NaN, ``L`` for an infinite force."""
@@ -204,7 +208,7 @@ def arrow_length(force, params: Params):
     return float(out) if out.ndim == 0 else out
 
 
-def arrow_vector(force, params: Params) -> np.ndarray:
+def arrow_vector(force: ArrayLike, params: Params) -> np.ndarray:
     """The arrow [m] of a planar force ``force`` (2,) [N]: along the force, :func:`arrow_length` of its norm.
     Zero for a zero force or one with a NaN component; an infinite component gives the longest arrow along it."""
     f = np.asarray(force, dtype=float).reshape(2)

@@ -18,10 +18,12 @@ both singularities (eqs. 11-12, :data:`~tpm_viz.paper.status.MOVE_LIMITS`); :fun
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from enum import Enum
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tpm_viz.errors import InputError
 from tpm_viz.numbers import fixed
@@ -99,7 +101,7 @@ class GeometricPath:
         """Arc lengths [m] where one segment meets the next (the curvature jumps there)."""
         return self.starts[1:].copy()
 
-    def evaluate(self, s, order: int = 0, side: str = "right") -> np.ndarray:
+    def evaluate(self, s: ArrayLike, order: int = 0, side: str = "right") -> np.ndarray:
         """``p(s)`` [m], ``p'(s)`` [-] or ``p''(s)`` [1/m] for ``order`` 0, 1, 2; shape ``s.shape + (2,)``.
 
         At a junction ``p''`` jumps: ``side="right"`` uses the segment that starts there, ``"left"`` the one
@@ -123,7 +125,7 @@ class GeometricPath:
             return np.where(arc, -radial / safe_r, 0.0)
         raise InputError(Phrase("path derivative order must be 0, 1 or 2, got {got}", got=repr(order)))
 
-    def __call__(self, s, order: int = 0) -> np.ndarray:
+    def __call__(self, s: ArrayLike, order: int = 0) -> np.ndarray:
         """Same as :meth:`evaluate` (the call signature of toppra's geometric paths)."""
         return self.evaluate(s, order)
 
@@ -181,19 +183,19 @@ def _chain(kind: PathKind, name: str, pieces: list[tuple]) -> GeometricPath:
     )
 
 
-def line_path(start=(-0.100, -0.050), end=(0.100, 0.050)) -> GeometricPath:
+def line_path(start: ArrayLike = (-0.100, -0.050), end: ArrayLike = (0.100, 0.050)) -> GeometricPath:
     """The straight line of the paper's Fig. 4 (defaults) [m]."""
     return _chain(PathKind.LINE, "line", [("line", start, end)])
 
 
-def circle_path(centre=(0.0, 0.0), radius: float = 0.100) -> GeometricPath:
+def circle_path(centre: Iterable[float] = (0.0, 0.0), radius: float = 0.100) -> GeometricPath:
     """The circle of the paper's Fig. 5: one counter-clockwise turn from ``centre + (radius, 0)`` [m]."""
     if not (math.isfinite(radius) and radius > 0):
         raise InputError(Phrase("the circle radius must be a positive number of metres, got {got}", got=repr(radius)))
     return _chain(PathKind.CIRCLE, "circle", [("arc", tuple(centre), float(radius), 0.0, 2 * math.pi)])
 
 
-def _polyline(kind: PathKind, name: str, points, radius: float) -> GeometricPath:
+def _polyline(kind: PathKind, name: str, points: ArrayLike, radius: float) -> GeometricPath:
     """Lines through ``points`` with every interior corner replaced by a tangent arc of ``radius`` [m].
 
     The radius is reduced where a corner is too sharp for it: the tangent length ``r tan(α/2)`` (``α`` the turn
@@ -241,7 +243,9 @@ def _polyline(kind: PathKind, name: str, points, radius: float) -> GeometricPath
     return _chain(kind, name, pieces)
 
 
-def waypoint_path(points, corner_radius: float = DEFAULT_CORNER_RADIUS, name: str = "waypoints") -> GeometricPath:
+def waypoint_path(
+    points: ArrayLike, corner_radius: float = DEFAULT_CORNER_RADIUS, name: str = "waypoints"
+) -> GeometricPath:
     """A polyline through ``points`` [m] ``(n, 2)``, interior corners rounded to ``corner_radius`` [m].
 
     The rounded path passes within ``r (1/cos(α/2) - 1)`` of an interior waypoint (turn angle ``α``) and through
@@ -250,7 +254,7 @@ def waypoint_path(points, corner_radius: float = DEFAULT_CORNER_RADIUS, name: st
     return _polyline(PathKind.WAYPOINTS, name, points, float(corner_radius))
 
 
-def pick_and_place(start=(0.0, 0.0), size: PickSize = DEFAULT_PICK) -> GeometricPath:
+def pick_and_place(start: Sequence[float] | np.ndarray = (0.0, 0.0), size: PickSize = DEFAULT_PICK) -> GeometricPath:
     """The forward stroke of a pick-and-place cycle from ``start`` [m]: up ``h`` (+Y), across ``w``, down ``h``.
 
     The two corners are quarter circles of radius ``size.r``; the return stroke is :meth:`GeometricPath.reversed`.
@@ -338,7 +342,7 @@ def default_pick(
 def path_for(
     params: Params,
     kind: PathKind | str,
-    points=None,
+    points: ArrayLike | None = None,
     corner_radius: float | None = None,
     pick: PickSize | None = None,
 ) -> GeometricPath:

@@ -28,8 +28,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import SupportsFloat
 
 import numpy as np
+from numpy.typing import ArrayLike
 from toppra.algorithm import TOPPRA, ParameterizationReturnCode
 from toppra.constraint import DiscretizationType, LinearConstraint
 from toppra.interpolator import AbstractGeometricPath
@@ -51,9 +53,10 @@ MAX_SAMPLES = 2_000_000
 MAX_DURATION = 1e4
 """Longest motion [s] the planner returns."""
 MAX_CHECK = 200_000
+_PAPER = Arrangement.PERPENDICULAR  # the default arrangement of the helpers below
 
 
-def _limit(value, name: str | Phrase, unit: str | Phrase, top: float = 1e9) -> float | None:
+def _limit(value: str | SupportsFloat | None, name: str | Phrase, unit: str | Phrase, top: float = 1e9) -> float | None:
     if value is None:
         return None
     try:
@@ -108,7 +111,7 @@ class _TimeLaw:
         """The same law run ``k`` times slower (``ṡ / k``, ``s̈ / k²``)."""
         return _TimeLaw(self.s_grid, self.sd / k, self.u / k**2, self.t_grid * k, self.stretch * k)
 
-    def __call__(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def __call__(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         t = np.clip(np.asarray(t, float), 0.0, self.t_grid[-1])
         k = np.clip(np.searchsorted(self.t_grid, t, side="right") - 1, 0, len(self.u) - 1)
         h = t - self.t_grid[k]
@@ -117,8 +120,8 @@ class _TimeLaw:
 
 
 def _coefficients(
-    params: Params, path: GeometricPath, s: np.ndarray, side: str = "right", arrangement=Arrangement.PERPENDICULAR
-) -> tuple:
+    params: Params, path: GeometricPath, s: np.ndarray, side: str = "right", arrangement: Arrangement = _PAPER
+) -> tuple[np.ndarray, np.ndarray]:
     """``a(s) = τ(p, 0, p')`` and ``b(s) = τ(p, p', p'')`` [N s²/m], so that ``τ = a s̈ + b ṡ²`` (eqs. 29-31).
 
     ``side`` picks the segment at a junction, where ``p''`` (hence ``b``) jumps; ``arrangement`` picks the closed form
@@ -130,7 +133,7 @@ def _coefficients(
 
 
 def _speed_bound(
-    params: Params, path: GeometricPath, s: np.ndarray, limits: Limits, arrangement=Arrangement.PERPENDICULAR
+    params: Params, path: GeometricPath, s: np.ndarray, limits: Limits, arrangement: Arrangement = _PAPER
 ) -> np.ndarray:
     """Upper bound on ``ṡ²`` [m²/s²] from the speed limits (``|p'| = 1``; ``ḋ = J p' ṡ``, eq. 9)."""
     bound = np.full(s.shape, np.inf)
@@ -178,7 +181,9 @@ class _ForceLimits(LinearConstraint):
         self.set_discretization_type(DiscretizationType.Interpolation)
         self.rows = rows
 
-    def compute_constraint_params(self, path, gridpoints, *args, **kwargs):
+    def compute_constraint_params(
+        self, path: object, gridpoints: np.ndarray, *args: object, **kwargs: object
+    ) -> tuple[np.ndarray | None, ...]:
         return (*self.rows, None, None)
 
 
@@ -196,7 +201,7 @@ class _Interval(AbstractGeometricPath):
     def path_interval(self) -> np.ndarray:
         return self._interval
 
-    def __call__(self, ss, order=0):
+    def __call__(self, ss: ArrayLike, order: int = 0) -> np.ndarray:
         return np.zeros((*np.shape(ss), 2))
 
 
@@ -218,7 +223,7 @@ def _scale(a: np.ndarray) -> float:
 
 
 def _plan_one(
-    params: Params, path: GeometricPath, limits: Limits, grid: int, rate: float, arrangement=Arrangement.PERPENDICULAR
+    params: Params, path: GeometricPath, limits: Limits, grid: int, rate: float, arrangement: Arrangement = _PAPER
 ) -> _TimeLaw:
     """The time law of one rest-to-rest motion, stretched if the ``rate`` check finds an overshoot."""
     s_grid = np.unique(np.concatenate([np.linspace(0.0, path.length, int(grid)), path.junctions]))
@@ -246,7 +251,7 @@ def _plan_one(
 
 
 def _state(
-    params: Params, path: GeometricPath, law: _TimeLaw, t: np.ndarray, arrangement=Arrangement.PERPENDICULAR
+    params: Params, path: GeometricPath, law: _TimeLaw, t: np.ndarray, arrangement: Arrangement = _PAPER
 ) -> tuple:
     """``(s, ṡ, s̈, p, ṗ, p̈, τ)`` at local times ``t`` [s]: exact chain rule, closed-form ``τ`` (eqs. 29-31)."""
     s, ds, dds = law(t)
@@ -293,10 +298,10 @@ class Plan:
         """How much each move was slowed after toppra to remove an overshoot between grid points (>= 1)."""
         return tuple(float(law.stretch) for law in self.laws)
 
-    def sample(self, t) -> PlanSamples:
+    def sample(self, t: ArrayLike) -> PlanSamples:
         """The exact states at times ``t`` [s] ``(n,)`` (clipped to ``[0, duration]``); at a move boundary the
         later move is used."""
-        t = np.clip(np.asarray(t, dtype=float).ravel(), 0.0, self.duration)
+        t = np.asarray(t, dtype=float).ravel().clip(0.0, self.duration)  # the method: typed as an array
         starts = self.starts
         k = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(self.laws) - 1)
         out = [np.empty(t.shape) for _ in range(3)] + [np.empty((*t.shape, 2)) for _ in range(4)]
@@ -344,7 +349,7 @@ class PlanSamples:
     dd: np.ndarray
 
 
-def _check_grid(grid) -> int:
+def _check_grid(grid: object) -> int:
     if isinstance(grid, bool) or not isinstance(grid, (int, np.integer)) or not 10 <= grid <= MAX_GRID:
         raise InputError(
             Phrase(

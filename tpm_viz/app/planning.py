@@ -1,4 +1,4 @@
-"""The planner tab's pure side (issue 15): a path chosen by name (or typed waypoints), its time-optimal cycle within
+"""The planner tab's pure side: a path chosen by name (or typed waypoints), its time-optimal cycle within
 the force (and speed) limits, the sizing table, and the paper's cubic law scaled to the same peak force.
 
 :func:`solve` is what the tab runs in its background worker at every slider change (~20-70 ms): the path (cached

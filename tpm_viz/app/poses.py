@@ -10,6 +10,7 @@ mode says so in its :class:`~tpm_viz.app.moves.Move` ``reason`` (a note: the mov
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tpm_viz.app.moves import Move, Pose, check, ik_branch, pose_codes, why_not
 from tpm_viz.errors import InputError, InvalidParametersError
@@ -38,13 +39,15 @@ def _grid(params: Params, n: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _valid(
-    params: Params, p: np.ndarray, d: np.ndarray, limits: SingularityThresholds, modes=(1, -1)
+    params: Params, p: np.ndarray, d: np.ndarray, limits: SingularityThresholds, modes: tuple[int, ...] = (1, -1)
 ) -> list[np.ndarray]:
     """Masks of the valid grid points, one per assembly mode in ``modes`` (in that order)."""
     return [pose_codes(params, p, d, m, _WORKING, limits) == PoseStatus.REGULAR for m in modes]
 
 
-def home_pose(params: Params, near=(0.0, 0.0), limits: SingularityThresholds = MOVE_LIMITS, n: int = 101) -> Pose:
+def home_pose(
+    params: Params, near: ArrayLike = (0.0, 0.0), limits: SingularityThresholds = MOVE_LIMITS, n: int = 101
+) -> Pose:
     """The valid working-mode pose nearest ``near`` [m], preferring assembly mode +1 (the home pose's mode).
 
     Raises :class:`~tpm_viz.InvalidParametersError` if no pose is valid (e.g. a stroke so short that every
@@ -163,7 +166,7 @@ _WHAT = {
 def preset_pose(
     params: Params,
     kind: str,
-    near=(0.0, 0.0),
+    near: ArrayLike | Pose = (0.0, 0.0),
     limits: SingularityThresholds = MOVE_LIMITS,
     thresholds: SingularityThresholds = WARN,
     n: int = 161,

@@ -16,10 +16,12 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import NamedTuple, Protocol
+from typing import NamedTuple, Protocol, SupportsFloat
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tpm_viz.app.moves import Pose
 from tpm_viz.errors import InputError, TpmVizError
@@ -42,14 +44,16 @@ class Reference(Protocol):
     for one state (shape (2,)) or arrays of states (shape (n, 2)), e.g. ``tpm_viz.multibody.inverse_dynamics``
     (the app layer never imports Pinocchio: the UI passes it in)."""
 
-    def __call__(self, params: Params, p, dp, ddp, f_ext=None) -> np.ndarray: ...
+    def __call__(
+        self, params: Params, p: ArrayLike, dp: ArrayLike, ddp: ArrayLike, f_ext: ArrayLike | None = None
+    ) -> np.ndarray: ...
 
 
 STROKE_END_TOL = 0.5e-3
 """An actuator within this distance [m] of 0 or ``Δd`` counts as *at* its stroke end."""
 
 
-def _vec2(value, name: str) -> tuple[float, float]:
+def _vec2(value: Iterable[str | SupportsFloat], name: str) -> tuple[float, float]:
     try:
         x, y = (float(v) for v in value)
     except (TypeError, ValueError):
@@ -150,7 +154,7 @@ class Readout:
     alerts: tuple[Alert, ...] = ()
 
 
-def _finite(x) -> bool:
+def _finite(x: ArrayLike | None) -> bool:
     return x is not None and bool(np.all(np.isfinite(x)))
 
 

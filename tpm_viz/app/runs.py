@@ -16,9 +16,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Literal, SupportsFloat
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tpm_viz.app.moves import ik_branch, pose_codes, why_not
 from tpm_viz.app.readouts import Reference, reason
@@ -26,7 +27,7 @@ from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.numbers import fixed
 from tpm_viz.paper.dynamics import inverse_dynamics_detail
 from tpm_viz.paper.spline import CubicSpline
-from tpm_viz.paper.status import MOVE_LIMITS, PoseStatus
+from tpm_viz.paper.status import MOVE_LIMITS, PoseStatus, SingularityThresholds
 from tpm_viz.paper.trajectories import DEFAULT_DURATIONS, Trajectory, circle_state, line_state
 from tpm_viz.params import Params
 from tpm_viz.words import Phrase, T
@@ -79,21 +80,21 @@ class Source:
         return cls("csv", traj.duration, f"{name}, T = {traj.duration:g} s", knots=(t - t[0], p))
 
     @classmethod
-    def segment(cls, start, end, duration: float, label: str = "") -> Source:
+    def segment(cls, start: tuple[float, float], end: tuple[float, float], duration: float, label: str = "") -> Source:
         """A straight move ``start -> end`` [m] with the paper's cubic time law."""
-        start = tuple(float(v) for v in start)
-        end = tuple(float(v) for v in end)
+        start = (float(start[0]), float(start[1]))
+        end = (float(end[0]), float(end[1]))
         duration = _duration(duration)
         return cls("segment", duration, label or f"segment, T = {duration:g} s", start, end)
 
-    def motion(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def motion(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(p, ṗ, p̈)`` at times ``t`` [s] (clipped to ``[0, T]``), each of shape ``t.shape + (2,)``."""
         t = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
         if self.kind == "line":
             return line_state(t, self.duration)
         if self.kind == "circle":
             return circle_state(t, self.duration)
-        if self.kind == "segment":
+        if self.kind == "segment" and self.start is not None and self.end is not None:
             return line_state(t, self.duration, self.start, self.end)
         if self.kind == "csv" and self.knots is not None:
             spline = CubicSpline(*self.knots)
@@ -101,7 +102,7 @@ class Source:
         raise InputError(Phrase("unknown trajectory source {kind}", kind=repr(self.kind)))
 
 
-def _duration(value) -> float:
+def _duration(value: str | SupportsFloat) -> float:
     try:
         duration = float(value)
     except (TypeError, ValueError):
@@ -119,7 +120,11 @@ def _duration(value) -> float:
 
 
 def check_path(
-    params: Params, t: np.ndarray, p: np.ndarray, what: str | Phrase = T("the trajectory"), limits=MOVE_LIMITS
+    params: Params,
+    t: np.ndarray,
+    p: np.ndarray,
+    what: str | Phrase = T("the trajectory"),
+    limits: SingularityThresholds = MOVE_LIMITS,
 ) -> None:
     """Raise :class:`InputError` at the first sample of ``p`` (``(n, 2)`` [m] at times ``t``) that is not a
     valid working-mode pose in the assembly mode of the first sample."""

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES, MAX_UPLOAD_ROWS
 from tpm_viz.app.moves import Pose, check
@@ -81,7 +82,7 @@ class Document:
 
 
 # -- writing ----------------------------------------------------------------------------------------------------------
-def _vec(v) -> list[float]:
+def _vec(v: ArrayLike) -> list[float]:
     return [float(x) for x in np.asarray(v, dtype=float).reshape(-1)]
 
 
@@ -89,7 +90,7 @@ def _source(source: Source | None) -> dict[str, Any] | None:
     if source is None:
         return None
     out: dict[str, Any] = {"kind": source.kind, "duration": float(source.duration), "label": source.label}
-    if source.kind == "segment":
+    if source.kind == "segment" and source.start is not None and source.end is not None:
         out["start"], out["end"] = _vec(source.start), _vec(source.end)
     if source.kind == "csv" and source.knots is not None:
         t, p = source.knots

@@ -24,8 +24,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import SupportsFloat
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tpm_viz.errors import InputError
 from tpm_viz.paper.dynamics import inverse_dynamics
@@ -89,7 +91,7 @@ class Sizing:
         return [(q, u, float(a), float(b)) for q, u, a, b in rows]
 
 
-def _nonnegative(value, name: str | Phrase) -> float:
+def _nonnegative(value: str | SupportsFloat, name: str | Phrase) -> float:
     try:
         value = float(value)
     except (TypeError, ValueError):
@@ -109,7 +111,14 @@ def _positive_part_integral(h: np.ndarray, y0: np.ndarray, y1: np.ndarray) -> np
     return np.where(cross, 0.5 * h * top * frac, 0.5 * h * both)
 
 
-def size_motion(t, tau, dd, dwell: float = 0.0, motor_constant: float | None = None, dp=None) -> Sizing:
+def size_motion(
+    t: ArrayLike,
+    tau: ArrayLike,
+    dd: ArrayLike,
+    dwell: float = 0.0,
+    motor_constant: float | None = None,
+    dp: ArrayLike | None = None,
+) -> Sizing:
     """The sizing table of a motion sampled at ``t`` [s] with forces ``tau`` [N] and velocities ``dd`` [m/s].
 
     ``dp`` [m/s] ``(n, 2)``, the platform velocity, is optional (for the peak platform speed).
@@ -178,7 +187,14 @@ def size_motion(t, tau, dd, dwell: float = 0.0, motor_constant: float | None = N
 
 
 def size_trajectory(
-    params: Params, t, p, dp, ddp, dwell: float = 0.0, motor_constant: float | None = None, tau=None
+    params: Params,
+    t: ArrayLike,
+    p: ArrayLike,
+    dp: ArrayLike,
+    ddp: ArrayLike,
+    dwell: float = 0.0,
+    motor_constant: float | None = None,
+    tau: ArrayLike | None = None,
 ) -> Sizing:
     """Sizing of a platform motion ``p, ṗ, p̈`` [m, m/s, m/s²] ``(n, 2)`` at times ``t`` [s].
 

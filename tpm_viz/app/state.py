@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
+from typing import TypedDict, Unpack
 
 from tpm_viz.app.moves import Pose
 from tpm_viz.app.poses import home_pose
@@ -15,7 +16,7 @@ from tpm_viz.app.readouts import Load
 from tpm_viz.params import Params
 from tpm_viz.words import Phrase
 
-__all__ = ["AppState", "TrajectorySample"]
+__all__ = ["AppState", "Changes", "TrajectorySample"]
 
 
 @dataclass(frozen=True)
@@ -27,6 +28,16 @@ class TrajectorySample:
     control or planner run)."""
     duration: float = 0.2
     t: float = 0.0
+
+
+class Changes(TypedDict, total=False):
+    """The fields :meth:`AppState.replace` may change (it bumps ``version`` itself)."""
+
+    params: Params
+    pose: Pose
+    load: Load
+    trajectory: TrajectorySample
+    note: str | Phrase
 
 
 @dataclass(frozen=True)
@@ -48,6 +59,6 @@ class AppState:
         params = Params.paper() if params is None else params
         return cls(params=params, pose=home_pose(params))
 
-    def replace(self, **changes) -> AppState:
+    def replace(self, **changes: Unpack[Changes]) -> AppState:
         """A copy with some fields changed and the version bumped."""
         return dataclasses.replace(self, version=self.version + 1, **changes)

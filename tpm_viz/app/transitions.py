@@ -12,6 +12,8 @@ on the pose's branch, inside the stroke, clear of both singularities) or raises 
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from tpm_viz.app.inputs import read_choice, read_number, read_params, read_vec2
@@ -61,30 +63,30 @@ def _moved(state: AppState, move: Move) -> AppState:
     return state.replace(pose=move.pose, note=move.reason, trajectory=sample, load=load)
 
 
-def drag(state: AppState, position) -> AppState:
+def drag(state: AppState, position: object) -> AppState:
     """The gizmo at ``position`` (x, y[, z]) [m]: clamped inverse kinematics (z is ignored)."""
     try:
-        xy = list(position)[:2]
+        xy = list(position)[:2]  # type: ignore[call-overload]  # anything a browser sent: TypeError is caught
     except TypeError:
         xy = position
     p_req = read_vec2(xy, T("platform position"), bound=MAX_POSITION)
     return _moved(state, drag_to(state.params, state.pose, p_req))
 
 
-def move(state: AppState, p_mm) -> AppState:
+def move(state: AppState, p_mm: object) -> AppState:
     """The typed platform position ``p`` [mm]: clamped inverse kinematics."""
     p_req = read_vec2(p_mm, T("platform position p"), scale=1e-3, bound=MAX_POSITION)
     return _moved(state, drag_to(state.params, state.pose, p_req))
 
 
-def drive(state: AppState, i: int, d_mm) -> AppState:
+def drive(state: AppState, i: int, d_mm: object) -> AppState:
     """Actuator ``i`` (0 or 1) to ``d_mm`` [mm]: forward kinematics in the current assembly mode, clamped."""
     d_req = np.array(state.pose.d, dtype=float)
     d_req[i] = read_number(d_mm, f"d{i + 1}", scale=1e-3, lo=-MAX_POSITION, hi=MAX_POSITION)
     return _moved(state, drive_to(state.params, state.pose, d_req))
 
 
-def drive_both(state: AppState, d_mm) -> AppState:
+def drive_both(state: AppState, d_mm: object) -> AppState:
     """Both actuators to ``d_mm`` = (d1, d2) [mm] (a typed pair): forward kinematics in the current assembly mode,
     clamped like :func:`drive`. A value within :data:`STROKE_SLACK` of a stroke end is that end (the round trip
     m -> mm -> m of ``d = Δd`` may land an ulp beyond it)."""
@@ -105,13 +107,13 @@ def home(state: AppState) -> AppState:
     return _moved(state, go_home(state.params, state.pose))
 
 
-def demo(state: AppState, kind) -> AppState:
+def demo(state: AppState, kind: object) -> AppState:
     """A pose near an inverse singularity, the direct singularity or a stroke end (``DEMO_KINDS``)."""
     kind = read_choice(kind, T("demo"), DEMO_KINDS)
     return _moved(state, preset_pose(state.params, kind, near=state.pose))
 
 
-def set_load(state: AppState, mode, f_ext, dp, ddp) -> AppState:
+def set_load(state: AppState, mode: object, f_ext: object, dp: object, ddp: object) -> AppState:
     """The load inputs; the same state object if nothing changed."""
     load = Load(
         mode=read_choice(mode, T("load"), LOAD_MODES),
@@ -122,7 +124,7 @@ def set_load(state: AppState, mode, f_ext, dp, ddp) -> AppState:
     return state if load == state.load else state.replace(load=load, note="")
 
 
-def apply_params(state: AppState, raw) -> AppState:
+def apply_params(state: AppState, raw: Mapping[str, object]) -> AppState:
     """The parameter inputs (mm, kg): a new mechanism and the nearest valid pose on it."""
     params = read_params(state.params, raw)
     move = settle(params, state.pose)

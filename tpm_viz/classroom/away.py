@@ -96,7 +96,13 @@ class Away:
         self._forget(victim)
 
     def park(
-        self, key: str, private: bool, saved: Saved | None, camera: Any = None, presenter: bool = False, address=""
+        self,
+        key: str,
+        private: bool,
+        saved: Saved | None,
+        camera: Any = None,
+        presenter: bool = False,
+        address: str = "",
     ) -> None:
         """A tab of browser ``key`` left from ``address``: keep what it had (and whether it was the presenter's)."""
         with self._lock:

@@ -1,4 +1,4 @@
-"""A fair queue of heavy jobs per tab, run by a small pool of threads (issue 23: fair workers).
+"""A fair queue of heavy jobs per tab, run by a small pool of threads.
 
 Every tab (any hashable owner: a browser tab, a session) submits jobs of a few kinds (a trajectory run, a floor
 map, a control-lab simulation, a plan), each 20-200 ms of computation. The rules:
@@ -265,7 +265,7 @@ class FairJobs:
         if job.done is not None:
             self._call(job.done, result, error)
 
-    def _call(self, callback: Callable, *args) -> None:
+    def _call(self, callback: Callable[..., object], *args: object) -> None:
         try:
             callback(*args)
         except Exception as exc:  # a bug in a publisher: logged, the pool carries on

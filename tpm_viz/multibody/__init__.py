@@ -5,6 +5,7 @@
 - :mod:`.forward`: forward dynamics: the KKT solve, the constraint projection, the 2-DOF platform plant;
 - :mod:`.locking`: the per-model lock (Pinocchio's ``Data`` is shared scratch memory);
 - :mod:`.rank`: rank-revealing SVD helpers for the over-constrained closures;
+- :mod:`.parallel`: the parallel arrangement's own closed-loop model (``docs/parallel.md``), a subclass of the model;
 - :mod:`.replay`: the paper's forces applied to the model and integrated (does the platform follow the path?);
 - :mod:`.crosscheck`: closed form against the model, on random states and on the paper's trajectories;
 - :mod:`.control`: the control lab: sampled controllers (:mod:`tpm_viz.paper.control`) drive the model.

@@ -9,10 +9,12 @@ a geometric starting guess that only selects the branch. It calls the model's Pi
 from __future__ import annotations
 
 import math
+import threading
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from tpm_viz.errors import InputError, SingularConfigurationError, UnreachablePoseError
 from tpm_viz.multibody.locking import locked
@@ -20,13 +22,15 @@ from tpm_viz.numbers import fixed
 from tpm_viz.params import Params
 from tpm_viz.words import Phrase
 
-__all__ = ["DOF", "NEWTON_FLOOR", "NEWTON_MAX_ITER", "NEWTON_TOL", "ClosedLoopAssembly"]
+__all__ = ["DOF", "NEWTON_FLOOR", "NEWTON_MAX_ITER", "NEWTON_TOL", "ClosedLoopAssembly", "ThreeArrays"]
 
 DOF = 2
 NEWTON_TOL = 1e-12  # m: accepted residual of the closure and platform/actuator equations ...
 NEWTON_FLOOR = 1e-15  # m: ... but Newton polishes down to this or until it stops improving
 NEWTON_MAX_ITER = 40
 _MAX_ANGLE_STEP = 0.5  # rad, Newton step limit on the revolute coordinates
+ThreeArrays = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+"""Three arrays: ``(q, J_c, J_P)`` of an assembly, ``(q, v, a)`` of a motion."""
 
 
 class ClosedLoopAssembly:
@@ -34,19 +38,22 @@ class ClosedLoopAssembly:
 
     # What the model provides (built in MultibodyModel.__init__):
     params: Params
-    model: Any
+    model: Any  # pinocchio.Model (Pinocchio ships no type information)
     index: dict[str, int]
-    _cdatas: Any
+    _cdatas: Any  # pinocchio.StdVec_RigidConstraintData
+    _lock: threading.RLock
     _slider_idx: np.ndarray
     _angle_idx: np.ndarray
     _s_t: np.ndarray
     _last: tuple[np.ndarray, np.ndarray, np.ndarray | None] | None
-    _closure_terms: Callable[..., Any]
-    _platform_position_now: Callable[..., Any]
-    _platform_jacobian: Callable[..., Any]
-    _one: Callable[..., Any]
+    _closure_terms: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
+    _platform_position_now: Callable[[], np.ndarray]
+    _platform_jacobian: Callable[[], np.ndarray]
+    _one: Callable[[ArrayLike, str], np.ndarray]
 
-    def _newton(self, q: np.ndarray, target: np.ndarray, driven: str):
+    def _newton(
+        self, q: np.ndarray, target: np.ndarray, driven: str
+    ) -> tuple[NDArray[np.float64], bool, NDArray[np.float64], NDArray[np.float64]]:
         """Gauss-Newton on ``[Φ(q); x(q) - target] = 0``, ``x`` = platform P or actuators d.
 
         ``[J_c; J_x]`` has full column rank away from singularities, so the normal equations give the
@@ -85,7 +92,7 @@ class ClosedLoopAssembly:
         q[self._angle_idx] = [math.remainder(x, 2 * math.pi) for x in q[self._angle_idx].tolist()]
         return q
 
-    def _pack(self, d, phi1: float, phi2: float) -> np.ndarray:
+    def _pack(self, d: ArrayLike, phi1: float, phi2: float) -> np.ndarray:
         """``q`` from actuator positions and the link angles ``φ_1 = θ_1``, ``φ_2 = -θ_2`` of a parallelogram."""
         q = np.empty(self.model.nq)
         q[self._slider_idx] = d
@@ -117,14 +124,14 @@ class ClosedLoopAssembly:
         return self._pack(d, t1, t2)
 
     @locked
-    def configuration(self, p, d=None) -> np.ndarray:
+    def configuration(self, p: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
         """Full configuration ``q`` (7,) for platform position ``p`` (2,) [m], by Newton on Pinocchio's
         closure residual. Working mode (eq. 4: ``cos θ_i > 0``) unless actuator positions ``d`` (2,)
         are given: they are the starting point and so select the branch."""
         p = self._one(p, "p")
         return self._configure(p, None if d is None else self._one(d, "d"))[0]
 
-    def _configure(self, p: np.ndarray, d: np.ndarray | None):
+    def _configure(self, p: np.ndarray, d: np.ndarray | None) -> ThreeArrays:
         """``(q, J_c, J_P)`` at the closed-loop configuration of platform position ``p``."""
         la, (p1, p2) = self.params.l_a, p.tolist()
         if max(abs(p1), abs(p2)) >= la:
@@ -157,7 +164,7 @@ class ClosedLoopAssembly:
         )
 
     @locked
-    def configuration_from_actuators(self, d, mode: int = +1) -> np.ndarray:
+    def configuration_from_actuators(self, d: ArrayLike, mode: int = +1) -> np.ndarray:
         """Full configuration ``q`` (7,) for actuator positions ``d`` (2,) [m] in assembly ``mode``
         (+1: ``cos(θ1 + θ2) > 0``, the home mode; -1: the other), by Newton on the closures."""
         if mode not in (1, -1):

@@ -1,4 +1,4 @@
-"""Closed-loop control lab (issue 14): a sampled controller drives the Pinocchio closed-loop model.
+"""Closed-loop control lab: a sampled controller drives the Pinocchio closed-loop model.
 
 Plant: the closed-loop multibody model of :mod:`tpm_viz.multibody.model`, in its 2 independent platform
 coordinates (:class:`~tpm_viz.multibody.forward.PlatformPlant`, the same dynamics as the KKT forward

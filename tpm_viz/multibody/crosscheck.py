@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from tpm_viz.errors import InputError
 from tpm_viz.multibody.model import inverse_dynamics as pinocchio_inverse_dynamics
@@ -65,7 +66,9 @@ def compare_forces(params: Params, kind: str, duration: float | None = None, sam
     return ForceComparison(kind, traj.duration, traj.t, tau_paper, tau_pin)
 
 
-def random_regular_states(params: Params, n: int, seed: int = 0):
+def random_regular_states(
+    params: Params, n: int, seed: int = 0
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """``(p, ṗ, p̈, f_ext)``, each ``(n, 2)``: seeded regular poses (``classify == 0``) in SI units,
     velocities ~ N(0, 1 m/s), accelerations ~ N(0, 20 m/s²), platform forces ~ N(0, 20 N)."""
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:

@@ -19,19 +19,43 @@ Pinocchio itself: it calls the model's evaluations):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
+from typing import Any, Protocol
 
 import numpy as np
 
 from tpm_viz.errors import SingularConfigurationError, UnreachablePoseError
 from tpm_viz.multibody.assembly import DOF, NEWTON_FLOOR, NEWTON_MAX_ITER, NEWTON_TOL
-from tpm_viz.multibody.rank import ranked_svd
+from tpm_viz.multibody.rank import RankedSvd, ranked_svd
 from tpm_viz.numbers import fixed
+from tpm_viz.params import Params
 from tpm_viz.words import Phrase
 
-__all__ = ["PlatformPlant", "forward_dynamics", "project"]
+__all__ = ["ClosedLoopModel", "PlatformPlant", "forward_dynamics", "project"]
 
 
-def forward_dynamics(model, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+class ClosedLoopModel(Protocol):
+    """What this module uses of a :class:`~tpm_viz.multibody.model.MultibodyModel` (its Pinocchio evaluations)."""
+
+    params: Params
+    model: Any  # pinocchio.Model (Pinocchio ships no type information)
+    index: dict[str, int]
+    _s_t: np.ndarray
+
+    def _closure_terms(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+
+    def _closure_svd(self, jc: np.ndarray) -> RankedSvd: ...
+
+    def _drifts(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+
+    def _mass_matrix(self, q: np.ndarray) -> np.ndarray: ...
+
+    def _nle(self, q: np.ndarray, v: np.ndarray) -> np.ndarray: ...
+
+    def rnea_function(self) -> Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]: ...
+
+
+def forward_dynamics(model: ClosedLoopModel, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
     """Joint accelerations ``a`` (7,) [m/s², rad/s²] of ``model`` under actuator forces ``τ`` (2,) [N].
 
     Our own KKT solve (Gauss's principle) on the rank-revealed null space ``N`` of ``J_c``:
@@ -50,7 +74,7 @@ def forward_dynamics(model, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np
     return a_c + n @ np.linalg.solve(n.T @ mass @ n, n.T @ rhs)
 
 
-def project(model, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def project(model: ClosedLoopModel, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Constraint stabilisation: the nearest ``q`` on the closures (minimum-norm Newton steps)
     and ``v`` projected on the admissible motions ``N Nᵀ v``."""
     q, previous = q.copy(), np.inf
@@ -77,7 +101,7 @@ class PlatformPlant:
     platform joint ``φ_p = -θ_1`` (:mod:`tpm_viz.multibody.model`). Not thread-safe (one ``Data`` each).
     """
 
-    def __init__(self, model) -> None:
+    def __init__(self, model: ClosedLoopModel) -> None:
         self.params = model.params
         ix = model.index
         self._slots = (
@@ -95,7 +119,7 @@ class PlatformPlant:
         self._zero = np.zeros(model.model.nv)
         self._la, self._k = self.params.l_a, self.params.offset
 
-    def _place(self, d1, f1, fp, d2, f2) -> np.ndarray:
+    def _place(self, d1: float, f1: float, fp: float, d2: float, f2: float) -> np.ndarray:
         """A joint vector (7,) from the slider, leg-1 link, platform, slider-2 and leg-2 link values."""
         i_d1, i_10, i_11, i_p, i_d2, i_20, i_21 = self._slots
         out = [0.0] * 7
@@ -118,7 +142,12 @@ class PlatformPlant:
             )
         return math.sqrt(r1), math.sqrt(r2)
 
-    def joint_state(self, p, dp, ddp=(0.0, 0.0)) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def joint_state(
+        self,
+        p: Sequence[float] | np.ndarray,
+        dp: Sequence[float] | np.ndarray,
+        ddp: Sequence[float] | np.ndarray = (0.0, 0.0),
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Tree coordinates ``(q, v, a)`` (7,) each for a platform state ``p, ṗ, p̈`` [m, m/s, m/s²]."""
         (p1, p2), (dp1, dp2), (ddp1, ddp2) = (map(float, x) for x in (p, dp, ddp))
         c1, c2 = self._legs(p1, p2)
@@ -131,7 +160,7 @@ class PlatformPlant:
         a = self._place(ddp1 + c1 * w1 * w1 + p2 * a1, a1, -a1, ddp2 + c2 * w2 * w2 + p1 * a2, -a2)
         return q, v, a
 
-    def null_space(self, p) -> np.ndarray:
+    def null_space(self, p: Sequence[float] | np.ndarray) -> np.ndarray:
         """``N = ∂q/∂p`` (7, 2): joint velocities per unit platform velocity."""
         p1, p2 = float(p[0]), float(p[1])
         c1, c2 = self._legs(p1, p2)
@@ -139,7 +168,9 @@ class PlatformPlant:
             [self._place(1.0, 0.0, 0.0, p1 / c2, -1.0 / c2), self._place(p2 / c1, 1.0 / c1, -1.0 / c1, 1.0, 0.0)], -1
         )
 
-    def acceleration(self, p1: float, p2: float, dp1: float, dp2: float, tau1: float, tau2: float):
+    def acceleration(
+        self, p1: float, p2: float, dp1: float, dp2: float, tau1: float, tau2: float
+    ) -> tuple[float, float]:
         """Platform acceleration ``p̈`` [m/s²] (two floats) under actuator forces ``τ`` [N], from
         ``Nᵀ M N p̈ = Jᵀ τ - Nᵀ rnea(q, v, a_0)`` (module docstring). Plain floats and three ``rnea``
         calls: this is the inner loop of the control lab (4 calls per RK4 step)."""

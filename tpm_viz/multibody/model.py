@@ -50,12 +50,13 @@ from collections.abc import Callable
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from tpm_viz.errors import InputError, SingularConfigurationError
 from tpm_viz.multibody import forward
-from tpm_viz.multibody.assembly import DOF, ClosedLoopAssembly
+from tpm_viz.multibody.assembly import DOF, ClosedLoopAssembly, ThreeArrays
 from tpm_viz.multibody.locking import locked
-from tpm_viz.multibody.rank import ranked_svd
+from tpm_viz.multibody.rank import RankedSvd, ranked_svd
 from tpm_viz.paper.kinematics import as_xy
 from tpm_viz.params import Params
 from tpm_viz.words import Phrase
@@ -68,7 +69,7 @@ PART_NAMES = ("slider1", "slider2", "link1_0", "link1_1", "link2_0", "link2_1", 
 _SINGULAR_RTOL = 1e-9
 
 
-def _se3(xyz, angle: float = 0.0) -> pin.SE3:
+def _se3(xyz: ArrayLike, angle: float = 0.0) -> pin.SE3:
     c, s = np.cos(angle), np.sin(angle)
     return pin.SE3(np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]), np.asarray(xyz, dtype=float))
 
@@ -79,11 +80,11 @@ def _rod(mass: float, length: float) -> pin.Inertia:
     return pin.Inertia(mass, np.array([length / 2.0, 0.0, 0.0]), np.diag([0.0, i_t, i_t]))
 
 
-def _point_mass(mass: float, xyz=(0.0, 0.0, 0.0)) -> pin.Inertia:
+def _point_mass(mass: float, xyz: ArrayLike = (0.0, 0.0, 0.0)) -> pin.Inertia:
     return pin.Inertia(mass, np.asarray(xyz, dtype=float), np.zeros((3, 3)))
 
 
-def _build(params: Params):
+def _build(params: Params) -> tuple[pin.Model, list[pin.RigidConstraintModel], dict[str, int]]:
     """The Pinocchio model, its constraint models (LOCAL_WORLD_ALIGNED) and the part frame ids."""
     a, b, la, sp = params.a, params.b, params.l_a, params.pivot_spacing
     model = pin.Model()
@@ -135,11 +136,13 @@ class MultibodyModel(ClosedLoopAssembly):
     by a lock (Pinocchio's ``Data`` is shared scratch memory).
     """
 
-    def __init__(self, params: Params):
+    _build_model = staticmethod(_build)  # the tree, closures and frames; another arrangement overrides it
+
+    def __init__(self, params: Params) -> None:
         if not isinstance(params, Params):
             raise InputError(f"MultibodyModel needs a tpm_viz.Params, got {type(params).__name__}")
         self.params = params
-        self.model, self.constraint_models, self._frames = _build(params)
+        self.model, self.constraint_models, self._frames = self._build_model(params)
         """``pinocchio.Model`` and the three ``RigidConstraintModel`` loop closures (LOCAL_WORLD_ALIGNED)."""
         self.data = self.model.createData()
         self._cmodel_vec = pin.StdVec_RigidConstraintModel()
@@ -192,7 +195,7 @@ class MultibodyModel(ClosedLoopAssembly):
         acc_p = pin.getFrameClassicalAcceleration(m, d, fp.parentJoint, fp.placement, lwa).linear
         return np.concatenate(gamma), acc_p[:2]
 
-    def _closure_svd(self, jc: np.ndarray):
+    def _closure_svd(self, jc: np.ndarray) -> RankedSvd:
         """Rank-revealing SVD of ``J_c``; its null space is the 2 admissible motions (rank 5 expected)."""
         svd = ranked_svd(jc)
         if self.model.nv - svd.rank != DOF:
@@ -226,25 +229,25 @@ class MultibodyModel(ClosedLoopAssembly):
         return pin.updateFramePlacement(self.model, self.data, self._frames["platform"]).translation[:2].copy()
 
     @locked
-    def platform_position(self, q) -> np.ndarray:
+    def platform_position(self, q: ArrayLike) -> np.ndarray:
         """Platform position ``P`` (2,) [m] of configuration ``q``."""
         pin.forwardKinematics(self.model, self.data, self._as_q(q))
         return self._platform_position_now()
 
     @locked
-    def closure_terms(self, q) -> tuple[np.ndarray, np.ndarray]:
+    def closure_terms(self, q: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """Loop-closure residual ``Φ(q)`` (9,) [m] (world, 3 rows per closure) and Jacobian ``J_c`` (9, 7)."""
         phi, jc = self._closure_terms(self._as_q(q))
         return phi.copy(), jc.copy()
 
     @locked
-    def constraint_violation(self, q) -> float:
+    def constraint_violation(self, q: ArrayLike) -> float:
         """Largest loop-closure gap [m] (distance between the two sides of a closure) at ``q``."""
         phi, _ = self._closure_terms(self._as_q(q))
         return float(np.max(np.linalg.norm(phi.reshape(-1, 3), axis=1)))
 
     @locked
-    def placements(self, q) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    def placements(self, q: ArrayLike) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """``{part: (position (3,) [m], quaternion wxyz (4,))}`` for :data:`PART_NAMES`.
 
         Sliders: at ``A_i``; links: at their slider-side pivot, local x along the link (length
@@ -259,7 +262,7 @@ class MultibodyModel(ClosedLoopAssembly):
             out[name] = (placement.translation.copy(), np.array([w, x, y, z]))
         return out
 
-    def _as_q(self, q) -> np.ndarray:
+    def _as_q(self, q: ArrayLike) -> np.ndarray:
         q = np.asarray(q, dtype=float)
         if q.shape != (self.model.nq,) or not np.all(np.isfinite(q)):
             raise InputError(f"q must be a finite array of shape ({self.model.nq},), got shape {q.shape}")
@@ -286,7 +289,9 @@ class MultibodyModel(ClosedLoopAssembly):
         a = svd.solve(np.concatenate([-gamma, ddp - jp_dot_v]))
         return q, v, a, n, jp
 
-    def _tau(self, q, v, a, n, jp, f_ext) -> tuple[np.ndarray, np.ndarray]:
+    def _tau(
+        self, q: np.ndarray, v: np.ndarray, a: np.ndarray, n: np.ndarray, jp: np.ndarray, f_ext: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
         """``τ`` from ``(Nᵀ Sᵀ) τ = Nᵀ (rnea(q, v, a) - J_Pᵀ f_ext)`` (λ eliminated); also the right side.
 
         ``Nᵀ Sᵀ`` is the paper's ``Jᵀ`` (eq. 10, ``ḋ = J ṗ``): singular at ``cos(θ1 + θ2) = 0`` (eq. 12).
@@ -301,14 +306,16 @@ class MultibodyModel(ClosedLoopAssembly):
         return np.array([g22 * b1 - g12 * b2, g11 * b2 - g21 * b1]) / det, rhs
 
     @locked
-    def constrained_motion(self, p, dp, ddp) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def constrained_motion(self, p: ArrayLike, dp: ArrayLike, ddp: ArrayLike) -> ThreeArrays:
         """Joint ``(q, v, a)`` (7,) each, consistent with the closures, for one platform state (2,) each."""
         p, dp, ddp = (self._one(x, n) for x, n in ((p, "p"), (dp, "dp"), (ddp, "ddp")))
         q, v, a, _, _ = self._motion(p, dp, ddp)
         return q, v, a
 
     @locked
-    def inverse_dynamics(self, p, dp, ddp, f_ext=None) -> np.ndarray:
+    def inverse_dynamics(
+        self, p: ArrayLike, dp: ArrayLike, ddp: ArrayLike, f_ext: ArrayLike | None = None
+    ) -> np.ndarray:
         """Actuator forces ``τ`` [N], shape ``(..., 2)``, for platform ``p, ṗ, p̈`` [m, m/s, m/s²].
 
         ``f_ext`` [N] is a force applied to the platform (as in eq. 28), broadcastable to ``(..., 2)``.
@@ -331,7 +338,9 @@ class MultibodyModel(ClosedLoopAssembly):
         return tau.reshape(p.shape)
 
     @locked
-    def generalized_forces(self, p, dp, ddp, f_ext=None) -> dict[str, np.ndarray]:
+    def generalized_forces(
+        self, p: ArrayLike, dp: ArrayLike, ddp: ArrayLike, f_ext: ArrayLike | None = None
+    ) -> dict[str, np.ndarray]:
         """Every term of ``rnea - J_Pᵀ f_ext = Sᵀ τ + J_cᵀ λ`` at one state (for checks and teaching):
         ``q, v, a, tau, rhs`` (the left side), ``S_T`` (7, 2), ``J_c`` (9, 7), ``lam`` (minimum-norm λ)."""
         p, dp, ddp = (self._one(x, n) for x, n in ((p, "p"), (dp, "dp"), (ddp, "ddp")))
@@ -343,30 +352,30 @@ class MultibodyModel(ClosedLoopAssembly):
         return {"q": q, "v": v, "a": a, "tau": tau, "rhs": rhs, "S_T": self._s_t.copy(), "J_c": jc, "lam": lam}
 
     @locked
-    def forward_dynamics(self, q, v, tau) -> np.ndarray:
+    def forward_dynamics(self, q: ArrayLike, v: ArrayLike, tau: ArrayLike) -> np.ndarray:
         """Joint accelerations ``a`` (7,) [m/s², rad/s²] under actuator forces ``τ`` (2,) [N]
         (the KKT solve of :func:`tpm_viz.multibody.forward.forward_dynamics`)."""
         return forward.forward_dynamics(self, self._as_q(q), self._as_q(v), self._one(tau, "tau"))
 
     @locked
-    def project(self, q, v) -> tuple[np.ndarray, np.ndarray]:
+    def project(self, q: ArrayLike, v: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """Constraint stabilisation (:func:`tpm_viz.multibody.forward.project`): the nearest ``q`` on the
         closures and ``v`` projected on the admissible motions ``N Nᵀ v``."""
         return forward.project(self, self._as_q(q), self._as_q(v))
 
     @locked
-    def platform_velocity(self, q, v) -> np.ndarray:
+    def platform_velocity(self, q: ArrayLike, v: ArrayLike) -> np.ndarray:
         """Platform velocity ``J_P v`` (2,) [m/s]."""
         self._closure_terms(self._as_q(q))
         return self._platform_jacobian() @ self._as_q(v)
 
     @locked
-    def kinetic_energy(self, q, v) -> float:
+    def kinetic_energy(self, q: ArrayLike, v: ArrayLike) -> float:
         """Total kinetic energy [J] of the tree at ``(q, v)`` (Pinocchio)."""
         return float(pin.computeKineticEnergy(self.model, self.data, self._as_q(q), self._as_q(v)))
 
     @staticmethod
-    def _one(x, name: str) -> np.ndarray:
+    def _one(x: ArrayLike, name: str) -> np.ndarray:
         x = as_xy(x, name)
         if x.shape != (2,):
             raise InputError(f"{name} must have shape (2,), got {x.shape}")
@@ -379,7 +388,9 @@ def model_for(params: Params) -> MultibodyModel:
     return MultibodyModel(params)
 
 
-def inverse_dynamics(params: Params, p, dp, ddp, f_ext=None) -> np.ndarray:
+def inverse_dynamics(
+    params: Params, p: ArrayLike, dp: ArrayLike, ddp: ArrayLike, f_ext: ArrayLike | None = None
+) -> np.ndarray:
     """Actuator forces ``τ`` [N], shape ``(..., 2)``, from the Pinocchio model (see
     :meth:`MultibodyModel.inverse_dynamics`); one cached model per ``params``."""
     if not isinstance(params, Params):

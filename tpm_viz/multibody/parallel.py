@@ -24,6 +24,7 @@ import math
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from tpm_viz.errors import InputError, SingularConfigurationError, UnreachablePoseError
 from tpm_viz.multibody.locking import locked
@@ -99,7 +100,7 @@ class ParallelMultibodyModel(MultibodyModel):
         u = b - pose_a
         return self._pack(d, math.atan2(u[0, 1], u[0, 0]), math.atan2(-u[1, 1], -u[1, 0]))
 
-    def _configure(self, p: np.ndarray, d: np.ndarray | None):
+    def _configure(self, p: np.ndarray, d: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(q, J_c, J_P)`` at the closed-loop configuration of ``p``: Newton from the working-mode guess
         (or from ``d``'s branch), then the last pose as a continuation start."""
         la, (p1, p2) = self.params.l_a, p.tolist()
@@ -132,7 +133,9 @@ class ParallelMultibodyModel(MultibodyModel):
             )
         )
 
-    def _tau(self, q, v, a, n, jp, f_ext) -> tuple[np.ndarray, np.ndarray]:
+    def _tau(
+        self, q: np.ndarray, v: np.ndarray, a: np.ndarray, n: np.ndarray, jp: np.ndarray, f_ext: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
         """The perpendicular model's solve, after a scale-free check of ``Nᵀ Sᵀ = Jᵀ``: here its second row
         ``(tan θ_1, tan θ_2)`` vanishes at the direct singularity, which a per-row test cannot see."""
         g = n[self._slider_idx].T
@@ -141,7 +144,7 @@ class ParallelMultibodyModel(MultibodyModel):
         return super()._tau(q, v, a, n, jp, f_ext)
 
     @locked
-    def configuration_from_actuators(self, d, mode: int = +1) -> np.ndarray:
+    def configuration_from_actuators(self, d: ArrayLike, mode: int = +1) -> np.ndarray:
         """Full ``q`` (7,) for actuator positions ``d`` (2,) [m] in assembly ``mode`` (+1: ``det J_x =
         sin(θ1 + θ2) > 0``, the upper one with the legs inwards), by Newton on the closures."""
         if mode not in (1, -1):
@@ -168,7 +171,9 @@ def parallel_model_for(params: Params) -> ParallelMultibodyModel:
     return ParallelMultibodyModel(params)
 
 
-def inverse_dynamics(params: Params, p, dp, ddp, f_ext=None) -> np.ndarray:
+def inverse_dynamics(
+    params: Params, p: ArrayLike, dp: ArrayLike, ddp: ArrayLike, f_ext: ArrayLike | None = None
+) -> np.ndarray:
     """Actuator forces ``τ`` [N], shape ``(..., 2)``, from the parallel Pinocchio model (one cached per params)."""
     if not isinstance(params, Params):
         raise InputError(f"inverse_dynamics needs a tpm_viz.Params, got {type(params).__name__}")

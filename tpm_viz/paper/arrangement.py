@@ -12,6 +12,7 @@ import enum
 from types import ModuleType, SimpleNamespace
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tpm_viz.errors import InputError
 from tpm_viz.paper import dynamics as _perp_dyn
@@ -102,72 +103,88 @@ def home(arrangement: Arrangement, params: Params) -> np.ndarray:
     return _par.home(params) if Arrangement.parse(arrangement) is Arrangement.PARALLEL else np.zeros(2)
 
 
-def reachable(arrangement: Arrangement, params: Params, p) -> np.ndarray:
+def reachable(arrangement: Arrangement, params: Params, p: ArrayLike) -> np.ndarray:
     """Whether the inverse kinematics has a real solution at ``p`` [m] (bool, shape ``(...)``)."""
     return _kin(arrangement).reachable(params, p)
 
 
-def in_stroke(arrangement: Arrangement, params: Params, d, tol: float = 1e-12) -> np.ndarray:
+def in_stroke(arrangement: Arrangement, params: Params, d: ArrayLike, tol: float = 1e-12) -> np.ndarray:
     """Whether both actuators are within ``0 <= d_i <= Δd`` (the same rule for both arrangements)."""
     return _perp_kin.in_stroke(params, d, tol)
 
 
-def inverse_kinematics(arrangement: Arrangement, params: Params, p) -> np.ndarray:
+def inverse_kinematics(arrangement: Arrangement, params: Params, p: ArrayLike) -> np.ndarray:
     """Actuator positions ``d`` [m], working mode (eq. 4 or eq. P3)."""
     return _kin(arrangement).inverse_kinematics(params, p)
 
 
-def forward_kinematics(arrangement: Arrangement, params: Params, d, mode: int = +1) -> np.ndarray:
+def forward_kinematics(arrangement: Arrangement, params: Params, d: ArrayLike, mode: int = +1) -> np.ndarray:
     """Platform position [m] in assembly ``mode`` (+1 contains the working mode's regular poses)."""
     return _kin(arrangement).forward_kinematics(params, d, mode)
 
 
-def forward_kinematics_both(arrangement: Arrangement, params: Params, d) -> FkSolutions:
+def forward_kinematics_both(arrangement: Arrangement, params: Params, d: ArrayLike) -> FkSolutions:
     """Both assembly modes (:class:`FkSolutions`)."""
     return _kin(arrangement).forward_kinematics_both(params, d)
 
 
-def mechanism_pose(arrangement: Arrangement, params: Params, p, d=None) -> MechanismPose:
+def mechanism_pose(arrangement: Arrangement, params: Params, p: ArrayLike, d: ArrayLike | None = None) -> MechanismPose:
     """Every joint of one configuration, for drawing (:class:`MechanismPose`)."""
     return _kin(arrangement).mechanism_pose(params, p, d)
 
 
-def jacobians(arrangement: Arrangement, params: Params, p, d=None) -> Jacobians:
+def jacobians(arrangement: Arrangement, params: Params, p: ArrayLike, d: ArrayLike | None = None) -> Jacobians:
     """``J_x``, ``J_q``, ``J`` and the singularity measures ``det J_x`` (direct), ``det J_q`` (inverse)."""
     return _ns(arrangement).jac.jacobians(params, p, d)
 
 
-def condition_number(arrangement: Arrangement, params: Params, p, d=None) -> np.ndarray:
+def condition_number(arrangement: Arrangement, params: Params, p: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
     """2-norm condition number of ``J``; ``inf`` at a singularity."""
     return _ns(arrangement).jac.condition_number(params, p, d)
 
 
-def classify(arrangement: Arrangement, params: Params, p, thresholds: SingularityThresholds = WARN) -> np.ndarray:
+def classify(
+    arrangement: Arrangement, params: Params, p: ArrayLike, thresholds: SingularityThresholds = WARN
+) -> np.ndarray:
     """:class:`~tpm_viz.paper.status.PoseStatus` values per pose, the same thresholds for both."""
     return _ns(arrangement).jac.classify(params, p, thresholds)
 
 
-def actuator_velocity(arrangement: Arrangement, params: Params, p, dp, d=None) -> np.ndarray:
+def actuator_velocity(
+    arrangement: Arrangement, params: Params, p: ArrayLike, dp: ArrayLike, d: ArrayLike | None = None
+) -> np.ndarray:
     """``ḋ = J ṗ`` [m/s]."""
     return _ns(arrangement).jac.actuator_velocity(params, p, dp, d)
 
 
-def actuator_forces_from_platform_force(arrangement: Arrangement, params: Params, p, f, d=None) -> np.ndarray:
+def actuator_forces_from_platform_force(
+    arrangement: Arrangement, params: Params, p: ArrayLike, f: ArrayLike, d: ArrayLike | None = None
+) -> np.ndarray:
     """``τ = J⁻ᵀ f`` [N] (eq. 13 / P8); to hold an external load ``f_ext`` pass ``f = -f_ext``."""
     return _ns(arrangement).jac.actuator_forces_from_platform_force(params, p, f, d)
 
 
-def inverse_dynamics(arrangement: Arrangement, params: Params, p, dp, ddp, f_ext=None, d=None) -> np.ndarray:
+def inverse_dynamics(
+    arrangement: Arrangement,
+    params: Params,
+    p: ArrayLike,
+    dp: ArrayLike,
+    ddp: ArrayLike,
+    f_ext: ArrayLike | None = None,
+    d: ArrayLike | None = None,
+) -> np.ndarray:
     """Actuator forces ``τ`` [N] by the closed form (eqs. 29-31 / P14)."""
     return _ns(arrangement).dyn.inverse_dynamics(params, p, dp, ddp, f_ext, d)
 
 
-def kinetic_energy(arrangement: Arrangement, params: Params, p, dp, d=None) -> np.ndarray:
+def kinetic_energy(
+    arrangement: Arrangement, params: Params, p: ArrayLike, dp: ArrayLike, d: ArrayLike | None = None
+) -> np.ndarray:
     """Total kinetic energy [J]."""
     return _ns(arrangement).dyn.kinetic_energy(params, p, dp, d)
 
 
-def force_per_acceleration(arrangement: Arrangement, params: Params, p) -> np.ndarray:
+def force_per_acceleration(arrangement: Arrangement, params: Params, p: ArrayLike) -> np.ndarray:
     """``J⁻ᵀ M(p)`` [kg], shape ``(..., 2, 2)``: actuator forces per unit platform acceleration at rest (column
     ``k``: ``τ`` for ``p̈ = e_k``, ``ṗ = 0``, no load), from the closed-form inverse dynamics."""
     p = np.asarray(p, dtype=float)

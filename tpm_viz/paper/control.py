@@ -1,4 +1,4 @@
-"""Control laws on the paper's closed-form model: PD, PD + feedforward, computed torque (issue 14).
+"""Control laws on the paper's closed-form model: PD, PD + feedforward, computed torque.
 
 The paper derives its closed-form inverse dynamics (eqs. 29-31) "for the real-time computed torque
 control in the further work" (Sections 1, 3, 5). This module is that further work, on the numpy layer:
@@ -25,10 +25,13 @@ Each law also returns ``τ_ff`` [N], the part of ``τ`` that does not depend on 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from enum import StrEnum
+from typing import Protocol, SupportsFloat, TypeVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tpm_viz.errors import InputError, SingularConfigurationError, UnreachablePoseError
 from tpm_viz.numbers import fixed
@@ -38,7 +41,7 @@ from tpm_viz.numbers import fixed
 from tpm_viz.paper.dynamics import SINGULAR_TOL, _procedure, inverse_dynamics
 from tpm_viz.paper.jacobians import actuator_velocity
 from tpm_viz.paper.kinematics import inverse_kinematics
-from tpm_viz.paper.trajectories import Trajectory, circle_state, line_state, paper_duration
+from tpm_viz.paper.trajectories import State, Trajectory, circle_state, line_state, paper_duration
 from tpm_viz.params import Params
 from tpm_viz.words import Phrase
 
@@ -56,7 +59,7 @@ __all__ = [
 
 
 class ControllerKind(StrEnum):
-    """The three control laws of issue 14."""
+    """The three control laws."""
 
     PD = "pd"
     """PD on the actuator coordinates."""
@@ -66,7 +69,7 @@ class ControllerKind(StrEnum):
     """Computed torque in task space (feedback linearisation with the closed form)."""
 
     @classmethod
-    def parse(cls, value) -> ControllerKind:
+    def parse(cls, value: str) -> ControllerKind:
         """``value`` as a kind (``"pd"``, ``"pdff"``, ``"ctc"``) or a one-line :class:`InputError`."""
         try:
             return cls(value)
@@ -74,7 +77,7 @@ class ControllerKind(StrEnum):
             raise InputError(f"controller must be one of pd, pdff, ctc; got {value!r}") from None
 
 
-def _finite(value, name: str, low: float, strict: bool = True) -> float:
+def _finite(value: str | SupportsFloat, name: str, low: float, strict: bool = True) -> float:
     try:
         value = float(value)
     except (TypeError, ValueError):
@@ -147,7 +150,7 @@ _HERMITE = np.array(  # quintic Hermite basis: rows = [p0, h v0, h² a0, h² a1,
 )
 
 
-def _hermite(traj: Trajectory, t: np.ndarray):
+def _hermite(traj: Trajectory, t: np.ndarray) -> State:
     """``(p, ṗ, p̈)`` of ``traj`` at times ``t`` by quintic Hermite interpolation of its samples.
 
     Exact for any trajectory that is a polynomial of degree <= 5 between samples (so for the cubic
@@ -173,7 +176,7 @@ def _hermite(traj: Trajectory, t: np.ndarray):
     return p, dp, ddp
 
 
-def reference_state(reference, t, duration: float | None = None):
+def reference_state(reference: str | Trajectory, t: ArrayLike, duration: float | None = None) -> State:
     """Reference ``(p, ṗ, p̈)`` [m, m/s, m/s²], each ``(n, 2)``, at times ``t`` [s] ``(n,)``.
 
     ``reference``: ``"line"`` or ``"circle"`` (the paper's Figs. 4-5, exact, path duration ``duration``
@@ -210,16 +213,32 @@ class ReferenceSamples:
 
 
 # ----------------------------------------------------------------------------- the laws
+class Arithmetic(Protocol):
+    """A number :func:`task_space_command` computes with: a float, or a symbol of the C generator."""
+
+    def __add__(self: _N, other: _N, /) -> _N: ...
+
+    def __sub__(self: _N, other: _N, /) -> _N: ...
+
+    def __mul__(self: _N, other: _N, /) -> _N: ...
+
+
+_N = TypeVar("_N", bound=Arithmetic)
+
 CTC_DIRECT_TOL = 1e-9
 """The computed-torque law refuses a measured pose with ``|c_1 c_2 - p_1 p_2| < CTC_DIRECT_TOL l_a²``, i.e.
 ``|cos(θ1 + θ2)|`` below it (eq. 12); at the inverse singularity it refuses where the closed form does
 (``SINGULAR_TOL``, eq. 11). The generated C (:mod:`tpm_viz.exchange.c_code`) reads both from here."""
 
 
-def task_space_command(p_ref, dp_ref, ddp_ref, p, dp, kp, kd):
+def task_space_command(p_ref: _N, dp_ref: _N, ddp_ref: _N, p: _N, dp: _N, kp: _N, kd: _N) -> _N:
     """The computed-torque law's commanded acceleration on one axis [m/s²]:
     ``p̈_ref + K_d (ṗ_ref - ṗ) + K_p (p_ref - p)`` (floats, arrays, or the C generator's symbols)."""
     return ddp_ref + kd * (dp_ref - dp) + kp * (p_ref - p)
+
+
+ForceFunction = Callable[[tuple[float, ...], float, float, float, float], tuple[float, float, float, float]]
+"""``f(row, p1, p2, ṗ1, ṗ2) -> (τ1, τ2, τ_ff1, τ_ff2)`` [N] of :meth:`ControlLaw.force_function`."""
 
 
 @dataclass(frozen=True)
@@ -240,7 +259,7 @@ class ControlLaw:
         """``m_i`` [kg] of the PD loops (:func:`axis_masses` of the controller's model)."""
         return axis_masses(self.params)
 
-    def sample(self, t, p, dp, ddp) -> ReferenceSamples:
+    def sample(self, t: ArrayLike, p: ArrayLike, dp: ArrayLike, ddp: ArrayLike) -> ReferenceSamples:
         """The reference quantities this law needs at sample times ``t`` [s] (vectorised, closed form)."""
         p, dp, ddp = (np.asarray(x, dtype=float) for x in (p, dp, ddp))
         d = inverse_kinematics(self.params, p)
@@ -254,7 +273,7 @@ class ControlLaw:
             tau=inverse_dynamics(self.params, p, dp, ddp),
         )
 
-    def force_function(self):
+    def force_function(self) -> ForceFunction:
         """``f(row, p1, p2, ṗ1, ṗ2) -> (τ1, τ2, τ_ff1, τ_ff2)`` [N] for one sample (floats, no arrays).
 
         ``row`` is one entry of :meth:`ReferenceSamples.rows`; ``p, ṗ`` [m, m/s] the measured platform
@@ -264,7 +283,7 @@ class ControlLaw:
         la, k = prm.l_a, prm.a - prm.b
         m1, m2 = self.masses
 
-        def legs(p1, p2):
+        def legs(p1: float, p2: float) -> tuple[float, float]:
             if not (abs(p1) < la and abs(p2) < la):  # as inverse_dynamics refuses (eq. 4); also catches NaN
                 raise UnreachablePoseError(
                     Phrase(
@@ -280,7 +299,9 @@ class ControlLaw:
                 raise SingularConfigurationError(Phrase("the measured pose is at the direct singularity (eq. 12)"))
             return c1, c2
 
-        def pd(row, p1, p2, dp1, dp2, ff1, ff2):
+        def pd(
+            row: tuple[float, ...], p1: float, p2: float, dp1: float, dp2: float, ff1: float, ff2: float
+        ) -> tuple[float, float, float, float]:
             c1, c2 = legs(p1, p2)
             d1, d2 = p1 + k - c1, p2 + k - c2  # eq. (4)
             dd1, dd2 = dp1 + p2 / c1 * dp2, dp2 + p1 / c2 * dp1  # eq. (9): ḋ_i = ṗ_i + tan θ_i ṗ_j
@@ -293,7 +314,9 @@ class ControlLaw:
         if self.kind is ControllerKind.PDFF:
             return lambda row, p1, p2, dp1, dp2: pd(row, p1, p2, dp1, dp2, row[10], row[11])
 
-        def ctc(row, p1, p2, dp1, dp2):
+        def ctc(
+            row: tuple[float, ...], p1: float, p2: float, dp1: float, dp2: float
+        ) -> tuple[float, float, float, float]:
             c1, c2 = legs(p1, p2)
             a1 = task_space_command(row[0], row[2], row[4], p1, dp1, kp, kd)
             a2 = task_space_command(row[1], row[3], row[5], p2, dp2, kp, kd)
@@ -303,6 +326,8 @@ class ControlLaw:
 
         return ctc
 
-    def force(self, row, p, dp) -> np.ndarray:
+    def force(
+        self, row: tuple[float, ...], p: Sequence[float] | np.ndarray, dp: Sequence[float] | np.ndarray
+    ) -> np.ndarray:
         """``(τ1, τ2, τ_ff1, τ_ff2)`` [N] for one sample (convenience wrapper of :meth:`force_function`)."""
         return np.array(self.force_function()(row, float(p[0]), float(p[1]), float(dp[0]), float(dp[1])))

@@ -23,8 +23,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from tpm_viz.errors import SingularConfigurationError
 from tpm_viz.paper.jacobians import actuator_velocity
@@ -33,6 +35,11 @@ from tpm_viz.params import Params
 from tpm_viz.words import Phrase, T
 
 __all__ = ["SINGULAR_TOL", "DynamicsResult", "inverse_dynamics", "inverse_dynamics_detail", "kinetic_energy"]
+
+
+Component = float | NDArray[np.float64]
+"""One component of a state [SI]: a float, or an array of them (all of one shape). The C generator
+(:mod:`tpm_viz.exchange.c_code`) traces :func:`_procedure` with its own symbols instead."""
 
 
 @dataclass(frozen=True)
@@ -51,7 +58,20 @@ class DynamicsResult:
     tau: np.ndarray  # (e) actuator forces τ_i [N]
 
 
-def _v_leg(mp, mb, pi, pj, dpi, dpj, ddpi, ci, cj, ddi, ddj, dddj):
+def _v_leg(
+    mp: float,
+    mb: float,
+    pi: Component,
+    pj: Component,
+    dpi: Component,
+    dpj: Component,
+    ddpi: Component,
+    ci: Component,
+    cj: Component,
+    ddi: Component,
+    ddj: Component,
+    dddj: Component,
+) -> Component:
     """``v_i`` below eq. (29) [N] as printed; ``j`` is the other leg. Floats or arrays. :func:`_procedure` computes
     the same terms regrouped; this form is the tests' reference for the regrouping."""
     return (
@@ -64,7 +84,9 @@ def _v_leg(mp, mb, pi, pj, dpi, dpj, ddpi, ci, cj, ddi, ddj, dddj):
     )
 
 
-def _w_leg(ma, mb, pj, dpi, dpj, ddpj, ci, dddi):
+def _w_leg(
+    ma: float, mb: float, pj: Component, dpi: Component, dpj: Component, ddpj: Component, ci: Component, dddi: Component
+) -> Component:
     """``w_i`` below eq. (31) [N] as printed. Floats or arrays (the tests' reference, see :func:`_v_leg`)."""
     return (
         (ma + mb) * dddi
@@ -74,7 +96,19 @@ def _w_leg(ma, mb, pj, dpi, dpj, ddpj, ci, dddi):
     )
 
 
-def _procedure(params: Params, p1, p2, dp1, dp2, ddp1, ddp2, c1, c2, f1, f2) -> tuple:
+def _procedure(
+    params: Params,
+    p1: Component,
+    p2: Component,
+    dp1: Component,
+    dp2: Component,
+    ddp1: Component,
+    ddp2: Component,
+    c1: Component,
+    c2: Component,
+    f1: Component,
+    f2: Component,
+) -> tuple:
     """Steps (b)-(e) on components (floats or equal-shape arrays); ``c_i = p_i - d_i + a - b``.
 
     Returns ``(dd1, dd2, ddd1, ddd2, v1, v2, w1, w2, lam1, lam2, tau1, tau2)``. The terms of ``v_i`` and ``w_i``
@@ -119,7 +153,7 @@ _EQ11 = "cos θ1 cos θ2 = 0 (eq. 11)"
 _EQ12 = "cos(θ1 + θ2) = 0 (eq. 12)"
 
 
-def _check_regular(params: Params, c1, c2, p1, p2) -> None:
+def _check_regular(params: Params, c1: Component, c2: Component, p1: Component, p2: Component) -> None:
     l2 = params.l_a**2
     if np.any(np.abs(c1 * c2) < SINGULAR_TOL * l2):
         raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq=_EQ11))
@@ -133,7 +167,17 @@ mmap threshold; 2-3x faster than whole 10^5-state arrays, ~1.4x faster than bloc
 overhead starts to count (benchmarks/bench_core.py)."""
 
 
-def _vectorised(params: Params, p, dp, ddp, f_ext, d, outputs: tuple[int, ...] = tuple(range(12))) -> tuple:
+def _vectorised(
+    params: Params,
+    p: ArrayLike,
+    dp: ArrayLike,
+    ddp: ArrayLike,
+    f_ext: ArrayLike | None,
+    d: ArrayLike | None,
+    outputs: tuple[int, ...] = tuple(range(12)),
+) -> tuple[
+    NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64]
+]:
     """Steps (a)-(e) on broadcast arrays: returns ``(p, dp, ddp, d, out)``; ``out[k]`` (shape ``(...)``) is the
     ``outputs[k]``-th result of :func:`_procedure`; ``d`` is None unless every output is wanted."""
     p, dp, ddp = np.broadcast_arrays(as_xy(p), as_xy(dp, "dp"), as_xy(ddp, "ddp"))
@@ -145,7 +189,7 @@ def _vectorised(params: Params, p, dp, ddp, f_ext, d, outputs: tuple[int, ...] =
         cols[2 * k : 2 * k + 2] = arr.reshape(n, 2).T
     cols[8:10] = np.broadcast_to(f, p.shape).reshape(n, 2).T
     working = d is None
-    if working:  # (a) eq. (4), working mode: c_i = sqrt(l_a² - p_j²) (in the loop), d_i = p_i + a - b - c_i
+    if d is None:  # (a) eq. (4), working mode: c_i = sqrt(l_a² - p_j²) (in the loop), d_i = p_i + a - b - c_i
         if n and not np.abs(cols[0:2]).max() < params.l_a:
             inverse_kinematics(params, p)  # raises the precise error
     else:
@@ -168,7 +212,14 @@ def _vectorised(params: Params, p, dp, ddp, f_ext, d, outputs: tuple[int, ...] =
     return p, dp, ddp, d, out.reshape(len(outputs), *shape)
 
 
-def inverse_dynamics_detail(params: Params, p, dp, ddp, f_ext=None, d=None) -> DynamicsResult:
+def inverse_dynamics_detail(
+    params: Params,
+    p: ArrayLike,
+    dp: ArrayLike,
+    ddp: ArrayLike,
+    f_ext: ArrayLike | None = None,
+    d: ArrayLike | None = None,
+) -> DynamicsResult:
     """The paper's procedure (a)-(e) with every intermediate (see module docstring).
 
     ``p, dp, ddp`` [m, m/s, m/s²] have shape ``(..., 2)``; ``f_ext`` [N] is an external force
@@ -177,17 +228,18 @@ def inverse_dynamics_detail(params: Params, p, dp, ddp, f_ext=None, d=None) -> D
     configuration (``cos θ_i = 0`` or ``cos(θ1 + θ2) = 0``).
     """
     p, dp, ddp, d, out = _vectorised(params, p, dp, ddp, f_ext, d)
-    dd, ddd, v, w, lam, tau = (np.stack(out[k : k + 2], -1) for k in range(0, 12, 2))
+    assert d is not None  # every output was asked for
+    dd, ddd, v, w, lam, tau = (np.stack(tuple(out[k : k + 2]), -1) for k in range(0, 12, 2))
     finite_result(tau, T("the actuator forces"))
     return DynamicsResult(p=p, dp=dp, ddp=ddp, d=d, dd=dd, ddd=ddd, v=v, w=w, lam=lam, tau=tau)
 
 
-def _pair(x) -> tuple[float, float] | None:
+def _pair(x: object) -> tuple[float, float] | None:
     """``x`` as two floats if it is one 2-vector (a sequence or an array of shape ``(2,)``), else None."""
     if isinstance(x, np.ndarray):
         if x.shape != (2,):
             return None
-        x = x.tolist()
+        x = cast(list, x.tolist())
     elif not isinstance(x, (list, tuple)) or len(x) != 2:
         return None
     try:
@@ -196,7 +248,9 @@ def _pair(x) -> tuple[float, float] | None:
         return None
 
 
-def _inverse_dynamics_one(params: Params, p, dp, ddp, f_ext, d=None) -> np.ndarray | None:
+def _inverse_dynamics_one(
+    params: Params, p: ArrayLike, dp: ArrayLike, ddp: ArrayLike, f_ext: ArrayLike | None, d: ArrayLike | None = None
+) -> np.ndarray | None:
     """Fast path for one state given as 2-vectors: pure ``math``, no array temporaries (~5 µs).
 
     Returns None when the input is not a plain single state, or not finite (the caller then vectorises,
@@ -233,7 +287,14 @@ def _inverse_dynamics_one(params: Params, p, dp, ddp, f_ext, d=None) -> np.ndarr
     return np.array((tau1, tau2))
 
 
-def inverse_dynamics(params: Params, p, dp, ddp, f_ext=None, d=None) -> np.ndarray:
+def inverse_dynamics(
+    params: Params,
+    p: ArrayLike,
+    dp: ArrayLike,
+    ddp: ArrayLike,
+    f_ext: ArrayLike | None = None,
+    d: ArrayLike | None = None,
+) -> np.ndarray:
     """Actuator forces ``τ`` [N], shape ``(..., 2)``, by the paper's closed form (eqs. 29, 31).
 
     See :func:`inverse_dynamics_detail` for the arguments and the intermediates. One state given as 2-vectors
@@ -246,7 +307,7 @@ def inverse_dynamics(params: Params, p, dp, ddp, f_ext=None, d=None) -> np.ndarr
     return finite_result(np.stack((out[0], out[1]), -1), T("the actuator forces"))
 
 
-def kinetic_energy(params: Params, p, dp, d=None) -> np.ndarray:
+def kinetic_energy(params: Params, p: ArrayLike, dp: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
     """Total kinetic energy ``K`` [J] of eqs. (20)-(22) (``ḋ_i^2`` read for ``d_i^2`` in eq. 22)."""
     p, dp = as_xy(p), as_xy(dp, "dp")
     d = inverse_kinematics(params, p) if d is None else as_xy(d, "d")

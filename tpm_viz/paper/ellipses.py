@@ -15,6 +15,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tpm_viz.errors import SingularConfigurationError
 from tpm_viz.paper.jacobians import jacobians
@@ -36,7 +37,7 @@ class ManipulabilityEllipses(NamedTuple):
     force: Ellipse  # radii in N per N of actuator force
 
 
-def manipulability_ellipses(params: Params, p, max_ratio: float = 1e6) -> ManipulabilityEllipses:
+def manipulability_ellipses(params: Params, p: ArrayLike, max_ratio: float = 1e6) -> ManipulabilityEllipses:
     """Both ellipses at one platform position ``p`` [m], working mode.
 
     Raises :class:`SingularConfigurationError` when ``J`` is singular or its condition number exceeds
@@ -54,7 +55,7 @@ def manipulability_ellipses(params: Params, p, max_ratio: float = 1e6) -> Manipu
     return ManipulabilityEllipses(velocity=Ellipse(axes, 1.0 / sigma), force=Ellipse(axes, sigma.copy()))
 
 
-def ellipse_outline(ellipse: Ellipse, centre=(0.0, 0.0), scale: float = 1.0, n: int = 64) -> np.ndarray:
+def ellipse_outline(ellipse: Ellipse, centre: ArrayLike = (0.0, 0.0), scale: float = 1.0, n: int = 64) -> np.ndarray:
     """``(n, 2)`` points on the ellipse (closed: first point repeated last), scaled by ``scale``."""
     phi = np.linspace(0.0, 2.0 * np.pi, n)
     unit = np.stack([np.cos(phi), np.sin(phi)], -1)

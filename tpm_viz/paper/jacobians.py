@@ -18,6 +18,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from tpm_viz.errors import SingularConfigurationError
 from tpm_viz.paper.kinematics import as_xy, finite_result, in_stroke, inverse_kinematics, leg_components, reachable
@@ -42,6 +43,10 @@ __all__ = [
 ]
 
 
+#: a scalar [SI] or an array of them, broadcast together (eq. 14 row by row)
+FloatOrArray = float | NDArray[np.float64]
+
+
 class Jacobians(NamedTuple):
     """``J_x``, ``J_q`` (eq. 8), ``J`` (eq. 10) and the two singularity measures (eqs. 11-12)."""
 
@@ -52,14 +57,16 @@ class Jacobians(NamedTuple):
     det_jq: np.ndarray  # (...,) cos θ1 cos θ2, inverse singularity at 0
 
 
-def _cos_sin(params: Params, p, d):
+def _cos_sin(
+    params: Params, p: ArrayLike, d: ArrayLike | None
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     p = as_xy(p)
     d = inverse_kinematics(params, p) if d is None else as_xy(d, "d")
     c, s = leg_components(params, p, d)
     return p, d, c / params.l_a, s / params.l_a
 
 
-def jacobians(params: Params, p, d=None) -> Jacobians:
+def jacobians(params: Params, p: ArrayLike, d: ArrayLike | None = None) -> Jacobians:
     """The Jacobian matrices of eqs. (8) and (10) at ``p`` [m] (dimensionless)."""
     _, _, cos, sin = _cos_sin(params, p, d)
     jx = np.stack([np.stack([cos[..., 0], sin[..., 0]], -1), np.stack([sin[..., 1], cos[..., 1]], -1)], -2)
@@ -74,7 +81,7 @@ def jacobians(params: Params, p, d=None) -> Jacobians:
     return Jacobians(jx, jq, j, det_jx, det_jq)
 
 
-def condition_number(params: Params, p, d=None) -> np.ndarray:
+def condition_number(params: Params, p: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
     """2-norm condition number of ``J`` (eq. 10); ``inf`` at a singularity (shape ``(...)``)."""
     j = jacobians(params, p, d).j
     bad = ~np.all(np.isfinite(j), axis=(-2, -1))
@@ -84,7 +91,7 @@ def condition_number(params: Params, p, d=None) -> np.ndarray:
     return np.where(bad | ~np.isfinite(cond), np.inf, cond)
 
 
-def classify(params: Params, p, thresholds: SingularityThresholds = WARN) -> np.ndarray:
+def classify(params: Params, p: ArrayLike, thresholds: SingularityThresholds = WARN) -> np.ndarray:
     """Status per pose (values of :class:`~tpm_viz.paper.status.PoseStatus`); the most severe condition wins.
 
     Working-mode inverse kinematics (eq. 4). Non-finite poses count as unreachable.
@@ -109,7 +116,7 @@ def _check_regular(jac: Jacobians, which: str) -> None:
         raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq=eq))
 
 
-def actuator_velocity(params: Params, p, dp, d=None) -> np.ndarray:
+def actuator_velocity(params: Params, p: ArrayLike, dp: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
     """Actuator velocities ``ḋ = J ṗ`` [m/s], eq. (9)."""
     jac = jacobians(params, p, d)
     _check_regular(jac, "inverse")
@@ -117,7 +124,7 @@ def actuator_velocity(params: Params, p, dp, d=None) -> np.ndarray:
         return finite_result(np.einsum("...ij,...j->...i", jac.j, as_xy(dp, "dp")), T("the actuator velocities"))
 
 
-def platform_velocity(params: Params, p, dd, d=None) -> np.ndarray:
+def platform_velocity(params: Params, p: ArrayLike, dd: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
     """Platform velocity ``ṗ = J^{-1} ḋ`` [m/s] (inverse of eq. 9; needs ``det J_x != 0``)."""
     jac = jacobians(params, p, d)
     _check_regular(jac, "direct")
@@ -126,7 +133,7 @@ def platform_velocity(params: Params, p, dd, d=None) -> np.ndarray:
         return finite_result(np.linalg.solve(jac.jx, rhs[..., None])[..., 0], T("the platform velocity"))
 
 
-def theta_dot(params: Params, p, dp, d=None) -> np.ndarray:
+def theta_dot(params: Params, p: ArrayLike, dp: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
     """Leg angular rates ``θ̇_i = ṗ_j / (l_a cos θ_i)`` [rad/s], eq. (24)."""
     _, _, cos, _ = _cos_sin(params, p, d)
     if np.any(np.abs(cos) < 1e-12):
@@ -135,7 +142,16 @@ def theta_dot(params: Params, p, dp, d=None) -> np.ndarray:
         return finite_result(as_xy(dp, "dp")[..., ::-1] / (params.l_a * cos), T("the leg angular rates"))
 
 
-def eq14_row(pi, pj, dpi, dpj, ddpi, ddpj, ci, ddi):
+def eq14_row(
+    pi: FloatOrArray,
+    pj: FloatOrArray,
+    dpi: FloatOrArray,
+    dpj: FloatOrArray,
+    ddpi: FloatOrArray,
+    ddpj: FloatOrArray,
+    ci: FloatOrArray,
+    ddi: FloatOrArray,
+) -> FloatOrArray:
     """Row ``i`` of eq. (14) with the corrected eq. (15), for floats or arrays [m/s²].
 
     With ``cos θ_i = c_i / l_a``, ``sin θ_i = p_j / l_a`` and ``θ̇_i = ṗ_j / c_i`` (eq. 24),
@@ -148,7 +164,14 @@ def eq14_row(pi, pj, dpi, dpj, ddpi, ddpj, ci, ddi):
     return thi * (dpj - ti * dpi) + ddpi + ti * ddpj + ti * thi * ddi
 
 
-def actuator_acceleration(params: Params, p, dp, ddp, d=None, dd=None) -> np.ndarray:
+def actuator_acceleration(
+    params: Params,
+    p: ArrayLike,
+    dp: ArrayLike,
+    ddp: ArrayLike,
+    d: ArrayLike | None = None,
+    dd: NDArray[np.float64] | None = None,
+) -> np.ndarray:
     """Actuator accelerations [m/s²], eq. (14) with the corrected eq. (15).
 
     ``d̈ = J_q^{-1} (J̇_x ṗ + J_x p̈ - J̇_q ḋ)`` with
@@ -170,7 +193,9 @@ def actuator_acceleration(params: Params, p, dp, ddp, d=None, dd=None) -> np.nda
     return finite_result(np.stack(rows, -1), T("the actuator accelerations"))
 
 
-def actuator_forces_from_platform_force(params: Params, p, f, d=None) -> np.ndarray:
+def actuator_forces_from_platform_force(
+    params: Params, p: ArrayLike, f: ArrayLike, d: ArrayLike | None = None
+) -> np.ndarray:
     """Actuator forces ``τ = J^{-T} f`` [N] for a platform force ``f`` [N], eq. (13).
 
     ``f`` is the force the platform exerts on its surroundings (eq. 13: ``f = J^T τ``). To
@@ -188,7 +213,9 @@ def actuator_forces_from_platform_force(params: Params, p, f, d=None) -> np.ndar
         return finite_result(np.einsum("...ij,...j->...i", jac.jq, g), T("the actuator forces"))
 
 
-def platform_force_from_actuator_forces(params: Params, p, tau, d=None) -> np.ndarray:
+def platform_force_from_actuator_forces(
+    params: Params, p: ArrayLike, tau: ArrayLike, d: ArrayLike | None = None
+) -> np.ndarray:
     """Platform force ``f = J^T τ`` [N] for actuator forces ``τ`` [N], eq. (13)."""
     jac = jacobians(params, p, d)
     _check_regular(jac, "inverse")

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tpm_viz.errors import InputError, SingularConfigurationError, UnreachablePoseError
 from tpm_viz.numbers import fixed
@@ -41,7 +42,7 @@ __all__ = [
 ]
 
 
-def as_xy(x, name: str = "p") -> np.ndarray:
+def as_xy(x: ArrayLike, name: str = "p") -> np.ndarray:
     """``x`` as a float array of shape ``(..., 2)``; raise :class:`InputError` otherwise."""
     arr = np.asarray(x, dtype=float)
     if arr.ndim == 0 or arr.shape[-1] != 2:
@@ -64,13 +65,13 @@ def finite_result(arr: np.ndarray, what: str | Phrase) -> np.ndarray:
     return arr
 
 
-def reachable(params: Params, p) -> np.ndarray:
+def reachable(params: Params, p: ArrayLike) -> np.ndarray:
     """Whether eq. (4) has a real solution for both legs: ``|p_j| < l_a`` (bool, shape ``(...)``)."""
     p = np.asarray(p, dtype=float)
     return np.all(np.abs(p) < params.l_a, axis=-1) & np.all(np.isfinite(p), axis=-1)
 
 
-def in_stroke(params: Params, d, tol: float = 1e-12) -> np.ndarray:
+def in_stroke(params: Params, d: ArrayLike, tol: float = 1e-12) -> np.ndarray:
     """Whether both actuators are within ``0 <= d_i <= Δd`` (bool, shape ``(...)``)."""
     d = np.asarray(d, dtype=float)
     return np.all((d >= -tol) & (d <= params.stroke + tol), axis=-1)
@@ -83,7 +84,7 @@ def _ik_unchecked(params: Params, p: np.ndarray) -> np.ndarray:
     return p + params.offset - root
 
 
-def inverse_kinematics(params: Params, p) -> np.ndarray:
+def inverse_kinematics(params: Params, p: ArrayLike) -> np.ndarray:
     """Actuator positions ``d`` [m] for platform positions ``p`` [m], eq. (4).
 
     Uses the negative root of eq. (3) (the working mode: each slider on its base side
@@ -105,14 +106,14 @@ def inverse_kinematics(params: Params, p) -> np.ndarray:
     return _ik_unchecked(params, p)
 
 
-def leg_components(params: Params, p, d) -> tuple[np.ndarray, np.ndarray]:
+def leg_components(params: Params, p: ArrayLike, d: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """``(c, s)`` with ``c_i = p_i - d_i + a - b = l_a cos θ_i`` and ``s_i = p_j = l_a sin θ_i`` [m]."""
     p = np.asarray(p, dtype=float)
     d = np.asarray(d, dtype=float)
     return p - d + params.offset, p[..., ::-1]
 
 
-def leg_angles(params: Params, p, d=None) -> np.ndarray:
+def leg_angles(params: Params, p: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
     """Leg angles ``θ = (θ_1, θ_2)`` [rad] from eq. (23), on the branch given by ``d``.
 
     ``d`` defaults to the working-mode inverse kinematics (eq. 4), where ``|θ_i| < π/2``.
@@ -141,7 +142,7 @@ class FkSolutions(NamedTuple):
     status: np.ndarray
 
 
-def forward_kinematics_both(params: Params, d) -> FkSolutions:
+def forward_kinematics_both(params: Params, d: ArrayLike) -> FkSolutions:
     """Both platform positions for actuator positions ``d`` [m] (intersections of two circles).
 
     Leg 1 confines ``P`` to the circle of radius ``l_a`` about ``C_1 = (d_1 - a + b, 0)``,
@@ -207,7 +208,7 @@ def _raise_if_missing(params: Params, d: np.ndarray, sol: FkSolutions) -> None:
     )
 
 
-def forward_kinematics(params: Params, d, mode: int = +1) -> np.ndarray:
+def forward_kinematics(params: Params, d: ArrayLike, mode: int = +1) -> np.ndarray:
     """Platform position [m] for actuator positions ``d`` [m] in assembly ``mode`` (+1 or -1).
 
     Raises :class:`UnreachablePoseError` if the two leg circles do not meet and
@@ -221,7 +222,7 @@ def forward_kinematics(params: Params, d, mode: int = +1) -> np.ndarray:
     return sol.plus if mode == 1 else sol.minus
 
 
-def forward_kinematics_nearest(params: Params, d, p_prev) -> tuple[np.ndarray, int]:
+def forward_kinematics_nearest(params: Params, d: ArrayLike, p_prev: ArrayLike) -> tuple[np.ndarray, int]:
     """The assembly mode nearest a previous platform position: ``(p, mode)`` for one pose."""
     d = as_xy(d, "d")
     sol = forward_kinematics_both(params, d)
@@ -250,7 +251,7 @@ class MechanismPose:
     links: np.ndarray  # (2, 2, 2, 2) leg, link, end, xy
 
 
-def mechanism_pose(params: Params, p, d=None) -> MechanismPose:
+def mechanism_pose(params: Params, p: ArrayLike, d: ArrayLike | None = None) -> MechanismPose:
     """Positions of every joint for one platform position ``p`` (and optional branch ``d``)."""
     p = as_xy(p)
     if p.shape != (2,):

@@ -18,6 +18,7 @@ No gravity (horizontal plane), no friction; forces in N, SI throughout.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from tpm_viz.errors import SingularConfigurationError
 from tpm_viz.paper.dynamics import DynamicsResult
@@ -39,7 +40,14 @@ def coordinate_mass_matrix(params: Params) -> np.ndarray:
     return np.array([[mp, 0.0, x, -x], [0.0, mp, 0.0, 0.0], [x, 0.0, ma, 0.0], [-x, 0.0, 0.0, ma]])
 
 
-def _procedure(params: Params, p, dp, ddp, c, f):
+def _procedure(
+    params: Params,
+    p: NDArray[np.float64],
+    dp: NDArray[np.float64],
+    ddp: NDArray[np.float64],
+    c: NDArray[np.float64],
+    f: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], ...]:
     """Steps (b)-(e) on arrays of shape ``(..., 2)``; returns ``(dd, ddd, v, w, lam, tau)``."""
     p2 = p[..., 1]
     dp1, dp2 = dp[..., 0], dp[..., 1]
@@ -75,7 +83,14 @@ def _check_regular(params: Params, p: np.ndarray, c: np.ndarray) -> None:
         raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq="sin(θ1 + θ2) = 0"))
 
 
-def inverse_dynamics_detail(params: Params, p, dp, ddp, f_ext=None, d=None) -> DynamicsResult:
+def inverse_dynamics_detail(
+    params: Params,
+    p: ArrayLike,
+    dp: ArrayLike,
+    ddp: ArrayLike,
+    f_ext: ArrayLike | None = None,
+    d: ArrayLike | None = None,
+) -> DynamicsResult:
     """Steps (a)-(e) with every intermediate (the perpendicular one's :class:`DynamicsResult`).
 
     ``p, dp, ddp`` [m, m/s, m/s²] of shape ``(..., 2)``; ``f_ext`` [N] applied to the platform, broadcastable;
@@ -93,12 +108,19 @@ def inverse_dynamics_detail(params: Params, p, dp, ddp, f_ext=None, d=None) -> D
     return DynamicsResult(p=p, dp=dp, ddp=ddp, d=d, dd=dd, ddd=ddd, v=v, w=w, lam=lam, tau=tau)
 
 
-def inverse_dynamics(params: Params, p, dp, ddp, f_ext=None, d=None) -> np.ndarray:
+def inverse_dynamics(
+    params: Params,
+    p: ArrayLike,
+    dp: ArrayLike,
+    ddp: ArrayLike,
+    f_ext: ArrayLike | None = None,
+    d: ArrayLike | None = None,
+) -> np.ndarray:
     """Actuator forces ``τ`` [N], shape ``(..., 2)``, by the closed form of eq. (P14) (see the module docstring)."""
     return inverse_dynamics_detail(params, p, dp, ddp, f_ext, d).tau
 
 
-def kinetic_energy(params: Params, p, dp, d=None) -> np.ndarray:
+def kinetic_energy(params: Params, p: ArrayLike, dp: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
     """Total kinetic energy ``K = ½ q̇ᵀ M_q q̇`` [J] (eq. P9), ``q̇ = (ṗ, J ṗ)``."""
     p, dp = as_xy(p), as_xy(dp, "dp")
     d = inverse_kinematics(params, p) if d is None else as_xy(d, "d")
@@ -106,7 +128,7 @@ def kinetic_energy(params: Params, p, dp, d=None) -> np.ndarray:
     return 0.5 * np.einsum("...i,ij,...j->...", qd, coordinate_mass_matrix(params), qd)
 
 
-def mass_matrix(params: Params, p, d=None) -> np.ndarray:
+def mass_matrix(params: Params, p: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
     """The platform-space mass matrix ``M(p) = Tᵀ M_q T`` [kg], ``T = [I; J]`` (eq. P15), shape ``(..., 2, 2)``:
     ``K = ½ ṗᵀ M(p) ṗ`` and, at rest, ``τ = J⁻ᵀ (M(p) p̈ - f_ext)``."""
     p = as_xy(p)

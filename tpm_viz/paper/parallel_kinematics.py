@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from tpm_viz.errors import InputError, InvalidParametersError, SingularConfigurationError, UnreachablePoseError
 from tpm_viz.numbers import fixed
@@ -89,7 +90,7 @@ def validate(params: Params) -> Params:
     return params
 
 
-def reachable(params: Params, p) -> np.ndarray:
+def reachable(params: Params, p: ArrayLike) -> np.ndarray:
     """Whether eq. (P3) has a real solution: ``|p_2| < l_a`` and ``p`` finite (bool, shape ``(...)``)."""
     p = np.asarray(p, dtype=float)
     return (np.abs(p[..., 1]) < params.l_a) & np.all(np.isfinite(p), axis=-1)
@@ -102,7 +103,7 @@ def _ik_unchecked(params: Params, p: np.ndarray) -> np.ndarray:
     return np.stack([p[..., 0] + k, -p[..., 0] + k], axis=-1)
 
 
-def inverse_kinematics(params: Params, p) -> np.ndarray:
+def inverse_kinematics(params: Params, p: ArrayLike) -> np.ndarray:
     """Actuator positions ``d`` [m] for platform positions ``p`` [m], eq. (P3) (working mode, legs inwards).
 
     Raises :class:`UnreachablePoseError` if some ``|p_2| >= l_a``. The stroke is not enforced (see ``classify``).
@@ -122,7 +123,7 @@ def inverse_kinematics(params: Params, p) -> np.ndarray:
     return _ik_unchecked(params, p)
 
 
-def leg_components(params: Params, p, d) -> tuple[np.ndarray, np.ndarray]:
+def leg_components(params: Params, p: ArrayLike, d: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """``(c, s)``: ``c_i = l_a cos θ_i`` (inward reach) and ``s_i = p_2 = l_a sin θ_i`` [m], shape ``(..., 2)``."""
     p = np.asarray(p, dtype=float)
     d = np.asarray(d, dtype=float)
@@ -130,7 +131,7 @@ def leg_components(params: Params, p, d) -> tuple[np.ndarray, np.ndarray]:
     return c, np.stack([p[..., 1], p[..., 1]], axis=-1)
 
 
-def leg_angles(params: Params, p, d=None) -> np.ndarray:
+def leg_angles(params: Params, p: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
     """Leg angles ``θ_i`` [rad] from the rail, inwards (``tan θ_i = p_2 / c_i``), on ``d``'s branch."""
     p = as_xy(p)
     d = inverse_kinematics(params, p) if d is None else as_xy(d, "d")
@@ -138,7 +139,7 @@ def leg_angles(params: Params, p, d=None) -> np.ndarray:
     return np.arctan2(s, c)
 
 
-def forward_kinematics_both(params: Params, d) -> FkSolutions:
+def forward_kinematics_both(params: Params, d: ArrayLike) -> FkSolutions:
     """Both platform positions for actuator positions ``d`` [m]: the intersections of two circles of radius
     ``l_a`` about ``C_1 = (d_1 - a + b, 0)`` and ``C_2 = (a - b - d_2, 0)`` (eq. P7).
 
@@ -187,7 +188,7 @@ def _raise_if_missing(params: Params, d: np.ndarray, sol: FkSolutions) -> None:
     )
 
 
-def forward_kinematics(params: Params, d, mode: int = +1) -> np.ndarray:
+def forward_kinematics(params: Params, d: ArrayLike, mode: int = +1) -> np.ndarray:
     """Platform position [m] for actuator positions ``d`` [m] in assembly ``mode`` (+1 upper, -1 lower)."""
     if mode not in (1, -1):
         raise InputError(f"assembly mode must be +1 or -1, got {mode!r}")
@@ -197,7 +198,7 @@ def forward_kinematics(params: Params, d, mode: int = +1) -> np.ndarray:
     return sol.plus if mode == 1 else sol.minus
 
 
-def forward_kinematics_nearest(params: Params, d, p_prev) -> tuple[np.ndarray, int]:
+def forward_kinematics_nearest(params: Params, d: ArrayLike, p_prev: ArrayLike) -> tuple[np.ndarray, int]:
     """The assembly mode nearest a previous platform position: ``(p, mode)`` for one pose."""
     d = as_xy(d, "d")
     sol = forward_kinematics_both(params, d)
@@ -209,7 +210,7 @@ def forward_kinematics_nearest(params: Params, d, p_prev) -> tuple[np.ndarray, i
     return sol.minus, -1
 
 
-def mechanism_pose(params: Params, p, d=None) -> MechanismPose:
+def mechanism_pose(params: Params, p: ArrayLike, d: ArrayLike | None = None) -> MechanismPose:
     """Every joint of one configuration (the perpendicular one's :class:`MechanismPose`); the second link of
     each parallelogram is offset by the pivot spacing along ``+Y`` (perpendicular to both rails)."""
     p = as_xy(p)
@@ -226,14 +227,16 @@ def mechanism_pose(params: Params, p, d=None) -> MechanismPose:
     return MechanismPose(p=p.copy(), d=d.copy(), theta=leg_angles(params, p, d), A=A, B=B, links=links)
 
 
-def _cos_sin(params: Params, p, d):
+def _cos_sin(
+    params: Params, p: ArrayLike, d: ArrayLike | None
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     p = as_xy(p)
     d = inverse_kinematics(params, p) if d is None else as_xy(d, "d")
     c, s = leg_components(params, p, d)
     return p, d, c / params.l_a, s / params.l_a
 
 
-def jacobians(params: Params, p, d=None) -> Jacobians:
+def jacobians(params: Params, p: ArrayLike, d: ArrayLike | None = None) -> Jacobians:
     """``J_x ṗ = J_q ḋ`` (eq. P4): ``J_x = [[cos θ1, sin θ1], [-cos θ2, sin θ2]]``, ``J_q = diag(cos θ_i)``,
     ``J = J_q⁻¹ J_x = [[1, tan θ1], [-1, tan θ2]]`` (working mode: ``[[1, p2/u], [-1, p2/u]]``);
     ``det J_x = sin(θ1 + θ2)`` (direct singularity, working mode ``p_2 = 0``), ``det J_q = cos θ1 cos θ2``
@@ -250,7 +253,7 @@ def jacobians(params: Params, p, d=None) -> Jacobians:
     return Jacobians(jx, jq, j, det_jx, cos[..., 0] * cos[..., 1])
 
 
-def condition_number(params: Params, p, d=None) -> np.ndarray:
+def condition_number(params: Params, p: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
     """2-norm condition number of ``J`` (eq. P4); ``inf`` at a singularity. In the working mode it equals
     ``max(|p_2|/u, u/|p_2|)`` (eq. P6)."""
     j = jacobians(params, p, d).j
@@ -261,7 +264,7 @@ def condition_number(params: Params, p, d=None) -> np.ndarray:
     return np.where(bad | ~np.isfinite(cond), np.inf, cond)
 
 
-def classify(params: Params, p, thresholds: SingularityThresholds = WARN) -> np.ndarray:
+def classify(params: Params, p: ArrayLike, thresholds: SingularityThresholds = WARN) -> np.ndarray:
     """Status per pose (:class:`PoseStatus` values), the most severe wins, with the perpendicular thresholds
     read on the same quantities: ``min_i |cos θ_i|`` (inverse) and ``|det J_x|`` = the sine of the angle between
     the legs (direct; here ``|sin(θ1 + θ2)|``, in the perpendicular arrangement ``|cos(θ1 + θ2)|``)."""
@@ -285,7 +288,7 @@ def _check_regular(jac: Jacobians, which: str) -> None:
         raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq=eq))
 
 
-def actuator_velocity(params: Params, p, dp, d=None) -> np.ndarray:
+def actuator_velocity(params: Params, p: ArrayLike, dp: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
     """``ḋ = J ṗ`` [m/s] (eq. P4)."""
     jac = jacobians(params, p, d)
     _check_regular(jac, "inverse")
@@ -293,7 +296,7 @@ def actuator_velocity(params: Params, p, dp, d=None) -> np.ndarray:
         return finite_result(np.einsum("...ij,...j->...i", jac.j, as_xy(dp, "dp")), T("the actuator velocities"))
 
 
-def platform_velocity(params: Params, p, dd, d=None) -> np.ndarray:
+def platform_velocity(params: Params, p: ArrayLike, dd: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
     """``ṗ = J_x⁻¹ J_q ḋ`` [m/s] (needs ``det J_x != 0``)."""
     jac = jacobians(params, p, d)
     _check_regular(jac, "direct")
@@ -302,7 +305,9 @@ def platform_velocity(params: Params, p, dd, d=None) -> np.ndarray:
         return finite_result(np.linalg.solve(jac.jx, rhs[..., None])[..., 0], T("the platform velocity"))
 
 
-def actuator_acceleration(params: Params, p, dp, ddp, d=None) -> np.ndarray:
+def actuator_acceleration(
+    params: Params, p: ArrayLike, dp: ArrayLike, ddp: ArrayLike, d: ArrayLike | None = None
+) -> np.ndarray:
     """``d̈`` [m/s²] (eq. P5): ``d̈_1 = p̈_1 + (ċ_1² + ṗ_2² + p_2 p̈_2)/c_1``,
     ``d̈_2 = -p̈_1 + (ċ_2² + ṗ_2² + p_2 p̈_2)/c_2`` with ``ċ_i = -p_2 ṗ_2 / c_i``."""
     p, d, cos, _ = _cos_sin(params, p, d)
@@ -317,7 +322,9 @@ def actuator_acceleration(params: Params, p, dp, ddp, d=None) -> np.ndarray:
         return finite_result(sign * ddp[..., 0:1] + num / c, T("the actuator accelerations"))
 
 
-def actuator_forces_from_platform_force(params: Params, p, f, d=None) -> np.ndarray:
+def actuator_forces_from_platform_force(
+    params: Params, p: ArrayLike, f: ArrayLike, d: ArrayLike | None = None
+) -> np.ndarray:
     """``τ = J⁻ᵀ f`` [N] for a platform force ``f`` [N] (eq. P8, the analogue of eq. 13); holding an external load
     ``f_ext`` at rest takes ``f = -f_ext``. Computed as ``J_q J_x⁻ᵀ f``: finite at the inverse singularity, raises
     at the direct one."""
@@ -329,7 +336,9 @@ def actuator_forces_from_platform_force(params: Params, p, f, d=None) -> np.ndar
         return finite_result(np.einsum("...ij,...j->...i", jac.jq, g), T("the actuator forces"))
 
 
-def platform_force_from_actuator_forces(params: Params, p, tau, d=None) -> np.ndarray:
+def platform_force_from_actuator_forces(
+    params: Params, p: ArrayLike, tau: ArrayLike, d: ArrayLike | None = None
+) -> np.ndarray:
     """``f = Jᵀ τ`` [N] for actuator forces ``τ`` [N] (eq. P8)."""
     jac = jacobians(params, p, d)
     _check_regular(jac, "inverse")

@@ -10,6 +10,7 @@ algorithm (O(n)).
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tpm_viz.errors import InputError
 from tpm_viz.words import Phrase
@@ -20,7 +21,7 @@ __all__ = ["CubicSpline"]
 class CubicSpline:
     """Natural cubic spline through ``(t, y)``; ``y`` has shape ``(n, m)``; ``t`` strictly increasing."""
 
-    def __init__(self, t, y) -> None:
+    def __init__(self, t: ArrayLike, y: ArrayLike) -> None:
         t = np.asarray(t, dtype=float)
         y = np.asarray(y, dtype=float)
         if y.ndim == 1:
@@ -72,7 +73,7 @@ class CubicSpline:
         m[1:-1] = inner
         return m
 
-    def __call__(self, tq, nu: int = 0) -> np.ndarray:
+    def __call__(self, tq: ArrayLike, nu: int = 0) -> np.ndarray:
         """Value (``nu=0``), first or second derivative (``nu=1, 2``) at times ``tq``; shape ``(..., m)``."""
         tq = np.asarray(tq, dtype=float)
         k = np.clip(np.searchsorted(self.t, tq, side="right") - 1, 0, self.t.size - 2)

@@ -16,8 +16,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import SupportsFloat
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from tpm_viz.csvio import parse_columns
 from tpm_viz.errors import InputError
@@ -47,6 +49,9 @@ MAX_SAMPLES = 1_000_000
 MAX_CSV_ROWS = 100_000
 """Most data rows in a trajectory CSV (a natural cubic spline through them)."""
 
+State = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+"""``(p, ṗ, p̈)`` [m, m/s, m/s²] (or ``(s, ṡ, s̈)`` of the time law), each shaped like the times given."""
+
 
 @dataclass(frozen=True)
 class Trajectory:
@@ -64,7 +69,7 @@ class Trajectory:
         return float(self.t[-1] - self.t[0])
 
 
-def positive_seconds(value, what: str | Phrase = T("duration")) -> float:
+def positive_seconds(value: str | SupportsFloat, what: str | Phrase = T("duration")) -> float:
     """``value`` as a positive, finite number of seconds, or a one-line :class:`InputError` naming ``what``."""
     try:
         value = float(value)
@@ -92,7 +97,7 @@ def _check_samples(samples: int) -> int:
     return int(samples)
 
 
-def _cubic_law(t, duration: float):
+def _cubic_law(t: ArrayLike, duration: float) -> State:
     """``s, ṡ, s̈`` of ``s(τ) = 3τ² - 2τ³`` at times ``t``; at rest before 0 and after ``T``.
 
     On the closed interval ``[0, T]`` these are the polynomial's values, so ``s̈(0) = 6/T²`` and
@@ -106,7 +111,9 @@ def _cubic_law(t, duration: float):
     return s, ds, dds
 
 
-def line_state(t, duration: float = DEFAULT_DURATIONS["line"], start=LINE_START, end=LINE_END):
+def line_state(
+    t: ArrayLike, duration: float = DEFAULT_DURATIONS["line"], start: ArrayLike = LINE_START, end: ArrayLike = LINE_END
+) -> State:
     """``(p, ṗ, p̈)`` on the straight line at times ``t`` [s]; each of shape ``t.shape + (2,)``."""
     duration = positive_seconds(duration)
     s, ds, dds = _cubic_law(t, duration)
@@ -114,7 +121,12 @@ def line_state(t, duration: float = DEFAULT_DURATIONS["line"], start=LINE_START,
     return start + s[..., None] * delta, ds[..., None] * delta, dds[..., None] * delta
 
 
-def circle_state(t, duration: float = DEFAULT_DURATIONS["circle"], centre=CIRCLE_CENTRE, radius=CIRCLE_RADIUS):
+def circle_state(
+    t: ArrayLike,
+    duration: float = DEFAULT_DURATIONS["circle"],
+    centre: ArrayLike = CIRCLE_CENTRE,
+    radius: float = CIRCLE_RADIUS,
+) -> State:
     """``(p, ṗ, p̈)`` on the circle at times ``t`` [s] (polar angle ``φ = 2π s(t/T)``)."""
     duration = positive_seconds(duration)
     s, ds, dds = _cubic_law(t, duration)
@@ -136,7 +148,7 @@ def paper_trajectory(kind: str, duration: float | None = None, samples: int = 20
     return Trajectory(kind, t, p, dp, ddp)
 
 
-def trajectory_from_samples(t, p, name: str = "custom") -> Trajectory:
+def trajectory_from_samples(t: ArrayLike, p: ArrayLike, name: str = "custom") -> Trajectory:
     """A trajectory through timed samples, derivatives from the natural cubic spline.
 
     ``t`` [s] shape ``(n,)`` strictly increasing, ``p`` [m] shape ``(n, 2)``, ``n >= 4``.
