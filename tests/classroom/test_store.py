@@ -21,7 +21,7 @@ from tpm_viz.classroom.records import Records
 from tpm_viz.classroom.store import Copy, Limits, SqliteStore, open_store
 from tpm_viz.paper.trajectories import Trajectory
 from tpm_viz.params import Params
-from tpm_viz.ui.continuity import Store
+from tpm_viz.ui.continuity import lecture_store as Store
 
 OLD = Path(__file__).resolve().parents[1] / "fixtures" / "session-v1.json"
 """A session file written by tpm-viz before the store (a real server: lecture with an uploaded CSV and lesson step
@@ -43,6 +43,7 @@ def test_a_blob_is_kept_once_under_its_sha256(tmp_path):
     assert sqlite3.connect(tmp_path / "s.sqlite3").execute("SELECT COUNT(*) FROM blobs").fetchone()[0] == 1
 
 
+@pytest.mark.slow
 def test_nine_students_with_one_upload_keep_it_once_and_everything_reads_back(tmp_path):
     store = SqliteStore(tmp_path / "s.sqlite3")
     records, source = Records(store), _csv(20_000)

@@ -4,17 +4,23 @@ without saving: 4 of 16 fresh servers)."""
 
 from __future__ import annotations
 
-import json
 import os
 import signal
 
+import pytest
+
 from tests.support.protocol import ServerProcess
+from tpm_viz.classroom.identity import Keys
+from tpm_viz.classroom.lecture import LectureStore
+
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
 
 def test_a_stop_right_after_the_url_line_saves_the_session(tmp_path):
     for k in range(4):
-        session = tmp_path / f"session-{k}.json"
+        session = tmp_path / f"session-{k}.sqlite3"
         server = ServerProcess(session=session)
         os.kill(server.pid, signal.SIGTERM)
         assert server.proc.wait(timeout=30) == 0
-        assert "shared" in json.loads(session.read_text())  # the shared mechanism, written by the stop
+        lecture, _ = LectureStore(session, Keys()).load()
+        assert lecture is not None  # the shared mechanism, written by the stop

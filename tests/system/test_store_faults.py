@@ -23,7 +23,9 @@ from tests.support.stores import page_cookie, stored_tabs
 from tests.support.storm import storm
 from tpm_viz.ui.app import TpmApp, build_server
 from tpm_viz.ui.classroom import Classroom
-from tpm_viz.ui.continuity import Store
+from tpm_viz.ui.continuity import lecture_store as Store
+
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
 __all__ = ["classroom_app"]  # the fixture, imported
 

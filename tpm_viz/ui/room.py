@@ -19,7 +19,7 @@ from tpm_viz.classroom.away import Away
 from tpm_viz.errors import TpmVizError
 from tpm_viz.ui._viser import connection_request
 from tpm_viz.ui.classroom import Classroom, identity, student_urls
-from tpm_viz.ui.continuity import Store, reload, restore, saved_of
+from tpm_viz.ui.continuity import LectureStore, lecture_store, reload, restore, saved_of
 from tpm_viz.ui.guard import guarded, log
 from tpm_viz.ui.lecturer import LecturerPanel
 
@@ -36,10 +36,10 @@ class Room:
     """Classroom mode, continuity and persistence of one app (``app``: its ``server``, ``hub``, ``access``,
     ``services``, ``views``)."""
 
-    def __init__(self, app: Any, classroom: Classroom | None = None, store: Store | None = None) -> None:
+    def __init__(self, app: Any, classroom: Classroom | None = None, store: LectureStore | None = None) -> None:
         self.app = app
         self.classroom = classroom
-        self.store = store if store is not None else Store(None)
+        self.store = store if store is not None else lecture_store(None)
         self.away = Away()
         self.lesson_step = 0
         self.urls: list[str] | None = None
