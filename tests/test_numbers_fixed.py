@@ -11,6 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.support.hypo import examples
 from tpm_viz.numbers import DASH, fixed
 
 FIXED_POINT = [".0f", ".1f", ".2f", ".3f", ".4f", "+.1f", "+.2f", "+.3f", ",.1f", "+,.2f", ">9.2f", "<7.1f", ".1%"]
@@ -32,7 +33,7 @@ def test_tiny_negatives_show_as_zero_without_a_sign(x, fmt):
     assert text == format(0.0, fmt)  # what zero looks like in that format (a + sign where the format asks one)
 
 
-@settings(max_examples=500, deadline=None, derandomize=True)
+@settings(max_examples=examples(500), deadline=None, derandomize=True)
 @given(st.floats(allow_nan=False, allow_infinity=False, min_value=-1e15, max_value=1e15), st.sampled_from(ANY_FORMAT))
 def test_never_a_negative_zero_and_otherwise_the_plain_format(x, fmt):
     text = fixed(x, fmt)

@@ -14,6 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tests.support.fake_viser import FakeApi
+from tests.support.hypo import examples
 from tpm_viz.app.overlays import arrow_length, arrow_reach, arrow_vector
 from tpm_viz.app.palette import PALETTE
 from tpm_viz.app.readouts import Load, evaluate
@@ -25,7 +26,7 @@ from tpm_viz.ui.snapshot import Snapshot
 P = Params.paper()
 REACH = 0.15 * (0.482 + 0.260)  # m: 0.15 (a + l_a) of the paper's prototype
 SLOPE = REACH / 50.0  # m/N for small forces (2.2 mm per newton)
-SETTINGS = settings(max_examples=300, deadline=None, derandomize=True)
+SETTINGS = settings(max_examples=examples(300), deadline=None, derandomize=True)
 FORCE = st.floats(1e-3, 1e12)
 
 

@@ -129,6 +129,7 @@ def test_a_point_hiding_the_others_keeps_the_camera_at_the_near_distance():
     np.testing.assert_allclose(uv, 0.5, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_a_camera_moved_closer_loses_a_point_whatever_its_sideways_shift():
     """The closest camera: 2 % closer along the view, no sideways shift (searched on a fine grid) keeps every
     point in the free region."""

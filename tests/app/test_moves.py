@@ -7,6 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.support.hypo import examples
 from tpm_viz import InputError, Params, forward_kinematics_both, inverse_kinematics
 from tpm_viz.app.moves import (
     Pose,
@@ -109,7 +110,7 @@ def test_drag_slides_along_a_boundary():
     _assert_valid(P, move.pose)
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(st.floats(-1.0, 1.0), st.floats(-1.0, 1.0), st.floats(-0.1, 0.1), st.floats(-0.1, 0.1))
 def test_any_drag_ends_valid_and_never_jumps(x, y, x0, y0):
     start = drag_to(P, HOME, (x0, y0)).pose

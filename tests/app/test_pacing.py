@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.support.hypo import examples
 from tpm_viz.app.pacing import WATCH_INTERVAL, WATCH_TABS, Pacer, watch_phase, watch_slot
 
 
@@ -40,7 +41,7 @@ def test_a_light_class_is_never_paced():
     assert loads[-1] == pytest.approx(5 * 20 * 0.002, rel=0.1)
 
 
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=examples(25), deadline=None)
 @given(students=st.integers(10, 60), cost=st.floats(0.001, 0.004))
 def test_an_overloaded_class_settles_at_the_budget(students, cost):
     demand = students * 20 * cost

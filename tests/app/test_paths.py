@@ -11,6 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import tpm_viz as tv
+from tests.support.hypo import examples
 from tpm_viz.app import paths
 from tpm_viz.errors import InputError
 from tpm_viz.paper.status import MOVE_LIMITS, PoseStatus
@@ -145,7 +146,7 @@ def test_bad_kinds_and_sizes_are_refused():
         paths.path_for(P, "waypoints")
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 @given(
     pts=st.lists(st.tuples(st.floats(-0.1, 0.1), st.floats(-0.1, 0.1)), min_size=2, max_size=7),
     radius=st.floats(0.001, 0.05),

@@ -16,6 +16,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import tpm_viz as tv
+from tests.support.hypo import examples
 from tests.support.strategies import params_sets
 from tpm_viz.app import paths, planner
 from tpm_viz.errors import InputError
@@ -199,7 +200,7 @@ def test_bad_grids_are_refused(grid):
         planner.plan_path(P, paths.line_path(), planner.Limits(F_MAX), grid=grid)
 
 
-@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=examples(12), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(params=params_sets(), force=st.floats(5.0, 2000.0), seed=st.integers(0, 2**16))
 def test_random_parameters_default_pick_within_the_limit(params, force, seed):
     try:

@@ -10,6 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import tpm_viz as tv
+from tests.support.hypo import examples
 from tpm_viz.app import paths, planner
 from tpm_viz.app.sizing import SIZING_COLUMNS, format_sizing, size_motion, size_trajectory, sizing_columns
 from tpm_viz.errors import InputError
@@ -37,7 +38,7 @@ def trapezoid(m: float, acc: float, v: float, cruise: float, k: int = 7):
     return t, tau, dd, ta
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(
     m=st.floats(0.1, 20.0),
     acc=st.floats(0.5, 50.0),

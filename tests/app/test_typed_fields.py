@@ -14,6 +14,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.support.hypo import examples
 from tpm_viz.app.typed import (
     QUIET,
     Quantity,
@@ -68,7 +69,7 @@ def test_range_messages_say_what_to_type():
         Quantity("f", "N", hi=1e5).read("2e6")
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300), deadline=None)
 @given(
     st.floats(allow_nan=False, allow_infinity=False, min_value=-1e12, max_value=1e12),
     st.sampled_from([1.0, 1e-3]),
@@ -145,7 +146,7 @@ NUMBERS = st.one_of(
 )
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(
     NUMBERS,
     st.lists(st.floats(min_value=0.02, max_value=QUIET * 0.95), min_size=1, max_size=6),
@@ -173,7 +174,7 @@ def test_no_prefix_is_ever_applied_and_the_settled_text_is_applied_once(text, ga
     assert group.lines(last + 10 * QUIET) == []  # nothing to say
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 @given(
     st.text(alphabet="abx,.-e ", min_size=1, max_size=6).filter(lambda t: t.strip() not in ("",)),
     st.floats(min_value=-100, max_value=100, allow_nan=False),

@@ -14,6 +14,8 @@ from tpm_viz.app.overlays import MAP_KINDS
 from tpm_viz.app.paths import path_for
 from tpm_viz.app.planner import Limits, plan_cycle
 
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
+
 FLOODERS = 10
 PRESSES = 4  # per flooder: control lab presses and force-slider moves
 

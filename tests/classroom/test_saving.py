@@ -100,6 +100,7 @@ def test_a_full_disk_is_said_once_retried_with_back_off_and_the_recovery_said_on
     assert shared.state.params.l_a == pytest.approx(0.2 + 1e-4 * last)  # what failed was saved once it could be
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", range(6))
 def test_sigkill_during_saves_leaves_a_readable_store_with_the_last_acknowledged_save(tmp_path, seed):
     proc = _writer(tmp_path, "kill")

@@ -66,6 +66,7 @@ def test_trajectory_samples_the_cubic_line(tmp_path):
     assert {"d1", "dd1", "ddd1", "tau1", "tau2", "theta1", "det_jx", "cond"} <= set(r[0])
 
 
+@pytest.mark.slow
 def test_trajectory_from_a_users_csv_matches_the_paper_circle(tmp_path):
     """Timed positions of the paper's circle in, spline derivatives and forces out (vs the exact trajectory)."""
     t = np.linspace(0, 0.5, 401)

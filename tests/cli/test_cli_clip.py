@@ -19,6 +19,8 @@ from PIL import Image
 
 from tpm_viz.cli import main
 
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 README_CLIP = [
     "clip", "--trajectory", "circle", "--samples", "101", "--fps", "20", "--size", "640x360",

@@ -22,6 +22,8 @@ from tpm_viz.cli.serve import check_bind
 from tpm_viz.csvio import MAX_BYTES, MAX_ROWS
 from tpm_viz.errors import InputError
 
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
+
 POSES = "p1,p2\n0.05,-0.02\n0,0\n"
 
 

@@ -16,6 +16,8 @@ import tpm_viz as tv
 from tests.support.cli import parser_for
 from tpm_viz.cli import multibody as cli_multibody
 
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
+
 P = tv.Params.paper()
 
 

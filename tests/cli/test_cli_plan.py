@@ -175,6 +175,7 @@ def _registered() -> bool:
     return True
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not _registered(), reason="tpm_viz.cli does not register plan/size yet")
 def test_end_to_end_through_tpm_viz_main(tmp_path):
     ok = subprocess.run(

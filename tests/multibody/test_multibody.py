@@ -20,6 +20,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 import tpm_viz as tv
+from tests.support.hypo import examples
 from tests.support.reference import rod_kinetic_energy
 from tests.support.strategies import params_sets, regular_states
 from tpm_viz import multibody
@@ -71,7 +72,7 @@ def test_constraint_jacobian_matches_finite_differences_and_has_rank_five():
 
 
 # ----------------------------------------------------------------------------- kinematics
-@settings(max_examples=100, deadline=None, derandomize=True)
+@settings(max_examples=examples(100), deadline=None, derandomize=True)
 @given(params=params_sets(), u=st.floats(-0.97, 0.97), w=st.floats(-0.97, 0.97))
 def test_configuration_matches_closed_form_inverse_kinematics(params, u, w):
     model = multibody.model_for(params)
@@ -117,7 +118,7 @@ def test_configuration_on_the_other_branch_follows_the_given_actuators():
     assert np.cos(q[MB.index["link1_0"]]) < 0
 
 
-@settings(max_examples=80, deadline=None, derandomize=True)
+@settings(max_examples=examples(80), deadline=None, derandomize=True)
 @given(params=params_sets(), u=st.floats(-0.9, 0.9), w=st.floats(-0.9, 0.9), mode=st.sampled_from([1, -1]))
 def test_configuration_from_actuators_matches_both_closed_form_assembly_modes(params, u, w, mode):
     d = tv.inverse_kinematics(params, np.array([u, w]) * params.l_a)
@@ -149,7 +150,7 @@ def test_placements_match_the_closed_form_mechanism_pose():
 
 
 # ----------------------------------------------------------------------------- inverse dynamics
-@settings(max_examples=200, deadline=None, derandomize=True)
+@settings(max_examples=examples(200), deadline=None, derandomize=True)
 @given(params=params_sets(), data=st.data(), f=st.tuples(st.floats(-50, 50), st.floats(-50, 50)))
 def test_inverse_dynamics_matches_the_paper_closed_form(params, data, f):
     p, dp, ddp = data.draw(regular_states(params))
@@ -271,7 +272,7 @@ def test_projection_restores_the_closures_and_admissible_velocity():
 ANY = st.floats(allow_nan=True, allow_infinity=True) | st.floats(-0.3, 0.3) | st.sampled_from([1e300, -0.26, 0.2599])
 
 
-@settings(max_examples=300, deadline=None, derandomize=True)
+@settings(max_examples=examples(300), deadline=None, derandomize=True)
 @given(p=st.tuples(ANY, ANY), dp=st.tuples(ANY, ANY), ddp=st.tuples(ANY, ANY), mode=st.sampled_from([1, -1]))
 def test_arbitrary_numbers_give_finite_results_or_one_line_errors(p, dp, ddp, mode):
     for call in (

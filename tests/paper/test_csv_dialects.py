@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.support.hypo import examples
 from tpm_viz.csvio import decode_text, format_columns, parse_columns, parse_lines, time_unit_note
 from tpm_viz.errors import InputError
 from tpm_viz.paper.trajectories import parse_trajectory_csv
@@ -135,7 +136,7 @@ CELLS = st.sampled_from(["t", "p1", "p2", "t [ms]", "p1 (mm)", '"0,5"', "1e3", "
 SEPS = st.sampled_from([",", ";", "\t", "\r\n", "\n", "\r", '"', "sep=;\n", "\ufeff"])
 
 
-@settings(max_examples=400, deadline=None)
+@settings(max_examples=examples(400), deadline=None)
 @given(st.lists(st.one_of(CELLS, SEPS, st.text(max_size=6)), max_size=40))
 def test_any_text_is_read_or_refused_in_one_line(parts):
     try:

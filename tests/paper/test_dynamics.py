@@ -12,6 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.support.hypo import examples
 from tests.support.reference import minimal_coordinate_forces, rod_kinetic_energy
 from tests.support.strategies import params_sets, regular_states
 from tpm_viz import (
@@ -29,7 +30,7 @@ from tpm_viz import (
 P = Params.paper()
 
 
-@settings(max_examples=80, deadline=None, derandomize=True)
+@settings(max_examples=examples(80), deadline=None, derandomize=True)
 @given(params=params_sets(), data=st.data(), f=st.tuples(st.floats(-50, 50), st.floats(-50, 50)))
 def test_matches_minimal_coordinate_lagrangian(params, data, f):
     p, dp, ddp = data.draw(regular_states(params))
@@ -68,7 +69,7 @@ def test_static_case_is_eq13_with_the_load_sign():
     assert tau == pytest.approx(actuator_forces_from_platform_force(P, p, -f), rel=1e-12)
 
 
-@settings(max_examples=60, deadline=None, derandomize=True)
+@settings(max_examples=examples(60), deadline=None, derandomize=True)
 @given(params=params_sets(), data=st.data())
 def test_kinetic_energy_eq22_corrected_matches_rigid_bodies(params, data):
     p, dp, _ = data.draw(regular_states(params))
@@ -96,7 +97,7 @@ def test_vectorised_equals_pointwise():
     assert inverse_dynamics(P, p, dp, 0 * dp).shape == (7, 1, 2)
 
 
-@settings(max_examples=200, deadline=None, derandomize=True)
+@settings(max_examples=examples(200), deadline=None, derandomize=True)
 @given(params=params_sets(), data=st.data(), branch=st.tuples(st.sampled_from([1, -1]), st.sampled_from([1, -1])))
 def test_the_one_state_fast_path_equals_the_vectorised_path_on_every_branch(params, data, branch):
     """One state (shape (2,)) takes the scalar fast path, a batch of one (shape (1, 2)) the vectorised one: same τ,

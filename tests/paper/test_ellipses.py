@@ -7,13 +7,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.support.hypo import examples
 from tests.support.strategies import params_sets, regular_states
 from tpm_viz import Params, SingularConfigurationError
 from tpm_viz.paper.ellipses import ellipse_outline, manipulability_ellipses
 from tpm_viz.paper.jacobians import jacobians
 
 
-@settings(max_examples=100, deadline=None, derandomize=True)
+@settings(max_examples=examples(100), deadline=None, derandomize=True)
 @given(params=params_sets(), data=st.data())
 def test_outlines_satisfy_the_definitions(params, data):
     p, _, _ = data.draw(regular_states(params))

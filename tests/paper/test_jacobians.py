@@ -13,6 +13,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.support.hypo import examples
 from tests.support.reference import ik_quadratic, jacobian_fd
 from tests.support.strategies import params_sets, regular_states
 from tpm_viz import (
@@ -34,7 +35,7 @@ from tpm_viz.paper.jacobians import jacobians
 P = Params.paper()
 
 
-@settings(max_examples=150, deadline=None, derandomize=True)
+@settings(max_examples=examples(150), deadline=None, derandomize=True)
 @given(params=params_sets(), data=st.data())
 def test_jacobian_matches_finite_differences_of_eq3(params, data):
     p, dp, _ = data.draw(regular_states(params))
@@ -54,7 +55,7 @@ def _fd_acceleration(params, p, dp, ddp, h=1e-4):
     return (d[0] - 2 * d[1] + d[2]) / h**2
 
 
-@settings(max_examples=150, deadline=None, derandomize=True)
+@settings(max_examples=examples(150), deadline=None, derandomize=True)
 @given(params=params_sets(), data=st.data())
 def test_acceleration_eq14_with_corrected_eq15_matches_finite_differences(params, data):
     p, dp, ddp = data.draw(regular_states(params))
@@ -90,7 +91,7 @@ def test_erratum_eq15_sign_of_jq_dot():
     assert np.max(np.abs(printed - fd)) > 0.5  # m/s², far beyond FD error (~1e-6)
 
 
-@settings(max_examples=150, deadline=None, derandomize=True)
+@settings(max_examples=examples(150), deadline=None, derandomize=True)
 @given(params=params_sets(), data=st.data(), f=st.tuples(st.floats(-500, 500), st.floats(-500, 500)))
 def test_statics_eq13_satisfies_virtual_work(params, data, f):
     """τ·δd = f·δp for every admissible virtual displacement (δd = J δp from FD of eq. 3)."""

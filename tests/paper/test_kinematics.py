@@ -9,6 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.support.hypo import examples
 from tests.support.reference import ik_quadratic
 from tests.support.strategies import params_sets, regular_states
 from tpm_viz import (
@@ -35,7 +36,7 @@ def test_home_pose_by_hand():
     assert leg_angles(P, [0.0, 0.0]) == pytest.approx([0.0, 0.0], abs=1e-15)
 
 
-@settings(max_examples=200, deadline=None, derandomize=True)
+@settings(max_examples=examples(200), deadline=None, derandomize=True)
 @given(params=params_sets(), data=st.data())
 def test_ik_matches_eq3_negative_root_and_closes_the_loop(params, data):
     p, _, _ = data.draw(regular_states(params, margin=0.05))
@@ -53,7 +54,7 @@ def test_ik_matches_eq3_negative_root_and_closes_the_loop(params, data):
     assert math.sin(pose.theta[1]) == pytest.approx(p[0] / params.l_a, abs=1e-12)
 
 
-@settings(max_examples=200, deadline=None, derandomize=True)
+@settings(max_examples=examples(200), deadline=None, derandomize=True)
 @given(params=params_sets(), data=st.data())
 def test_fk_of_ik_round_trip_in_the_plus_mode(params, data):
     p, _, _ = data.draw(regular_states(params, margin=0.05))

@@ -8,11 +8,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.support.hypo import examples
 from tpm_viz.errors import InputError
 from tpm_viz.numbers import MAX_TEXT, parse_number, plausibility_note
 
 finite = st.floats(allow_nan=False, allow_infinity=False)
-BOUNDED = settings(max_examples=300, deadline=None)
+BOUNDED = settings(max_examples=examples(300), deadline=None)
 
 
 def same(a: float, b: float) -> bool:

@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.support.hypo import examples
 from tpm_viz import InvalidParametersError, Params, in_stroke, inverse_kinematics
 
 
@@ -76,7 +77,7 @@ def _has_valid_pose(params: Params, n: int = 401) -> bool:
     return bool(np.any(in_stroke(params, inverse_kinematics(params, grid))))
 
 
-@settings(max_examples=60, deadline=None, derandomize=True)
+@settings(max_examples=examples(60), deadline=None, derandomize=True)
 @given(k=st.floats(-0.6, 0.8), stroke=st.floats(0.01, 0.5))
 def test_workspace_rule_matches_a_grid_search(k, stroke):
     """The constructor accepts a geometry iff a grid search finds a reachable pose inside the stroke."""

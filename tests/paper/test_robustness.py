@@ -12,6 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import tpm_viz as tv
+from tests.support.hypo import examples
 
 ANY = (
     st.floats(allow_nan=True, allow_infinity=True, width=64)
@@ -19,7 +20,9 @@ ANY = (
     | st.sampled_from([0.0, -0.0, 1e-300, -1e-300, 1e300, 0.26, -0.26, 0.2599999999999])
 )
 VEC = st.tuples(ANY, ANY)
-SETTINGS = settings(max_examples=3400, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+SETTINGS = settings(
+    max_examples=examples(3400), deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow]
+)
 P = tv.Params.paper()
 
 

@@ -7,6 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.support.hypo import examples
 from tpm_viz import (
     InputError,
     circle_state,
@@ -28,7 +29,7 @@ def test_endpoints_and_rest_at_both_ends(kind):
     assert traj.duration == pytest.approx({"line": 0.2, "circle": 0.5}[kind])
 
 
-@settings(max_examples=40, deadline=None, derandomize=True)
+@settings(max_examples=examples(40), deadline=None, derandomize=True)
 @given(kind=st.sampled_from(["line", "circle"]), duration=st.floats(0.05, 5.0), t=st.floats(0.01, 0.99))
 def test_analytic_derivatives_match_finite_differences(kind, duration, t):
     state = line_state if kind == "line" else circle_state

@@ -34,6 +34,8 @@ from tpm_viz.ui.app import TpmApp, build_server
 from tpm_viz.ui.guard import ACTIVITY, Faults
 from tpm_viz.ui.limits import Gate, guard_of
 
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
+
 UPLOAD_LABEL = "Upload CSV (t, p1, p2 in s, m)"
 
 

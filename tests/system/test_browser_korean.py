@@ -47,6 +47,7 @@ def test_this_machine_has_a_font_with_hangul():
     assert fonts.strip(), "no font with Hangul: apt-get install -y fonts-nanum (else Chromium draws boxes)"
 
 
+@pytest.mark.browser
 @pytest.mark.parametrize(("width", "height"), [(1024, 768), (390, 844)])
 def test_a_korean_tab_fits_its_panel(app, width, height):
     if not os.path.exists(CHROMIUM):

@@ -15,12 +15,15 @@ import pytest
 from websockets.exceptions import InvalidStatus
 
 import tpm_viz.ui.app as app_module
+from tests.support.browser import text_input
 from tests.support.pages import ADDRESSES, TOKEN, Page, classroom_app, views_of
 from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz import InputError
 from tpm_viz.app.access import MAX_FAILURES, MAX_FAILURES_SERVER, Access
 from tpm_viz.ui.app import TpmApp, build_server
 from tpm_viz.ui.classroom import same_origin
+
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
 __all__ = ["classroom_app"]  # the fixture, imported
 
@@ -217,7 +220,7 @@ def test_the_token_field_shows_dots_not_the_token(browser):
         field.fill("typed-secret")
         security = field.evaluate("e => getComputedStyle(e).webkitTextSecurity")
         assert security == "disc"
-        other = page.locator(f'div:has(> div > p > label[for="{view.panel.p.inputs["p1"]._impl.uuid}"]) input')
+        other = text_input(page, view.panel.p.inputs["p1"])  # a typed number: a textarea drawn as one line
         assert other.evaluate("e => getComputedStyle(e).webkitTextSecurity") == "none"
         page.close()
     finally:

@@ -26,7 +26,8 @@ from tpm_viz.app.sessions import Document, Saved
 from tpm_viz.app.state import AppState
 from tpm_viz.paper.trajectories import Trajectory
 from tpm_viz.params import Params
-from tpm_viz.ui.continuity import SAVE_SECONDS, Store
+from tpm_viz.ui.continuity import SAVE_SECONDS
+from tpm_viz.ui.continuity import lecture_store as Store
 from tpm_viz.ui.teaching.playing import sampled
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out

@@ -20,6 +20,8 @@ from tpm_viz import Params
 from tpm_viz.app import transitions
 from tpm_viz.ui.guard import ACTIVITY, guarded
 
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
+
 P = Params.paper()
 
 

@@ -3,12 +3,18 @@ one door; no module over 400 lines. The rules are per folder (a new module obeys
 
 Layers, bottom up (a module may import its own layer and the layers its rule lists, never one above):
 
-- base (``errors``, ``params``, ``csvio``, ``csvdialect``, ``numbers``, ``words``): the standard library and numpy;
+- base (``errors``, ``params``, ``csvio``, ``csvdialect``, ``numbers``, ``words``, ``files``): the standard library and
+  numpy;
 - ``paper/``: the paper's maths, numpy only;
-- drawing (``meshes``, ``figures``): trimesh / matplotlib over the paper's maths;
+- drawing (``meshes``, ``meshes_parallel``, ``figures``, ``clips``, ``videos``): trimesh / matplotlib / Pillow /
+  PyAV over the paper's maths;
+- ``reports/``: documents of a run (the lab report) from the app's runs and the drawing layer;
 - ``exchange/``: model files written from the parameters (no simulator imported);
 - ``multibody/``: the only place that imports pinocchio;
 - ``app/``: pure app behaviour, no viser, no pinocchio;
+- ``classroom/``: the classroom's store, identities, saving and jobs: the standard library, base, paper, app and
+  platformdirs (no viser);
+- ``cluster`` (``tpm_viz/cluster.py``): the only place that imports Dask (the optional extra ``.[cluster]``);
 - ``ui/``: the only place that imports viser; its private names only in ``ui/_viser.py``;
 - ``cli/``: may import every layer; nothing imports it but ``__main__``.
 """
@@ -16,6 +22,7 @@ Layers, bottom up (a module may import its own layer and the layers its rule lis
 from __future__ import annotations
 
 import ast
+import functools
 import pathlib
 import re
 import subprocess
@@ -26,22 +33,28 @@ import pytest
 PACKAGE = pathlib.Path(__file__).resolve().parents[2] / "tpm_viz"
 STDLIB = set(sys.stdlib_module_names) | {"__future__"}
 
-BASE = {"errors", "params", "csvio", "csvdialect", "numbers", "words"}
-DRAWING = {"meshes", "figures"}
+BASE = {"errors", "params", "csvio", "csvdialect", "numbers", "words", "files"}
+DRAWING = {"meshes", "figures", "clips", "videos", "meshes_parallel"}
 
 # layer -> (tpm_viz layers it may import, third-party packages it may import)
 RULES: dict[str, tuple[set[str], set[str]]] = {
     "base": ({"base"}, {"numpy"}),
     "paper": ({"base", "paper"}, {"numpy"}),
-    "drawing": ({"base", "paper", "drawing"}, {"numpy", "trimesh", "matplotlib"}),
+    "drawing": ({"base", "paper", "drawing"}, {"numpy", "trimesh", "matplotlib", "PIL", "av"}),
+    "reports": ({"base", "paper", "drawing", "app", "reports"}, {"numpy"}),
     "exchange": ({"base", "paper", "exchange"}, {"numpy"}),
     "multibody": ({"base", "paper", "multibody"}, {"numpy", "pinocchio"}),
-    "app": ({"base", "paper", "app"}, {"numpy", "toppra"}),
+    "app": ({"base", "paper", "app"}, {"numpy", "toppra", "scipy"}),
+    "classroom": ({"base", "paper", "app", "classroom"}, {"platformdirs"}),
+    "cluster": ({"base", "paper", "app", "cluster"}, {"numpy", "distributed", "dask"}),  # tpm_viz/cluster.py
     "ui": (
-        {"base", "paper", "drawing", "multibody", "app", "ui"},
+        {"base", "paper", "drawing", "multibody", "app", "reports", "classroom", "ui"},
         {"numpy", "trimesh", "viser", "platformdirs", "segno"},
     ),
-    "cli": ({"base", "paper", "drawing", "exchange", "multibody", "app", "ui", "cli"}, {"numpy"}),
+    "cli": (
+        {"base", "paper", "drawing", "exchange", "multibody", "app", "reports", "classroom", "ui", "cluster", "cli"},
+        {"numpy"},
+    ),
     "api": ({"base", "paper"}, set()),  # tpm_viz/__init__.py: the public API
     "main": ({"cli"}, set()),  # tpm_viz/__main__.py
 }
@@ -62,8 +75,9 @@ def layer_of(module: str) -> str:
     return head
 
 
+@functools.cache
 def modules() -> dict[str, pathlib.Path]:
-    """Every module of the package, by dotted name."""
+    """Every module of the package, by dotted name (read once: the tests never change the tree)."""
     found = {}
     for path in sorted(PACKAGE.rglob("*.py")):
         parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
@@ -72,8 +86,9 @@ def modules() -> dict[str, pathlib.Path]:
     return found
 
 
+@functools.cache
 def imports(path: pathlib.Path, module: str) -> list[tuple[str, bool]]:
-    """``(imported module, at module level)`` for every import statement of ``path``."""
+    """``(imported module, at module level)`` for every import statement of ``path`` (parsed once)."""
     tree = ast.parse(path.read_text())
     top = {id(node) for node in tree.body}
     package = module if path.name == "__init__.py" else module.rsplit(".", 1)[0]

@@ -28,9 +28,12 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from tests.support.fake_viser import assert_clean
+from tests.support.hypo import examples
 from tests.support.protocol import ProtocolClient, wait_for
 from tests.ui.test_reliability_app import CSV_TEXT, GOOD_ROWS, NASTY_FLOAT, _timed, assert_valid
 from tpm_viz.ui.guard import ACTIVITY
+
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
 INT64 = st.integers(-(2**62), 2**62)
 NASTY_VALUES = [
@@ -271,7 +274,7 @@ def test_generated_protocol_messages_never_break_the_app(two_tabs):
     errors_before = ACTIVITY.snapshot()[1]
 
     @settings(
-        max_examples=300,
+        max_examples=examples(300),
         deadline=None,
         derandomize=True,
         suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],

@@ -18,9 +18,13 @@ import threading
 import time
 from pathlib import Path
 
+import pytest
+
 from tests.support.protocol import ProtocolClient, wait_for
 from tests.ui.test_reliability_app import assert_valid
 from tpm_viz.ui.guard import ACTIVITY
+
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
 WARM_UP, CYCLES, BATCH = 30, 240, 4
 MAX_GROWTH_MB = 20.0

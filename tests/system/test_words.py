@@ -34,6 +34,8 @@ from tests.support.protocol import CAMERA, decode_batch
 from tpm_viz.app.lessons import DEMOS
 from tpm_viz.words import Lang, Phrase, catalogue, fields_of
 
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
+
 __all__ = ["classroom_app"]  # the fixture, imported
 
 ROOT = Path(__file__).resolve().parents[2]

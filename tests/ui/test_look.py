@@ -12,7 +12,7 @@ import pytest
 import viser
 import viser.transforms as tf
 
-from tests.support.protocol import CAMERA, wait_for
+from tests.support.protocol import CAMERA, ProtocolClient, wait_for
 from tpm_viz import meshes
 
 
@@ -135,3 +135,47 @@ def test_presentation_mode_styles_this_tabs_lines_and_labels_only(connect):
     wait_for(lambda: view.scene.private is None, what="back to the shared mechanism")
     assert view.scene._styled == {}
     wait_for(lambda: client.shadows() == set(), what="nothing over the shared drawing in this tab")
+
+
+class _Page(ProtocolClient):
+    """A page whose canvas was resized by the panel without telling the server (viser's page reports a resize with
+    the drawing buffer's old size): it answers a field-of-view write with its camera at the canvas's real size."""
+
+    def __init__(self, port: int) -> None:
+        self.canvas = (1280, 720)
+        self.fov_writes = 0
+        self.pose = {"position": CAMERA["position"], "look_at": CAMERA["look_at"]}
+        super().__init__(port)
+
+    def take(self, m: dict, now: float) -> None:
+        super().take(m, now)
+        kind = m.get("type")
+        if kind == "SetCameraPositionMessage" and not m.get("initial", False):
+            self.pose = {**self.pose, "position": tuple(m["position"])}
+        elif kind == "SetCameraLookAtMessage" and not m.get("initial", False):
+            self.pose = {**self.pose, "look_at": tuple(m["look_at"])}
+        elif kind == "SetCameraFovMessage" and not m.get("initial", False):
+            self.fov_writes += 1
+            self.send(**{**_camera(*self.canvas, **self.pose), "fov": float(m["fov"])})
+
+
+def test_after_presentation_mode_the_tab_is_asked_for_its_canvas_and_framed_for_its_real_size(app):
+    before = set(app.views)
+    page = _Page(app.port)
+    try:
+        new = wait_for(lambda: set(app.views) - before, what="the app to build a view for the page")
+        view = app.views[next(iter(new))]
+        wait_for(lambda: _fills_the_canvas(view), what="the first framing, for the 1280 x 720 canvas")
+        page.canvas = (1004, 720)  # the wider panel took 276 device pixels: the page does not say so by itself
+        page.set_value(view.panel.presentation, True)
+        wait_for(lambda: page.fov_writes >= 1, what="the server asking the page for its camera again")
+        wait_for(lambda: view.client.camera.image_width == 1004, what="the real canvas size on the server")
+
+        def in_view() -> bool:  # the whole mechanism on the real canvas (presentation mode keeps a band free below)
+            uv = _fractions(view.client.camera, _corners(view.session.state.params))
+            return bool(uv.min() >= 0.0 and uv.max() <= 1.0 and np.ptp(uv, axis=0).max() > 0.6)
+
+        wait_for(in_view, what="the framing for the canvas beside the wider panel")
+        assert abs(view.client.camera.fov - CAMERA["fov"]) < 1e-4 * CAMERA["fov"]  # the question shows nothing
+    finally:
+        page.close()

@@ -16,6 +16,8 @@ from tpm_viz import InputError, Params
 from tpm_viz.app.runs import Source, build_run
 from tpm_viz.ui.notebook import MAX_FRAMES, Embed
 
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
+
 NOTEBOOK = pathlib.Path(__file__).resolve().parents[2] / "docs" / "example.ipynb"
 BUDGET = 60.0  # s, the whole notebook in CI
 

@@ -16,6 +16,8 @@ from tpm_viz.app.lessons import DEMOS
 from tpm_viz.paper.trajectories import circle_state, line_state
 from tpm_viz.ui.teaching.charts import CHART_POINTS
 
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
+
 P = Params.paper()
 
 

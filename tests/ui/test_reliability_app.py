@@ -26,6 +26,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from tests.support.fake_viser import FakeView, assert_clean
+from tests.support.hypo import examples
 from tpm_viz import InputError, Params, TpmVizError
 from tpm_viz.app import transitions as T
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES, read_choice, read_flag, read_number, read_upload, read_vec2
@@ -35,13 +36,15 @@ from tpm_viz.paper.status import PoseStatus
 from tpm_viz.params import PARAM_INFO
 from tpm_viz.ui.session import Hub
 
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
+
 P = Params.paper()
 BAD_TEXT = re.compile(r"\bnan\b|\binf\b|infinity", re.IGNORECASE)
 
 
 def _settings(n: int):
     return settings(
-        max_examples=n,
+        max_examples=examples(n),
         deadline=None,
         derandomize=True,
         suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],

@@ -17,6 +17,8 @@ from tpm_viz.clips import ClipRenderer
 from tpm_viz.ui.teaching.recording import APP_FRAMES, SLOTS, frames_of
 from tpm_viz.words import Lang, say
 
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
+
 BLUE, RED = (31, 119, 180), (214, 39, 40)  # the bars of τ1 and τ2 (tpm_viz.clips.BAR_COLOURS)
 
 

@@ -6,9 +6,13 @@ from __future__ import annotations
 
 import re
 
+import pytest
+
 from tests.support.protocol import wait_for
 from tpm_viz.ui.text import LEGEND
 from tpm_viz.words import Lang, catalogue
+
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
 HANGUL = re.compile("[\uac00-\ud7a3]")
 

@@ -19,6 +19,8 @@ from tpm_viz.app import transitions
 from tpm_viz.app.typed import QUIET
 from tpm_viz.words import Lang, catalogue
 
+pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
+
 P = Params.paper()
 HOME_D = 0.482 - 0.092 - 0.260  # a - b - l_a: both actuators at p = 0 (eq. 4), m
 

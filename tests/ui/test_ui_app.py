@@ -83,7 +83,7 @@ def test_loopback_detection_and_warning(monkeypatch):
         def __init__(self, server, **kwargs):
             self.port = 1234
 
-    monkeypatch.setattr(app_module, "build_server", lambda host, port: None)
+    monkeypatch.setattr(app_module, "build_server", lambda host, port, *more: None)
     monkeypatch.setattr(app_module, "TpmApp", Fake)
     err, out = io.StringIO(), io.StringIO()
     with redirect_stderr(err), redirect_stdout(out):

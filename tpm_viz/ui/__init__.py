@@ -1,16 +1,13 @@
 """The browser app (viser). The only package of tpm-viz that imports viser; nothing in the library imports it.
 
-- :mod:`.scene`: the 3D mechanism of one tab, handles built once, then moved;
-- :mod:`.panels`: the control panel of one tab, handles built once, then written;
-- :mod:`.text`: formatting of the readouts (HTML), no maths;
-- :mod:`.session`: shared state, private copies and the lock that serialises changes;
-- :mod:`.frame`: one committed state and its drawing data, computed once for all tabs;
-- :mod:`.client`: one tab's callbacks (widget -> pure library function -> commit);
-- :mod:`.transitions`: the state transitions those callbacks run (pure), :mod:`.validate`: the readers of
-  untrusted values and uploads, :mod:`.guard`: callbacks that log and keep going, :mod:`.access`: presenter mode,
-  :mod:`.transport`: malformed messages and oversized uploads dropped before viser handles them;
-- :mod:`.teaching`: the teaching layer of one tab: :mod:`.player` (trajectories, with :mod:`.runs` per session
-  and :mod:`.charts`), :mod:`.explorer` (floor maps, ellipses), :mod:`.demos_panel`; :mod:`.worker` runs their slow
-  computations off the callbacks;
-- :mod:`.app`: the server and ``main(host, port, presenter_token=None)``.
+- the server: :mod:`.app` (``main(host, port, ...)``, :func:`~.app.build_server`), :mod:`.room` (presenter, tabs
+  that come back, the session file), :mod:`.classroom` (addresses, identities, handshakes), :mod:`.continuity`
+  (tabs that left, the saved session), :mod:`.lecturer` and :mod:`.login` (the presenter's folders);
+- shared state: :mod:`.session` (the hub, sessions and the lock), :mod:`.snapshot` (one committed state drawn once
+  for all tabs), :mod:`.drags` and :mod:`.dragging` (when drags are committed), :mod:`.worker` (slow jobs);
+- one tab: :mod:`.client` (its callbacks), :mod:`.panels`, :mod:`.fields` and :mod:`.text` (the panel),
+  :mod:`.scene` and :mod:`.tabscene` (the 3D view), :mod:`.look` (layout, presentation mode, camera),
+  :mod:`.language`, :mod:`.notebook` (Jupyter), and :mod:`.teaching` (the teaching tabs);
+- viser's internals and the server's limits: :mod:`._viser` (every private viser name), :mod:`.wire`,
+  :mod:`.windows`, :mod:`.wakeups`, :mod:`.transport`, :mod:`.limits`, :mod:`.guard`.
 """

@@ -175,6 +175,7 @@ class ClientView:
         with self.hub.lock:
             self.closed = True
             self.typing.close()
+            self.look.close()
             self.hub.leave(self, self.session)
             self.teaching.close()
 

@@ -25,6 +25,7 @@ Nothing here computes; the style sheets are constants, and the messages are word
 from __future__ import annotations
 
 import math
+import threading
 from typing import Any
 
 import numpy as np
@@ -66,6 +67,12 @@ TOUCH = 24
 """Least width and height of a control on a phone [CSS px] (WCAG 2.2 target size, level AA)."""
 ASPECT_CHANGE = 0.01
 """Relative change of a canvas's aspect ratio that frames the camera again (a pixel of rounding does not)."""
+RESIZE_ASKS = (0.3, 1.0, 3.0)
+"""When, after the panel changes width [s], the tab is asked for its canvas size again (:meth:`Look.ask_canvas`):
+viser's page reports a resize with the canvas's drawing-buffer size, which its renderer may not have updated yet."""
+FOV_NUDGE = 2e-5
+"""Relative change of the field of view [-] that makes the page send its camera (and canvas size) again: the least
+that viser's camera setter does not drop as unchanged (``np.allclose``), a 0.002 % zoom that nobody sees."""
 LIVE_WIDTH = 560
 """Width of the box of banner and forces [CSS px] (presentation mode, while the panel is collapsed)."""
 LIVE_GAP = 12
@@ -179,6 +186,8 @@ class Look:
         self.view = view
         self.presentation = False
         self._aspect: float | None = None  # the canvas aspect the camera was last framed for
+        self._asks: list[threading.Timer] = []
+        self._nudge = 1.0
         gui = view.client.gui
         self.style = gui.add_html(PHONE_CSS)
         self.live: Any = None  # the box of banner and forces (a viser panel), made when first needed
@@ -206,6 +215,37 @@ class Look:
                 return
             view.frame_camera(view.session.state.params)
             view.client.flush()
+
+    def ask_canvas(self) -> None:
+        """Ask the page for its camera and canvas size again, :data:`RESIZE_ASKS` after a change of the panel's
+        width: an answer with another aspect ratio frames the camera again (:meth:`_on_camera`)."""
+        for timer in self._asks:
+            timer.cancel()
+        self._asks = [threading.Timer(delay, self._ask) for delay in RESIZE_ASKS]
+        for timer in self._asks:
+            timer.daemon = True
+            timer.start()
+
+    @guarded
+    def _ask(self) -> None:
+        view = self.view
+        with view.hub.lock:
+            if view.closed:
+                return
+            camera = view.client.camera
+            try:
+                fov = float(camera.fov)
+            except AssertionError:  # no camera message yet: the first one frames the camera
+                return
+            self._nudge = -self._nudge  # up, then back: viser's page answers a new field of view with its camera
+            camera.fov = fov * (1.0 + self._nudge * FOV_NUDGE)
+            view.client.flush()
+
+    def close(self) -> None:
+        """The tab went away: no more questions to its page."""
+        for timer in self._asks:
+            timer.cancel()
+        self._asks = []
 
     # -- presentation mode -------------------------------------------------------------------------------------
     @guarded
@@ -243,6 +283,7 @@ class Look:
             teaching.set_presentation(on)
         self.show()
         self.view.frame_camera(self.view.session.state.params)
+        self.ask_canvas()
 
     def show(self) -> None:
         """Copy the panel's dashboard into the box of banner and forces (presentation mode only)."""
