@@ -1,4 +1,4 @@
-"""Frames of an animated clip of a trajectory run: a top view of the mechanism and a force strip (issue 28).
+"""Frames of an animated clip of a trajectory run: a top view of the mechanism and a force strip.
 
 One frame per sample of the run (frame ``k`` shows the run at its time ``t[k]``: the frames are the run's times,
 never the wall clock, so the same run gives the same frames). Left, the mechanism seen from above as in the

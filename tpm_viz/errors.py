@@ -8,6 +8,8 @@ command line and the app can show it as it is.
 from __future__ import annotations
 
 __all__ = [
+    "BusyError",
+    "FileRefusedError",
     "InputError",
     "InvalidParametersError",
     "SingularConfigurationError",
@@ -34,3 +36,17 @@ class SingularConfigurationError(TpmVizError):
 
 class InputError(TpmVizError):
     """Malformed user input: a CSV file, a command-line value, a non-finite number."""
+
+
+class FileRefusedError(InputError):
+    """A file the app would not read (too big, not a regular file, outside its folder, nested too deep, not
+    text); the one-line message names the path and what to change, and never quotes the file's contents.
+    ``why``: the same words without the path (to quote inside another line that names the file already)."""
+
+    def __init__(self, message: object, why: object = None) -> None:
+        super().__init__(message)
+        self.why = message if why is None else why
+
+
+class BusyError(TpmVizError):
+    """The server refused a job over a bound of its queue (``tpm_viz.classroom.jobs``): try again in a moment."""

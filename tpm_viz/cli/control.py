@@ -1,4 +1,4 @@
-"""``tpm-viz control``: the computed-torque control lab on the command line (issue 14).
+"""``tpm-viz control``: the computed-torque control lab on the command line.
 
 :func:`register` adds the subcommand to the ``tpm-viz`` parser (:mod:`tpm_viz.cli`). The simulation
 (Pinocchio plant) is imported by the handler, so that ``import tpm_viz.cli`` stays free of Pinocchio.

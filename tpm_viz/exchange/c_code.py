@@ -1,4 +1,4 @@
-"""The closed form as C99 for a real-time controller: ``tpm_2ppa.h`` and ``tpm_2ppa.c`` (issue 27).
+"""The closed form as C99 for a real-time controller: ``tpm_2ppa.h`` and ``tpm_2ppa.c``.
 
 The arithmetic is not restated here: :mod:`.c_expr` traces the project's own Python functions on symbols and
 prints what they compute, operation by operation:

@@ -1,4 +1,4 @@
-"""Server-level limits: one tab cannot freeze or fill the server (issue 12).
+"""Server-level limits: one tab cannot freeze or fill the server.
 
 :func:`harden_server` (called once by ``build_server``) installs, on one viser server:
 

@@ -1,4 +1,4 @@
-"""The :class:`~.recording.Material` of each teaching tab's current run (issue 28), read under the hub's lock.
+"""The :class:`~.recording.Material` of each teaching tab's current run, read under the hub's lock.
 
 - Player: the loaded run (:class:`tpm_viz.app.runs.Run`, its Pinocchio forces already computed) as it is.
 - Control: the actual platform path and the applied forces of the last simulation; the report is of the

@@ -1,4 +1,4 @@
-"""What a tab takes out of the room (issue 28): the material of its Player, Control or Planner run, and a clip
+"""What a tab takes out of the room: the material of its Player, Control or Planner run, and a clip
 recorded a few frames at a time.
 
 :class:`Material` is what *Record clip* and *Download report* need of a tab: the frames' arrays (a

@@ -23,6 +23,7 @@ from tpm_viz.ui.teaching.lessons import DemosView
 from tpm_viz.ui.teaching.planner import PlannerView
 from tpm_viz.ui.teaching.player import PlayerView
 from tpm_viz.ui.teaching.playing import RunHub
+from tpm_viz.ui.teaching.takeout import TakeOut, takeout_for
 from tpm_viz.ui.worker import Worker
 
 __all__ = ["Services", "Teaching"]
@@ -33,10 +34,11 @@ class Services:
     """What the tabs of one hub share."""
 
     worker: Worker
+    """The fair queue of every tab's heavy jobs (runs, maps, control simulations, plans): tabs take turns."""
     maps: MapService
     runs: RunHub
     plans: Worker
-    """The planner's own worker: a slider's re-plan never waits behind a map, a run or a control simulation."""
+    """The planner's worker: the same fair queue (a re-plan takes its tab's turn like any other job)."""
     lessons: tuple[Demo, ...] = DEMOS
     """The lessons of the *Demos* tab: the packaged ones, or a lecturer's (``tpm-viz serve --lessons DIR``)."""
     problems: tuple[str, ...] = PROBLEMS
@@ -44,11 +46,10 @@ class Services:
 
     @classmethod
     def create(cls, hub: Hub, lessons: Sequence[Demo] = DEMOS, problems: Sequence[str] = PROBLEMS) -> Services:
-        """The services of ``hub``: one worker thread for slow computations (maps, runs, control simulations), the
-        floor maps, the runs, one worker for the planner's live re-plans, and the lessons."""
+        """The services of ``hub``: one fair worker pool for slow computations (maps, runs, control simulations,
+        the planner's live re-plans), the floor maps, the runs and the lessons."""
         worker = Worker()
-        plans = Worker("tpm-viz-planner")
-        return cls(worker, MapService(worker), RunHub(hub, worker), plans, tuple(lessons), tuple(problems))
+        return cls(worker, MapService(worker), RunHub(hub, worker), worker, tuple(lessons), tuple(problems))
 
 
 class Teaching:
@@ -64,20 +65,24 @@ class Teaching:
         )
         self.control = ControlView(view, self.services.worker, self.services.runs)
         self.planner = PlannerView(view, self.services.plans)
+        self.takeouts: list[TakeOut] = []  # Record clip and Download report of the player, control and planner
 
     def build_tabs(self, tabs: viser.GuiTabGroupHandle) -> None:
         """Add the *Player*, *Explorer*, *Demos*, *Control* and *Planner* tabs to the panel's tab group."""
         gui = self.view.client.gui
         with tabs.add_tab("Player", icon=viser.Icon.PLAYER_PLAY):
             self.player.build(gui)
+            self.takeouts.append(takeout_for(self.view, self.services.worker, self.player, "player", gui))
         with tabs.add_tab("Explorer", icon=viser.Icon.MAP):
             self.explorer.build(gui)
         with tabs.add_tab("Demos", icon=viser.Icon.SCHOOL):
             self.demos.build(gui)
         with tabs.add_tab("Control", icon=viser.Icon.ADJUSTMENTS):
             self.control.build(gui)
+            self.takeouts.append(takeout_for(self.view, self.services.worker, self.control, "control", gui))
         with tabs.add_tab("Planner", icon=viser.Icon.ROUTE):
             self.planner.build(gui)
+            self.takeouts.append(takeout_for(self.view, self.services.worker, self.planner, "planner", gui))
 
     def attach(self) -> None:
         """The tab has joined its session: draw the session's run (the first render came before that)."""
@@ -120,3 +125,4 @@ class Teaching:
         self.explorer.close()
         self.control.player.stop()
         self.planner.player.stop()
+        self.services.worker.leave(self.view)  # its pending maps, simulations and plans are dropped

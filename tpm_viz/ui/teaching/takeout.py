@@ -1,4 +1,4 @@
-"""*Record clip* and *Download report* in the Player, Control and Planner tabs of one browser tab (issue 28).
+"""*Record clip* and *Download report* in the Player, Control and Planner tabs of one browser tab.
 
 A folder of widgets (clip size from :data:`tpm_viz.clips.SIZE_PRESETS`, GIF or MP4, frame rate) with the two
 buttons and a progress line. The tab's view passes a function that returns its current :class:`Material` (or None:
