@@ -23,7 +23,7 @@ from tpm_viz.errors import InputError
 __all__ = ["FORMATS", "register", "write_atomically"]
 
 FORMATS = ("mjcf", "urdf", "c")
-"""Export formats: MJCF (MuJoCo, Pinocchio's MJCF reader), URDF and C99 source (the closed form, issue 27)."""
+"""Export formats: MJCF (MuJoCo, Pinocchio's MJCF reader), URDF and C99 source (the closed form)."""
 
 
 def _file_mode(path: str) -> int:

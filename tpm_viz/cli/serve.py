@@ -78,6 +78,8 @@ def _cmd_serve(args) -> int:
         session=args.session if args.session is not None else default_path(),
         fresh=args.fresh,
         lessons=args.lessons,
+        trusted_proxies=args.trusted_proxy or (),
+        allowed_hosts=args.allowed_host or (),
     )
     return 0
 
@@ -100,9 +102,12 @@ def register(sub, common: argparse.ArgumentParser) -> None:
         "--session",
         type=Path,
         metavar="FILE",
-        help="session file: read at start, saved on every change (default: session.json in the user data folder)",
+        help="the session store: read at start, saved on every change (default: classroom.sqlite3 in the user data "
+        "folder); a JSON session file is imported once into FILE.sqlite3 beside it and never written",
     )
-    s.add_argument("--fresh", action="store_true", help="start with the defaults (the session file is overwritten)")
+    s.add_argument(
+        "--fresh", action="store_true", help="start with the defaults (the old store is set aside, never overwritten)"
+    )
     s.add_argument(
         "--lessons",
         type=Path,
@@ -119,5 +124,18 @@ def register(sub, common: argparse.ArgumentParser) -> None:
         "--presenter-token",
         metavar="TOKEN",
         help="only a tab that logs in with TOKEN changes the shared mechanism (others use their own copy)",
+    )
+    s.add_argument(
+        "--trusted-proxy",
+        action="append",
+        metavar="ADDR",
+        help="a reverse proxy (nginx, Caddy) in front of the app: its X-Forwarded-For / Forwarded name the client "
+        "(an address or a network; repeatable; docs/classroom.md)",
+    )
+    s.add_argument(
+        "--allowed-host",
+        action="append",
+        metavar="NAME",
+        help="answer to this host name too (the name students type when a proxy or DNS serves the app; repeatable)",
     )
     s.set_defaults(func=_cmd_serve)

@@ -31,14 +31,15 @@ import asyncio
 import contextlib
 import copy
 import dataclasses
+import functools
 import threading
 import uuid
 import weakref
 from collections.abc import Callable, Iterator
-from typing import Any, cast
+from typing import Any, cast, get_type_hints
 
 import viser
-from viser import _messages
+from viser import _assignable_props_api, _messages
 from viser.infra import _infra
 from viser.infra._async_message_buffer import AsyncMessageBuffer
 
@@ -331,7 +332,8 @@ def share_serialization() -> None:
     match: it holds its message's id); array buffers are shared, their placeholders renumbered per window."""
     if getattr(_messages.Message, "_tpm_viz_shared", False):
         return
-
+    hints = functools.cache(get_type_hints)  # a handle's property types once per props class (a sixth of a storm)
+    _assignable_props_api.AssignablePropsBase._prop_hints = property(lambda h: hints(type(h._impl.props)))  # type: ignore
     _messages.Message.as_serializable_dict = wire.shared_serializer(_SERIALIZE)  # type: ignore[method-assign]
     _messages.Message._tpm_viz_shared = True  # type: ignore[attr-defined]
 
@@ -355,11 +357,12 @@ def hook_handshakes(hook: wire.Handshake) -> Iterator[None]:
 
 
 def connection_request(server: viser.ViserServer, client_id: int) -> tuple[Any, Any] | None:
-    """``(remote_address, request headers)`` of a connected tab's websocket handshake, or None if it is gone."""
+    """``(client address as classroom.Handshakes read it, headers)`` of a tab's websocket handshake, or None."""
     connection = server._websock_server._live_connections.get(client_id)
     if connection is None or connection.request is None:
         return None
-    return connection.remote_address, connection.request.headers
+    client, remote = getattr(connection, "tpm_viz_client", None), tuple(connection.remote_address or ("", 0))
+    return (remote if client is None else (client, *remote[1:])), connection.request.headers
 
 
 # -- words on the wire (ui/language.py) ------------------------------------------------------------------------------
@@ -388,8 +391,9 @@ def reword(client: viser.ClientHandle, out: Callable[[str, Any, str], Any], back
         queue(message)
 
     async def handle(client_id: Any, message: Any) -> None:
-        if isinstance(message, _messages.GuiUpdateMessage) and isinstance(u := message.updates, dict) and "value" in u:
-            message.updates = {**u, "value": back(message.uuid, u["value"])}
+        u = getattr(message, "updates", None)  # a malformed one (an id that is a list) goes on: transport drops it
+        if isinstance(message, _messages.GuiUpdateMessage) and isinstance(message.uuid, str) and isinstance(u, dict):
+            message.updates = {**u, "value": back(message.uuid, u["value"])} if "value" in u else u
         await dispatch(client_id, message)
 
     conn.queue_message, conn._handle_incoming_message = queue_message, handle  # type: ignore[method-assign]

@@ -7,7 +7,7 @@ until Ctrl-C; problems go to the ``tpm_viz.ui`` logger (stderr).
 Safety: the default host is loopback, and a warning is printed for any other address. viser's share-URL tunnel (an
 outside relay that a client can request even with the button hidden) is disabled by replacing
 ``server.request_share_url`` with a no-op. Malformed GUI updates and uploads larger than
-:data:`~.validate.MAX_UPLOAD_BYTES` are dropped before viser handles them (:mod:`.transport`). With a presenter
+:data:`~tpm_viz.app.inputs.MAX_UPLOAD_BYTES` are dropped before viser handles them (:mod:`.transport`). With a presenter
 token only the presenter's tab changes the shared mechanism (:mod:`.access`). Connect and disconnect handlers are
 guarded (:mod:`.guard`): one bad tab never stops the server.
 """
@@ -32,8 +32,10 @@ import viser
 from tpm_viz import multibody
 from tpm_viz.app.access import Access
 from tpm_viz.app.lessons import Demo, load_lessons
+from tpm_viz.app.network import HostRules, Network
 from tpm_viz.app.readouts import Reference
 from tpm_viz.app.state import AppState
+from tpm_viz.classroom.identity import Keys
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.params import Params
 from tpm_viz.ui._viser import (
@@ -47,7 +49,7 @@ from tpm_viz.ui._viser import (
 )
 from tpm_viz.ui.classroom import Classroom, Handshakes, local_addresses, qr_text, student_urls
 from tpm_viz.ui.client import ClientView
-from tpm_viz.ui.continuity import Store
+from tpm_viz.ui.continuity import LectureStore, lecture_store
 from tpm_viz.ui.guard import guard_executor, guarded, log, log_fault, report
 from tpm_viz.ui.limits import DEFAULT_MAX_CONNECTIONS, harden_server, set_max_connections
 from tpm_viz.ui.login import LoginPanel
@@ -84,8 +86,12 @@ in the pool had run for up to 5 ms more: in a lecture hall, hundreds of times a 
 hall``)."""
 
 
-def build_server(host: str = "127.0.0.1", port: int = 8080) -> viser.ViserServer:
-    """A quiet viser server: no share tunnel, no environment map or shadows (fast first paint).
+def build_server(
+    host: str = "127.0.0.1", port: int = 8080, hosts: HostRules | None = None, keys: Keys | None = None
+) -> viser.ViserServer:
+    """A quiet viser server: no share tunnel, no environment map or shadows (fast first paint). ``hosts``: the
+    ``Host`` names it answers to and the trusted proxies (default: this machine's names and addresses, no proxy);
+    ``keys``: the identity cookies' keys (default: the process's, :data:`~.classroom.DEFAULT_KEYS`).
 
     Raises :class:`~tpm_viz.ui._viser.IncompatibleViserError` (one line) if the installed viser is not the tested one.
     """
@@ -95,7 +101,7 @@ def build_server(host: str = "127.0.0.1", port: int = 8080) -> viser.ViserServer
     sys.setswitchinterval(GIL_SWITCH_INTERVAL)
     with (
         contextlib.redirect_stdout(io.StringIO()),
-        hook_handshakes(Handshakes()),
+        hook_handshakes(Handshakes(hosts or HostRules(addresses=local_addresses, bound=host), keys)),
     ):  # same-origin check; viser prints its own banner even with verbose=False
         server = viser.ViserServer(host=host, port=port, label="tpm-viz", verbose=False)
     disable_share_url(server)
@@ -127,7 +133,7 @@ class TpmApp:
         presenter_token: str | None = None,
         max_connections: int = DEFAULT_MAX_CONNECTIONS,
         classroom: Classroom | None = None,
-        store: Store | None = None,
+        store: LectureStore | None = None,
         lessons: tuple[Sequence[Demo], Sequence[str]] | None = None,
     ) -> None:
         self.server = server
@@ -279,17 +285,23 @@ def main(
     fresh: bool = False,
     addresses: Callable[[], list[str]] | None = None,
     lessons: str | Path | None = None,
+    trusted_proxies: Sequence[str] = (),
+    allowed_hosts: Sequence[str] = (),
 ) -> TpmApp:
     """Serve the app; print the real URL; block until Ctrl-C (or SIGTERM) unless ``block`` is False.
 
     ``presenter_token``: if given, only a tab that logs in with it changes the shared mechanism. ``classroom``
     (implied by a non-loopback ``host``): print the URLs students type and a QR code, a tab on this machine is the
     presenter, and a token (``presenter_token`` or a random one, printed here only) lets the lecturer present from
-    another device. ``session``: the session file to read at start and keep saved (None: nothing is saved);
-    ``fresh``: start clean (the file is overwritten). ``addresses``: this machine's network addresses (a lookup;
+    another device. ``session``: the store to read at start and keep saved (None: nothing is saved; a JSON session
+    file is imported once into a store beside it: :mod:`.continuity`); ``fresh``: start clean (the store is set
+    aside, never overwritten). ``addresses``: this machine's network addresses (a lookup;
     tests inject theirs). ``lessons``: a folder of lesson files (or one file) for the *Demos* tab instead of the
-    packaged ones; a refused file is one warning line, and no lesson at all is an error."""
+    packaged ones; a refused file is one warning line, and no lesson at all is an error. ``trusted_proxies``: the
+    reverse proxies whose X-Forwarded-For / Forwarded name the client; ``allowed_hosts``: more ``Host`` names to
+    answer to (:mod:`tpm_viz.app.network`)."""
     access = Access(presenter_token)  # validates the token before anything starts
+    network = Network.of(trusted_proxies, allowed_hosts)
     tour = None if lessons is None else load_lessons(lessons)
     if tour is not None:
         if not tour[0]:
@@ -311,8 +323,11 @@ def main(
     # A tab that closes while its frame is being pushed makes viser warn once per connection; expected in a
     # classroom (the tab is dropped a moment later), and not worth a line in the log each time.
     warnings.filterwarnings("ignore", message=r"Queued a \w+ on a closed connection", category=UserWarning)
-    server = build_server(host, port)
-    store = None if room is None and session is None else Store(session, fresh)
+    store = None if room is None and session is None else lecture_store(session, fresh)
+    if store is not None:
+        store.open()  # its notices, and the cookie keys kept beside it, before the first page
+    keys = None if store is None else store.keys
+    server = build_server(host, port, HostRules(network, addresses or local_addresses, bound=host), keys)
     app = TpmApp(server, presenter_token=presenter_token, classroom=room, store=store, lessons=tour)
     gc.collect()
     gc.freeze()  # the start-up heap (numpy, trimesh, Pinocchio, viser) is never scanned again: full collections

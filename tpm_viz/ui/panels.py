@@ -212,7 +212,7 @@ class Panel:
             self.dashboard.content = frame.dashboard_in(lang)
             self._dashboard_at = now
         if not frame.in_drag or not self.equations.content:
-            self.equations.content = frame.equations
+            self.equations.content = frame.equations_in(lang)
         stroke_mm = state.params.stroke * 1e3
         for i, slider in enumerate(self.d):
             if slider.max != stroke_mm:

@@ -2,8 +2,8 @@
 play / pause / scrub it at 0.01x-1x, watch the path being traced and the charts' time marker move, export the
 run as CSV and the force plot as PNG.
 
-The run and the playback belong to the session (:mod:`.runs`); this view only reads widgets, calls
-:class:`~.runs.RunHub` and draws. The duration is a typed field (:class:`~tpm_viz.ui.fields.TypedBox`: ``5e-1`` and
+The run and the playback belong to the session (:mod:`.playing`); this view only reads widgets, calls
+:class:`~.playing.RunHub` and draws. The duration is a typed field (:class:`~tpm_viz.ui.fields.TypedBox`: ``5e-1`` and
 ``0,5`` are 0.5 s; applied on Enter or after a quiet time; the value in use and the plausibility notes under it);
 the player's refusals (upload, choice, playback, exports) are shown under the upload button, to that tab only, and
 the next success clears them. During playback the charts and the trace are refreshed at most
@@ -124,7 +124,7 @@ class PlayerView:
 
     def _guard(self, event, fn, *args) -> None:
         """Run ``fn`` for a user event (not a server echo); refused input is told to this tab only, under the upload
-        button; a success clears an earlier refusal there (a load: once it is computed, :meth:`_loaded`)."""
+        button; a success clears an earlier refusal there (a load: once it is computed)."""
         if getattr(event, "client", None) is None or getattr(self.view, "closed", False) or self.session is None:
             return
         try:
