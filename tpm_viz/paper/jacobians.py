@@ -33,13 +33,17 @@ __all__ = [
     "actuator_acceleration",
     "actuator_forces_from_platform_force",
     "actuator_velocity",
+    "check_regular",
     "classify",
     "condition_number",
     "eq14_row",
     "jacobians",
     "platform_force_from_actuator_forces",
     "platform_velocity",
+    "platform_velocity_through",
+    "pose_status",
     "theta_dot",
+    "velocity_through",
 ]
 
 
@@ -100,37 +104,59 @@ def classify(params: Params, p: ArrayLike, thresholds: SingularityThresholds = W
     ok = reachable(params, p)
     safe = np.where(ok[..., None], p, 0.0)
     d = inverse_kinematics(params, safe)
-    jac = jacobians(params, safe, d)
+    return pose_status(ok, jacobians(params, safe, d), in_stroke(params, d), thresholds)
+
+
+#: the singularity equations named in a refusal, (inverse, direct), of the paper's arrangement
+SINGULARITIES = ("cos θ1 cos θ2 = 0 (eq. 11)", "cos(θ1 + θ2) = 0 (eq. 12)")
+
+
+def pose_status(
+    ok: np.ndarray, jac: Jacobians, stroke_ok: np.ndarray, thresholds: SingularityThresholds = WARN
+) -> np.ndarray:
+    """Status per pose from its Jacobians, either arrangement: ``min_i |cos θ_i|`` (the diagonal of ``J_q``)
+    against the inverse threshold, ``|det J_x|`` against the direct one, then the stroke, then reachability
+    (``ok``); the most severe condition wins."""
     cos = np.stack([jac.jq[..., 0, 0], jac.jq[..., 1, 1]], -1)
     status = np.full(ok.shape, PoseStatus.REGULAR, dtype=int)
     status = np.where(np.min(np.abs(cos), axis=-1) < thresholds.inverse, PoseStatus.NEAR_INVERSE, status)
     status = np.where(np.abs(jac.det_jx) < thresholds.direct, PoseStatus.NEAR_DIRECT, status)
-    status = np.where(~in_stroke(params, d), PoseStatus.OUT_OF_STROKE, status)
+    status = np.where(~stroke_ok, PoseStatus.OUT_OF_STROKE, status)
     return np.where(ok, status, PoseStatus.UNREACHABLE)
 
 
-def _check_regular(jac: Jacobians, which: str) -> None:
+def check_regular(jac: Jacobians, which: str, equations: tuple[str, str] = SINGULARITIES) -> None:
+    """Refuse (:class:`SingularConfigurationError`) where ``det J_q`` (``which="inverse"``) or ``det J_x``
+    (``"direct"``) vanishes, naming the ``equations`` (inverse, direct) of the arrangement."""
     det = jac.det_jq if which == "inverse" else jac.det_jx
     if np.any(np.abs(det) < 1e-12):
-        eq = "cos θ1 cos θ2 = 0 (eq. 11)" if which == "inverse" else "cos(θ1 + θ2) = 0 (eq. 12)"
+        eq = equations[0] if which == "inverse" else equations[1]
         raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq=eq))
 
 
-def actuator_velocity(params: Params, p: ArrayLike, dp: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
-    """Actuator velocities ``ḋ = J ṗ`` [m/s], eq. (9)."""
-    jac = jacobians(params, p, d)
-    _check_regular(jac, "inverse")
+def velocity_through(jac: Jacobians, dp: ArrayLike, equations: tuple[str, str] = SINGULARITIES) -> np.ndarray:
+    """``ḋ = J ṗ`` [m/s] with the Jacobians of a pose (eq. 9; refused at an inverse singularity)."""
+    check_regular(jac, "inverse", equations)
     with np.errstate(over="ignore", invalid="ignore"):
         return finite_result(np.einsum("...ij,...j->...i", jac.j, as_xy(dp, "dp")), T("the actuator velocities"))
 
 
-def platform_velocity(params: Params, p: ArrayLike, dd: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
-    """Platform velocity ``ṗ = J^{-1} ḋ`` [m/s] (inverse of eq. 9; needs ``det J_x != 0``)."""
-    jac = jacobians(params, p, d)
-    _check_regular(jac, "direct")
+def platform_velocity_through(jac: Jacobians, dd: ArrayLike, equations: tuple[str, str] = SINGULARITIES) -> np.ndarray:
+    """``ṗ = J_x⁻¹ J_q ḋ`` [m/s] with the Jacobians of a pose (refused at a direct singularity)."""
+    check_regular(jac, "direct", equations)
     with np.errstate(over="ignore", invalid="ignore"):
         rhs = np.einsum("...ij,...j->...i", jac.jq, as_xy(dd, "dd"))
         return finite_result(np.linalg.solve(jac.jx, rhs[..., None])[..., 0], T("the platform velocity"))
+
+
+def actuator_velocity(params: Params, p: ArrayLike, dp: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
+    """Actuator velocities ``ḋ = J ṗ`` [m/s], eq. (9)."""
+    return velocity_through(jacobians(params, p, d), dp)
+
+
+def platform_velocity(params: Params, p: ArrayLike, dd: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
+    """Platform velocity ``ṗ = J^{-1} ḋ`` [m/s] (inverse of eq. 9; needs ``det J_x != 0``)."""
+    return platform_velocity_through(jacobians(params, p, d), dd)
 
 
 def theta_dot(params: Params, p: ArrayLike, dp: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
@@ -206,7 +232,7 @@ def actuator_forces_from_platform_force(
     at the direct singularity (eq. 12).
     """
     jac = jacobians(params, p, d)
-    _check_regular(jac, "direct")
+    check_regular(jac, "direct")
     jxt = np.swapaxes(jac.jx, -1, -2)
     with np.errstate(over="ignore", invalid="ignore"):
         g = np.linalg.solve(jxt, as_xy(f, "f")[..., None])[..., 0]
@@ -218,6 +244,6 @@ def platform_force_from_actuator_forces(
 ) -> np.ndarray:
     """Platform force ``f = J^T τ`` [N] for actuator forces ``τ`` [N], eq. (13)."""
     jac = jacobians(params, p, d)
-    _check_regular(jac, "inverse")
+    check_regular(jac, "inverse")
     with np.errstate(over="ignore", invalid="ignore"):
         return finite_result(np.einsum("...ji,...j->...i", jac.j, as_xy(tau, "tau")), T("the platform force"))

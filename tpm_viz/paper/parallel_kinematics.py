@@ -20,9 +20,15 @@ from numpy.typing import ArrayLike, NDArray
 
 from tpm_viz.errors import InputError, InvalidParametersError, SingularConfigurationError, UnreachablePoseError
 from tpm_viz.numbers import fixed
-from tpm_viz.paper.jacobians import Jacobians
+from tpm_viz.paper.jacobians import (
+    Jacobians,
+    check_regular,
+    platform_velocity_through,
+    pose_status,
+    velocity_through,
+)
 from tpm_viz.paper.kinematics import FkSolutions, MechanismPose, as_xy, finite_result, in_stroke
-from tpm_viz.paper.status import WARN, FkStatus, PoseStatus, SingularityThresholds
+from tpm_viz.paper.status import WARN, FkStatus, SingularityThresholds
 from tpm_viz.params import Params
 from tpm_viz.words import Phrase, T
 
@@ -272,37 +278,21 @@ def classify(params: Params, p: ArrayLike, thresholds: SingularityThresholds = W
     ok = reachable(params, p)
     safe = np.where(ok[..., None], p, 0.0)
     d = _ik_unchecked(params, safe)
-    jac = jacobians(params, safe, d)
-    cos = np.stack([jac.jq[..., 0, 0], jac.jq[..., 1, 1]], -1)
-    status = np.full(ok.shape, PoseStatus.REGULAR, dtype=int)
-    status = np.where(np.min(np.abs(cos), axis=-1) < thresholds.inverse, PoseStatus.NEAR_INVERSE, status)
-    status = np.where(np.abs(jac.det_jx) < thresholds.direct, PoseStatus.NEAR_DIRECT, status)
-    status = np.where(~in_stroke(params, d), PoseStatus.OUT_OF_STROKE, status)
-    return np.where(ok, status, PoseStatus.UNREACHABLE)
+    return pose_status(ok, jacobians(params, safe, d), in_stroke(params, d), thresholds)
 
 
-def _check_regular(jac: Jacobians, which: str) -> None:
-    det = jac.det_jq if which == "inverse" else jac.det_jx
-    if np.any(np.abs(det) < 1e-12):
-        eq = "cos θ1 cos θ2 = 0" if which == "inverse" else "sin(θ1 + θ2) = 0"
-        raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq=eq))
+SINGULARITIES = ("cos θ1 cos θ2 = 0", "sin(θ1 + θ2) = 0")
+"""The singularity equations named in a refusal, (inverse, direct), of the parallel arrangement."""
 
 
 def actuator_velocity(params: Params, p: ArrayLike, dp: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
     """``ḋ = J ṗ`` [m/s] (eq. P4)."""
-    jac = jacobians(params, p, d)
-    _check_regular(jac, "inverse")
-    with np.errstate(over="ignore", invalid="ignore"):
-        return finite_result(np.einsum("...ij,...j->...i", jac.j, as_xy(dp, "dp")), T("the actuator velocities"))
+    return velocity_through(jacobians(params, p, d), dp, SINGULARITIES)
 
 
 def platform_velocity(params: Params, p: ArrayLike, dd: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
     """``ṗ = J_x⁻¹ J_q ḋ`` [m/s] (needs ``det J_x != 0``)."""
-    jac = jacobians(params, p, d)
-    _check_regular(jac, "direct")
-    with np.errstate(over="ignore", invalid="ignore"):
-        rhs = np.einsum("...ij,...j->...i", jac.jq, as_xy(dd, "dd"))
-        return finite_result(np.linalg.solve(jac.jx, rhs[..., None])[..., 0], T("the platform velocity"))
+    return platform_velocity_through(jacobians(params, p, d), dd, SINGULARITIES)
 
 
 def actuator_acceleration(
@@ -329,7 +319,7 @@ def actuator_forces_from_platform_force(
     ``f_ext`` at rest takes ``f = -f_ext``. Computed as ``J_q J_x⁻ᵀ f``: finite at the inverse singularity, raises
     at the direct one."""
     jac = jacobians(params, p, d)
-    _check_regular(jac, "direct")
+    check_regular(jac, "direct", SINGULARITIES)
     jxt = np.swapaxes(jac.jx, -1, -2)
     with np.errstate(over="ignore", invalid="ignore"):
         g = np.linalg.solve(jxt, as_xy(f, "f")[..., None])[..., 0]
@@ -341,7 +331,7 @@ def platform_force_from_actuator_forces(
 ) -> np.ndarray:
     """``f = Jᵀ τ`` [N] for actuator forces ``τ`` [N] (eq. P8)."""
     jac = jacobians(params, p, d)
-    _check_regular(jac, "inverse")
+    check_regular(jac, "inverse", SINGULARITIES)
     with np.errstate(over="ignore", invalid="ignore"):
         return finite_result(np.einsum("...ji,...j->...i", jac.j, as_xy(tau, "tau")), T("the platform force"))
 
