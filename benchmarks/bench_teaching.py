@@ -33,9 +33,9 @@ from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz import Params
 from tpm_viz.app.runs import Source, build_run
 from tpm_viz.app.transitions import apply_params
+from tpm_viz.classroom.drags import PendingDrag
 from tpm_viz.multibody.model import inverse_dynamics as pinocchio
 from tpm_viz.ui.app import TpmApp, build_server
-from tpm_viz.ui.drags import PendingDrag
 from tpm_viz.ui.teaching import explorer as explorer_module
 
 P = Params.paper()

@@ -30,9 +30,9 @@ sys.path.insert(0, str(ROOT))  # the repository root: tests.support
 
 from tests.support.browser import CHROMIUM, CHROMIUM_ARGS, WORKER_LOG_JS
 from tests.support.protocol import ProtocolClient, wait_for
+from tpm_viz.classroom.dragging import Dragging
+from tpm_viz.classroom.drags import PendingDrag
 from tpm_viz.ui.app import TpmApp, build_server
-from tpm_viz.ui.dragging import Dragging
-from tpm_viz.ui.drags import PendingDrag
 
 
 def _stats(name: str, seconds) -> None:

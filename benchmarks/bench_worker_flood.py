@@ -15,7 +15,8 @@ value every 0.1 s (``planner``). Meanwhile, one after the other, three more tabs
 
 Prints median and p95 of each, without a flood and under each flood, the p95 against its target, and how long L's
 runs and M's maps waited in the worker's queue (submitted -> started: what the fair queue decides; the rest is
-computing and drawing). ``--threads N`` sets the pool size (``tpm_viz.ui.worker.THREADS``). The same script runs on
+computing and drawing). ``--threads N`` sets the pool size (``tpm_viz.classroom.worker.THREADS``). The same script
+runs on
 the tree before issue 23 (one worker thread in submission order, the planner's own thread): copy it there.
 """
 
@@ -172,7 +173,9 @@ def main() -> None:
     parser.add_argument(
         "--flood", nargs="*", default=["none", "control", "planner"], choices=("none", "control", "planner")
     )
-    parser.add_argument("--threads", type=int, default=None, help="pool size (default: tpm_viz.ui.worker.THREADS)")
+    parser.add_argument(
+        "--threads", type=int, default=None, help="pool size (default: tpm_viz.classroom.worker.THREADS)"
+    )
     args = parser.parse_args()
     if args.threads is not None and hasattr(worker, "THREADS"):
         worker.THREADS = args.threads

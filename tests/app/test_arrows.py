@@ -19,9 +19,9 @@ from tpm_viz.app.overlays import arrow_length, arrow_reach, arrow_vector
 from tpm_viz.app.palette import PALETTE
 from tpm_viz.app.readouts import Load, evaluate
 from tpm_viz.app.state import AppState
+from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.params import Params
 from tpm_viz.ui.scene import MechanismScene
-from tpm_viz.ui.snapshot import Snapshot
 
 P = Params.paper()
 REACH = 0.15 * (0.482 + 0.260)  # m: 0.15 (a + l_a) of the paper's prototype

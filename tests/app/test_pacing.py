@@ -1,4 +1,4 @@
-"""The pacing of own copies under load (tpm_viz.app.pacing), against a simulated class: N students dragging their
+"""The pacing of own copies under load (tpm_viz.classroom.pacing), against a simulated class: N students dragging their
 own copies at the browser's 20 Hz, each commit costing c seconds of the one core. The load the pacer settles on is
 checked against the budget it was given, and the interval against the closed form N c / budget."""
 
@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tests.support.hypo import examples
-from tpm_viz.app.pacing import WATCH_INTERVAL, WATCH_TABS, Pacer, watch_phase, watch_slot
+from tpm_viz.classroom.pacing import WATCH_INTERVAL, WATCH_TABS, Pacer, watch_phase, watch_slot
 
 
 def _simulate(pacer: Pacer, students: int, cost: float, seconds: float, rate: float = 20.0) -> list[float]:

@@ -1,4 +1,4 @@
-"""Typed number fields (``tpm_viz.app.typed``): what is read from a text, when it is applied, what the note says.
+"""Typed number fields (``tpm_viz.ui.typed``): what is read from a text, when it is applied, what the note says.
 
 The expected values are written out by hand (``1e9`` kg is 1 000 000 000 kg, ``-100000`` mm is -100 m) or come from
 the arithmetic of the test itself, never from the module under test. The keyboard is simulated with explicit times:
@@ -15,7 +15,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tests.support.hypo import examples
-from tpm_viz.app.typed import (
+from tpm_viz.errors import InputError
+from tpm_viz.ui.typed import (
     QUIET,
     Quantity,
     TypedField,
@@ -23,7 +24,6 @@ from tpm_viz.app.typed import (
     duration_note,
     force_note,
 )
-from tpm_viz.errors import InputError
 
 MASS = Quantity("m_p", "kg")
 LENGTH = Quantity("p1", "mm", 1e-3, -10_000.0, 10_000.0)

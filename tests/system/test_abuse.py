@@ -26,13 +26,13 @@ import viser
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect as connect_sync
 
-import tpm_viz.ui.transport as transport
+import tpm_viz.viserkit.transport as transport
 from tests.support.protocol import CAMERA, ProtocolClient, ServerProcess, Tab, decode_batch, wait_for
 from tests.system.test_security import _get
 from tpm_viz.app.inputs import MAX_TEXT
+from tpm_viz.classroom.guard import ACTIVITY, Faults
 from tpm_viz.ui.app import TpmApp, build_server
-from tpm_viz.ui.guard import ACTIVITY, Faults
-from tpm_viz.ui.limits import Gate, guard_of
+from tpm_viz.viserkit.limits import Gate, guard_of
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 

@@ -17,7 +17,7 @@ import pytest
 
 from tests.support.browser import text_input
 from tests.support.protocol import decode_batch, wait_for
-from tpm_viz.app.typed import QUIET
+from tpm_viz.ui.typed import QUIET
 
 pytestmark = pytest.mark.browser
 

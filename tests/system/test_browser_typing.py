@@ -2,7 +2,7 @@
 
 ``5e-1`` typed key by key into the Player's Duration (viser's number inputs dropped the ``e``: T became 0.01 s)
 gives T = 0.5 s, shown in the player's summary; a refused CSV gets its refusal under the upload button and never
-the page's own green "File uploaded successfully" toast (hidden by ``ui/transport.py`` before the last part is
+the page's own green "File uploaded successfully" toast (hidden by ``viserkit/transport.py`` before the last part is
 acknowledged), and a later good file clears the refusal. All GUI inputs share a 50 ms throttle in viser's
 client: we pause.
 """

@@ -19,7 +19,7 @@ from tests.support.browser import text_input
 from tests.support.pages import ADDRESSES, TOKEN, Page, classroom_app, views_of
 from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz import InputError
-from tpm_viz.app.access import MAX_FAILURES, MAX_FAILURES_SERVER, Access
+from tpm_viz.classroom.access import MAX_FAILURES, MAX_FAILURES_SERVER, Access
 from tpm_viz.ui.app import TpmApp, build_server
 from tpm_viz.ui.classroom import same_origin
 

@@ -18,7 +18,7 @@ from tests.support.protocol import ProtocolClient, wait_for
 from tests.ui.test_reliability_app import assert_valid
 from tpm_viz import Params
 from tpm_viz.app import transitions
-from tpm_viz.ui.guard import ACTIVITY, guarded
+from tpm_viz.classroom.guard import ACTIVITY, guarded
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
@@ -290,8 +290,8 @@ def test_a_background_thread_that_dies_is_logged(monkeypatch, caplog):
 
 def test_a_bug_in_a_background_job_is_logged_and_the_worker_carries_on(caplog):
     """The worker (maps, trajectory runs) logs a job's bug with its traceback through the guard and keeps going."""
-    from tpm_viz.ui.guard import ACTIVITY
-    from tpm_viz.ui.worker import Worker
+    from tpm_viz.classroom.guard import ACTIVITY
+    from tpm_viz.classroom.worker import Worker
 
     worker, results = Worker(), []
     errors_before = ACTIVITY.snapshot()[1]

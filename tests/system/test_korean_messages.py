@@ -16,7 +16,6 @@ import pytest
 
 from tpm_viz import Params
 from tpm_viz.app import sessions, transitions
-from tpm_viz.app.access import Access
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES, read_upload
 from tpm_viz.app.moves import Pose
 from tpm_viz.app.planner import Limits
@@ -24,6 +23,7 @@ from tpm_viz.app.planning import parse_waypoints
 from tpm_viz.app.readouts import evaluate
 from tpm_viz.app.runs import Source, build_run
 from tpm_viz.app.state import AppState
+from tpm_viz.classroom.access import Access
 from tpm_viz.errors import TpmVizError
 from tpm_viz.numbers import unit_factor
 from tpm_viz.paper.kinematics import forward_kinematics

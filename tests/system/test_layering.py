@@ -12,10 +12,12 @@ Layers, bottom up (a module may import its own layer and the layers its rule lis
 - ``exchange/``: model files written from the parameters (no simulator imported);
 - ``multibody/``: the only place that imports pinocchio;
 - ``app/``: pure app behaviour, no viser, no pinocchio;
-- ``classroom/``: the classroom's store, identities, saving and jobs: the standard library, base, paper, app and
-  platformdirs (no viser);
+- ``classroom/``: the classroom's shared state (sessions, drags, snapshot, pacing, access), store, identities, saving
+  and jobs: the standard library, base, paper, drawing, app and platformdirs (no viser);
+- ``viserkit/``: the adapter, the only place that touches viser's or websockets' internals: base, app, classroom,
+  viser and websockets;
 - ``cluster`` (``tpm_viz/cluster.py``): the only place that imports Dask (the optional extra ``.[cluster]``);
-- ``ui/``: the only place that imports viser; its private names only in ``ui/_viser.py``;
+- ``ui/``: the per-tab views through viser's public API (its private names only in ``viserkit/``);
 - ``cli/``: may import every layer; nothing imports it but ``__main__``.
 """
 
@@ -45,14 +47,28 @@ RULES: dict[str, tuple[set[str], set[str]]] = {
     "exchange": ({"base", "paper", "exchange"}, {"numpy"}),
     "multibody": ({"base", "paper", "multibody"}, {"numpy", "pinocchio"}),
     "app": ({"base", "paper", "app"}, {"numpy", "toppra", "scipy"}),
-    "classroom": ({"base", "paper", "app", "classroom"}, {"platformdirs"}),
+    "classroom": ({"base", "paper", "drawing", "app", "classroom"}, {"numpy", "platformdirs"}),
+    "viserkit": ({"base", "app", "classroom", "viserkit"}, {"numpy", "viser", "websockets"}),
     "cluster": ({"base", "paper", "app", "cluster"}, {"numpy", "distributed", "dask"}),  # tpm_viz/cluster.py
     "ui": (
-        {"base", "paper", "drawing", "multibody", "app", "reports", "classroom", "ui"},
+        {"base", "paper", "drawing", "multibody", "app", "reports", "classroom", "viserkit", "ui"},
         {"numpy", "trimesh", "viser", "platformdirs", "segno"},
     ),
     "cli": (
-        {"base", "paper", "drawing", "exchange", "multibody", "app", "reports", "classroom", "ui", "cluster", "cli"},
+        {
+            "base",
+            "paper",
+            "drawing",
+            "exchange",
+            "multibody",
+            "app",
+            "reports",
+            "classroom",
+            "viserkit",
+            "ui",
+            "cluster",
+            "cli",
+        },
         {"numpy"},
     ),
     "api": ({"base", "paper"}, set()),  # tpm_viz/__init__.py: the public API
@@ -182,11 +198,11 @@ PRIVATE_VISER = re.compile(
 
 def test_private_viser_names_are_used_in_one_module_only():
     users = {m for m, p in MODULES.items() if PRIVATE_VISER.search(p.read_text())}
-    assert users == {"tpm_viz.ui._viser"}, users
+    assert users == {"tpm_viz.viserkit.core"}, users
 
 
 def test_the_door_to_viser_refuses_an_untested_version_loudly():
-    from tpm_viz.ui._viser import IncompatibleViserError, check_viser
+    from tpm_viz.viserkit.core import IncompatibleViserError, check_viser
 
     check_viser()  # the installed one is the tested one
     with pytest.raises(

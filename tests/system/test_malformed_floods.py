@@ -1,8 +1,8 @@
 """Quiet, bounded faults (issue 23): a GUI update whose id is a list gave one full traceback per message (2,000
 messages: 20,000 log lines) and the tab was never dropped. Malformed ids and fields of any message type are now
 refused at the transport check, every unexpected failure of a tab's callback goes through the per-tab log limit,
-and a tab that keeps sending malformed messages is dropped (:attr:`~tpm_viz.ui.limits.Limits.max_malformed` in
-:attr:`~tpm_viz.ui.limits.Limits.malformed_window` seconds). Servers on 127.0.0.1, port 0; protocol-level clients.
+and a tab that keeps sending malformed messages is dropped (:attr:`~tpm_viz.viserkit.limits.Limits.max_malformed` in
+:attr:`~tpm_viz.viserkit.limits.Limits.malformed_window` seconds). Servers on 127.0.0.1, port 0; protocol-level clients.
 """
 
 from __future__ import annotations
@@ -13,9 +13,9 @@ import pytest
 
 from tests.support.fixtures import open_tab
 from tests.support.protocol import wait_for
-from tpm_viz.ui import guard
-from tpm_viz.ui.guard import ACTIVITY, report
-from tpm_viz.ui.limits import guard_of
+from tpm_viz.classroom import guard
+from tpm_viz.classroom.guard import ACTIVITY, report
+from tpm_viz.viserkit.limits import guard_of
 
 FLOOD = 2000
 

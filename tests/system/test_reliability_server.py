@@ -7,7 +7,7 @@ with NaN or far-away positions), the *observer* only watches the shared mechanis
 example the test waits until every callback has run (``guard.ACTIVITY``) and checks: no callback raised, every
 session holds a valid state, every number in the actor's widgets and in both scenes is finite, no text shows NaN
 or inf, and the observer never got a message meant for the actor. (NaN and inf in a GUI update are dropped by
-``ui/transport.py`` before any callback; the callbacks' own refusal of them is covered by the pure tests.)
+``viserkit/transport.py`` before any callback; the callbacks' own refusal of them is covered by the pure tests.)
 
 A deterministic sweep sends each of 21 nasty values to each of 24 fields (540 messages, each followed by Enter in a
 typed field); the property test 300 examples x 1-5 messages (+ an Apply and a sync click each): ~870 generated
@@ -31,7 +31,7 @@ from tests.support.fake_viser import assert_clean
 from tests.support.hypo import examples
 from tests.support.protocol import ProtocolClient, wait_for
 from tests.ui.test_reliability_app import CSV_TEXT, GOOD_ROWS, NASTY_FLOAT, _timed, assert_valid
-from tpm_viz.ui.guard import ACTIVITY
+from tpm_viz.classroom.guard import ACTIVITY
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
@@ -179,7 +179,7 @@ def _scene_values(view):
 def two_tabs(app, connect, monkeypatch):
     """The actor and the observer; exceptions reported by the background worker or escaping a thread fail the test
     (they would be lines in the server log)."""
-    import tpm_viz.ui.worker as worker_module
+    import tpm_viz.classroom.worker as worker_module
 
     crashes: list[BaseException] = []
     monkeypatch.setattr(worker_module, "report", lambda exc, *a, **k: crashes.append(exc))

@@ -26,10 +26,10 @@ import tpm_viz.ui.app as app_module
 from tests.support.fixtures import open_tab
 from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz import InputError
-from tpm_viz.app.access import LOCKOUT_SECONDS, MAX_FAILURES, Access, AccessDenied
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES
-from tpm_viz.ui.guard import ACTIVITY
-from tpm_viz.ui.session import Session
+from tpm_viz.classroom.access import LOCKOUT_SECONDS, MAX_FAILURES, Access, AccessDenied
+from tpm_viz.classroom.guard import ACTIVITY
+from tpm_viz.classroom.session import Session
 
 TOKEN = "s3cret-Token"
 UI = Path(__file__).resolve().parents[2] / "tpm_viz" / "ui"
@@ -406,7 +406,9 @@ def test_student_drags_never_swallow_the_presenters(presenter_app, pconnect, mon
 
 def test_presenter_login_is_rate_limited_per_address(presenter_app, pconnect):
     guesser, gv = pconnect()
-    for k in range(MAX_FAILURES):  # one at a time: repeated clicks queued behind a running one merge (ui/limits.py)
+    for k in range(
+        MAX_FAILURES
+    ):  # one at a time: repeated clicks queued behind a running one merge (viserkit/limits.py)
         calls = ACTIVITY.snapshot()[0]
         _login(guesser, gv, f"guess-{k}")
         wait_for(lambda calls=calls: ACTIVITY.snapshot()[0] > calls and gv.login.token.value == "", what="a try")

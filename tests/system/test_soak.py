@@ -22,7 +22,7 @@ import pytest
 
 from tests.support.protocol import ProtocolClient, wait_for
 from tests.ui.test_reliability_app import assert_valid
-from tpm_viz.ui.guard import ACTIVITY
+from tpm_viz.classroom.guard import ACTIVITY
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 

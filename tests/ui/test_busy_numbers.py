@@ -1,5 +1,6 @@
-"""A busy server draws a dragged own copy's mechanism at every commit and its numbers less often (ui/session.py,
-app/pacing.py ``BUSY_NUMBERS_INTERVAL``): with the pacer pacing, the panel of a copy dragged for 1.2 s is refreshed
+"""A busy server draws a dragged own copy's mechanism at every commit and its numbers less often (classroom/session.py,
+classroom/pacing.py ``BUSY_NUMBERS_INTERVAL``): with the pacer pacing, the panel of a copy dragged for 1.2 s is
+refreshed
 at the start, once a second and at the end, however many commits there were; without pacing it keeps its 4 Hz.
 The mechanism itself follows every commit either way, and the numbers shown at the end are those of the last pose,
 with both models."""
@@ -12,11 +13,11 @@ import numpy as np
 import pytest
 
 from tests.support.protocol import wait_for
-from tpm_viz.app.pacing import BUSY_NUMBERS_INTERVAL
 from tpm_viz.app.readouts import Load
+from tpm_viz.classroom.pacing import BUSY_NUMBERS_INTERVAL
+from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.paper.dynamics import inverse_dynamics
 from tpm_viz.ui import panels
-from tpm_viz.ui.snapshot import Snapshot
 
 
 class Clock:

@@ -1,4 +1,5 @@
-"""Where and when drags are committed (ui/dragging.py): never on the event loop (it must stay free to read and send
+"""Where and when drags are committed (classroom/dragging.py): never on the event loop (it must stay free to read and
+send
 every tab's messages), one drain per session, and a drain scheduled for a session is that session's even if the tab
 that scheduled it switched to its own copy meanwhile (the shared mechanism must never be left with a drain that
 nobody runs)."""
@@ -10,7 +11,7 @@ import threading
 import numpy as np
 
 from tests.support.protocol import wait_for
-from tpm_viz.ui.drags import PendingDrag
+from tpm_viz.classroom.drags import PendingDrag
 
 
 def _state(view):

@@ -1,4 +1,5 @@
-"""The drag queue of a session (tpm_viz.ui.drags): latest value wins across tabs, late drags never undo newer ones."""
+"""The drag queue of a session (tpm_viz.classroom.drags): latest value wins across tabs, late drags never undo newer
+ones."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import weakref
 
 import numpy as np
 
-from tpm_viz.ui.drags import DragQueue, PendingDrag
+from tpm_viz.classroom.drags import DragQueue, PendingDrag
 
 
 class Tab:

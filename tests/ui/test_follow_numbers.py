@@ -1,4 +1,4 @@
-"""Mid-drag, a dashboard shows the numbers of a frame at most ``LIVE_NUMBERS_INTERVAL`` old (ui/snapshot.py
+"""Mid-drag, a dashboard shows the numbers of a frame at most ``LIVE_NUMBERS_INTERVAL`` old (classroom/snapshot.py
 ``Snapshot.follow``): watching tabs refresh their panels in turn, one at nearly every commit, and each refresh of a
 new frame would evaluate the reference (Pinocchio) model again. Checked on a hub with 120 watching tabs: a 2 s drag
 at 20 Hz evaluates the reference model about 2 / 0.25 times, not 40; the numbers a dashboard shows are those of one
@@ -11,13 +11,13 @@ import dataclasses
 import numpy as np
 import pytest
 
-from tpm_viz.app.pacing import LIVE_NUMBERS_INTERVAL
 from tpm_viz.app.state import AppState
+from tpm_viz.classroom import snapshot
+from tpm_viz.classroom.pacing import LIVE_NUMBERS_INTERVAL
+from tpm_viz.classroom.session import Hub
 from tpm_viz.multibody import inverse_dynamics as pinocchio_inverse_dynamics
 from tpm_viz.paper.kinematics import forward_kinematics
 from tpm_viz.params import Params
-from tpm_viz.ui import snapshot
-from tpm_viz.ui.session import Hub
 from tpm_viz.words import Lang
 
 P = Params.paper()

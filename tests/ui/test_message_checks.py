@@ -1,4 +1,4 @@
-"""The type check of every incoming message (ui/transport.py ``message_problem``), built once per message class: a
+"""The type check of every incoming message (viserkit/transport.py ``message_problem``), built once per message class: a
 valid message passes, and each kind of wrong field is named with its fix-worthy problem (the expected lines are
 written here by hand). Also the real viser messages a tab sends while dragging and uploading."""
 
@@ -11,7 +11,7 @@ from typing import Any, Literal, Optional
 import pytest
 from viser import _messages
 
-from tpm_viz.ui.transport import message_problem
+from tpm_viz.viserkit.transport import message_problem
 
 
 @dataclass

@@ -258,7 +258,7 @@ def test_demos_set_mechanism_trajectory_camera_and_explorer(connect):
 
 
 def test_presenter_mode_refuses_player_inputs_from_students(app, connect):
-    from tpm_viz.app.access import Access
+    from tpm_viz.classroom.access import Access
 
     client, view = connect()
     app.hub.access = Access("secret")

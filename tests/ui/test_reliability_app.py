@@ -32,9 +32,9 @@ from tpm_viz.app import transitions as T
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES, read_choice, read_flag, read_number, read_upload, read_vec2
 from tpm_viz.app.moves import check, ik_branch
 from tpm_viz.app.state import AppState
+from tpm_viz.classroom.session import Hub
 from tpm_viz.paper.status import PoseStatus
 from tpm_viz.params import PARAM_INFO
-from tpm_viz.ui.session import Hub
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 

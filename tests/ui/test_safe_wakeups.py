@@ -1,6 +1,6 @@
 """viser wakes its senders with ``asyncio.Event.set()`` from whatever thread pushes a message. From a callback thread
 that races the event loop adding a waiter ("deque mutated during iteration", seen in the server log under
-``bench_load.py --mode hall``) and can leave a sender asleep for good. ``safe_wakeups`` (ui/_viser.py) hands the
+``bench_load.py --mode hall``) and can leave a sender asleep for good. ``safe_wakeups`` (viserkit/core.py) hands the
 wake-up to the loop instead; here four threads push while thirty senders wait and clear, as viser's do for a
 broadcast: no push raises, and no sender misses a wake-up (a lost one times out)."""
 
@@ -12,7 +12,7 @@ import threading
 
 from viser.infra._async_message_buffer import AsyncMessageBuffer
 
-from tpm_viz.ui._viser import safe_wakeups
+from tpm_viz.viserkit.core import safe_wakeups
 
 PUSHES = 4 * 2000
 

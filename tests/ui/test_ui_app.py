@@ -355,7 +355,7 @@ def test_a_class_pulling_the_shared_platform_at_once_is_paced_and_the_latest_dra
     """Seven tabs pulling the shared mechanism at once: drag commits are at least SHARED_DRAG_INTERVAL
     apart (latest value wins in between), the mechanism is drawn once per commit in the broadcast scope whatever
     the number of tabs, every tab shows the same state, and no drag is left stranded."""
-    from tpm_viz.ui import dragging
+    from tpm_viz.classroom import dragging
 
     tabs = [connect() for _ in range(7)]
     hub = app.hub

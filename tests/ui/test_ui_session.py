@@ -1,4 +1,4 @@
-"""Shared and private sessions, the lock, and validation of incoming widget values (tpm_viz.ui.session)."""
+"""Shared and private sessions, the lock, and validation of incoming widget values (tpm_viz.classroom.session)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import pytest
 from tpm_viz import InputError, Params
 from tpm_viz.app.moves import Pose
 from tpm_viz.app.state import AppState
-from tpm_viz.ui.session import Hub, read_number, read_vec2
+from tpm_viz.classroom.session import Hub, read_number, read_vec2
 
 P = Params.paper()
 

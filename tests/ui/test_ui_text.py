@@ -1,4 +1,4 @@
-"""Formatting of the panel (tpm_viz.ui.text): units, guards against NaN and infinity, banner levels."""
+"""Formatting of the panel (tpm_viz.classroom.text): units, guards against NaN and infinity, banner levels."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from tpm_viz.app.moves import Pose
 from tpm_viz.app.poses import preset_pose
 from tpm_viz.app.readouts import Forces, Load, evaluate
 from tpm_viz.app.state import AppState
-from tpm_viz.ui.text import banner_level, dashboard_html, force_scale, legend_html, num
+from tpm_viz.classroom.text import banner_level, dashboard_html, force_scale, legend_html, num
 
 P = Params.paper()
 

@@ -2,7 +2,7 @@
 
 Two routes, both through the websocket as a browser sends an upload:
 
-- the transport's refusal of a file larger than the limit (``tpm_viz.ui.transport.harden``, before any byte is
+- the transport's refusal of a file larger than the limit (``tpm_viz.viserkit.transport.harden``, before any byte is
   buffered), on a bare viser server whose tab is Korean or English (``harden(client, lang=...)``): the notification
   the page receives (``NotificationShowMessage``) is read from the wire;
 - the player's refusal of a file it reads (``tpm_viz.app.inputs.read_upload``), in a tab of the app switched to
@@ -21,7 +21,7 @@ import pytest
 from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES
 from tpm_viz.ui.app import build_server
-from tpm_viz.ui.transport import harden
+from tpm_viz.viserkit.transport import harden
 from tpm_viz.words import Lang
 
 HANGUL = re.compile("[\uac00-\ud7a3]")

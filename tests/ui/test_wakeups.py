@@ -1,4 +1,5 @@
-"""Waking viser's senders once per loop turn (``ui/wakeups.py``): a thread that asks for a thousand wake-ups while the
+"""Waking viser's senders once per loop turn (``viserkit/wakeups.py``): a thread that asks for a thousand wake-ups
+while the
 loop is busy costs one self-pipe write, every callback still runs (once, in the order first asked), a call on the
 loop thread writes nothing, a closed loop refuses like asyncio's, and one failing callback does not stop the others.
 Also: viser's buffers see their loop through one shared :class:`Wakeups` once :func:`safe_wakeups` is installed."""
@@ -11,8 +12,8 @@ import threading
 import pytest
 from viser.infra._async_message_buffer import AsyncMessageBuffer
 
-from tpm_viz.ui._viser import safe_wakeups
-from tpm_viz.ui.wakeups import Wakeups
+from tpm_viz.viserkit.core import safe_wakeups
+from tpm_viz.viserkit.wakeups import Wakeups
 
 
 class CountingLoop(asyncio.SelectorEventLoop):

@@ -1,4 +1,5 @@
-"""The leaner senders (ui/windows.py, installed by ``_viser.lean_senders``) send exactly the windows viser's own window
+"""The leaner senders (viserkit/windows.py, installed by ``_viser.lean_senders``) send exactly the windows viser's
+own window
 loop sends; a window of the shared buffer is encoded once for every tab, in viser's wire format; one pause timer
 serves every tab of a buffer, and a flush ends the pause."""
 
@@ -14,8 +15,8 @@ import zstandard
 from viser import _messages
 from viser.infra._async_message_buffer import AsyncMessageBuffer
 
-from tpm_viz.ui._viser import _WINDOW_LOOP, lean_senders, safe_wakeups
-from tpm_viz.ui.windows import Frames, Tick, encoder, window_loop
+from tpm_viz.viserkit.core import _WINDOW_LOOP, lean_senders, safe_wakeups
+from tpm_viz.viserkit.windows import Frames, Tick, encoder, window_loop
 
 MARKER = _messages.ReplayDoneMessage()
 

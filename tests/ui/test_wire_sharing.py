@@ -1,4 +1,4 @@
-"""Each outgoing message is serialised once for every tab it goes to (ui/_viser.py ``share_serialization``), and
+"""Each outgoing message is serialised once for every tab it goes to (viserkit/core.py ``share_serialization``), and
 what a tab receives is exactly what viser's own serialisation gives, wherever the message falls in a window."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from viser import _messages
 
-from tpm_viz.ui._viser import _SERIALIZE, share_serialization
+from tpm_viz.viserkit.core import _SERIALIZE, share_serialization
 
 
 @pytest.fixture(autouse=True)

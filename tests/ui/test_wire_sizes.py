@@ -1,4 +1,5 @@
-"""The watchdog's size of a queued message (ui/wire.py ``message_bytes``) runs in its own thread while the event loop
+"""The watchdog's size of a queued message (viserkit/wire.py ``message_bytes``) runs in its own thread while the
+event loop
 may add to the message's dict (the shared serialisation stores its wire dict there): it must never fail with
 "dictionary changed size during iteration", which stopped the watchdog in a lecture-hall run."""
 
@@ -6,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tpm_viz.ui.wire import message_bytes
+from tpm_viz.viserkit.wire import message_bytes
 
 
 class _Message:

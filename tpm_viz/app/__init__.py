@@ -1,5 +1,5 @@
 """Pure app behaviour, no browser: the app's state, its transitions, input readers, interactive moves, special
-poses, readouts, trajectory runs, lessons, floor overlays, the equations panel, the presenter policy, who a connection
+poses, readouts, trajectory runs, lessons, floor overlays, the equations panel, who a connection
 comes from (:mod:`.network`), share links (:mod:`.links`), and the design studio (:mod:`.design`, :mod:`.atlas`,
 :mod:`.compare`).
 

@@ -8,7 +8,7 @@ end); values that are not numbers at all (NaN, inf, text, wrong length) are refu
 
 The CSV trajectory upload goes through :func:`read_upload` only (size, encoding, row count, finiteness, timing),
 whichever widget receives it. :func:`value_problem` is the first, kind-level check of any widget value, applied to
-every GUI message before a callback runs (``ui/transport.py``): a number for a number, a boolean for a checkbox,
+every GUI message before a callback runs (``viserkit/transport.py``): a number for a number, a boolean for a checkbox,
 text of at most :data:`MAX_TEXT` characters, a tuple of the widget's length (its answer is a log line, in English:
 a browser never sends such a value, so no user reads it).
 
@@ -57,7 +57,7 @@ MAX_TEXT = 1000
 """Longest text a text input accepts [characters] (the presenter token is far shorter)."""
 TOO_LARGE = T("the file is too large ({size} bytes; at most {most} bytes)")
 """The refusal of an upload beyond the size limit (raise ``Phrase(TOO_LARGE.template, size=..., most=...)``; also
-the transport's, ``tpm_viz.ui.transport``, which refuses it before any byte is buffered)."""
+the transport's, ``tpm_viz.viserkit.transport``, which refuses it before any byte is buffered)."""
 
 
 def value_problem(current: object, value: object, max_text: int = MAX_TEXT) -> str | None:

@@ -1,4 +1,10 @@
-"""The classroom's memory and identities, without viser: what survives a restart and who may claim it.
+"""The classroom without viser: the shared state every tab draws, what survives a restart and who may claim it.
+
+- :mod:`.session`: the hub, the sessions (shared or a tab's own copy) and their lock; :mod:`.snapshot` (one
+  committed state drawn once for all tabs) and :mod:`.text` (the panel's texts); :mod:`.drags` and
+  :mod:`.dragging` (when a drag is committed); :mod:`.pacing` (how often tabs redraw); :mod:`.access` (who may
+  change what); :mod:`.worker` (a tab's slow jobs on :mod:`.jobs`); :mod:`.guard` (callbacks that never take the
+  server down, the bounded fault log).
 
 - :mod:`.store`: the store (a :class:`~.store.Store` protocol, :class:`~.store.SqliteStore` over the standard
   library's ``sqlite3``): the lecture in its own record, each remembered browser's tabs in its own record, uploaded
@@ -14,5 +20,6 @@
 - :mod:`.jobs`: the fair queue of every tab's heavy jobs (runs, maps, control lab, planner): one pending job per tab
   and kind (latest wins), light tabs before flooders, bounded per tab and in total, a small thread pool.
 
-Layer rule (tests/system/test_layering.py): the standard library, the base layer, ``paper`` and ``app`` only.
+Layer rule (tests/system/test_layering.py): the standard library, the base layer, ``paper``, the drawing layer and
+``app`` only.
 """

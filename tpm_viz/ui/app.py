@@ -30,15 +30,25 @@ from pathlib import Path
 import viser
 
 from tpm_viz import multibody
-from tpm_viz.app.access import Access
 from tpm_viz.app.lessons import Demo, load_lessons
 from tpm_viz.app.network import HostRules, Network
 from tpm_viz.app.readouts import Reference
 from tpm_viz.app.state import AppState
+from tpm_viz.classroom.access import Access
+from tpm_viz.classroom.guard import guard_executor, guarded, log, log_fault, report
 from tpm_viz.classroom.identity import Keys
+from tpm_viz.classroom.session import Hub
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.params import Params
-from tpm_viz.ui._viser import (
+from tpm_viz.ui.classroom import Classroom, Handshakes, local_addresses, qr_text, student_urls
+from tpm_viz.ui.client import ClientView
+from tpm_viz.ui.continuity import LectureStore, lecture_store
+from tpm_viz.ui.login import LoginPanel
+from tpm_viz.ui.look import dock_panel
+from tpm_viz.ui.room import Room
+from tpm_viz.ui.scene import MechanismScene, camera_pose
+from tpm_viz.ui.teaching.tabs import Services
+from tpm_viz.viserkit.core import (
     check_viser,
     disable_share_url,
     hook_handshakes,
@@ -47,18 +57,8 @@ from tpm_viz.ui._viser import (
     share_serialization,
     thread_pool,
 )
-from tpm_viz.ui.classroom import Classroom, Handshakes, local_addresses, qr_text, student_urls
-from tpm_viz.ui.client import ClientView
-from tpm_viz.ui.continuity import LectureStore, lecture_store
-from tpm_viz.ui.guard import guard_executor, guarded, log, log_fault, report
-from tpm_viz.ui.limits import DEFAULT_MAX_CONNECTIONS, harden_server, set_max_connections
-from tpm_viz.ui.login import LoginPanel
-from tpm_viz.ui.look import dock_panel
-from tpm_viz.ui.room import Room
-from tpm_viz.ui.scene import MechanismScene, camera_pose
-from tpm_viz.ui.session import Hub
-from tpm_viz.ui.teaching.tabs import Services
-from tpm_viz.ui.transport import harden
+from tpm_viz.viserkit.limits import DEFAULT_MAX_CONNECTIONS, harden_server, set_max_connections
+from tpm_viz.viserkit.transport import harden
 from tpm_viz.words import Lang, Phrase, say
 
 __all__ = ["TpmApp", "build_server", "main"]
@@ -93,7 +93,8 @@ def build_server(
     ``Host`` names it answers to and the trusted proxies (default: this machine's names and addresses, no proxy);
     ``keys``: the identity cookies' keys (default: the process's, :data:`~.classroom.DEFAULT_KEYS`).
 
-    Raises :class:`~tpm_viz.ui._viser.IncompatibleViserError` (one line) if the installed viser is not the tested one.
+    Raises :class:`~tpm_viz.viserkit.core.IncompatibleViserError` (one line) if the installed viser is not the tested
+    one.
     """
     check_viser()
     safe_wakeups()  # viser's senders woken safely from the callback threads (before its buffers exist)
@@ -105,9 +106,9 @@ def build_server(
     ):  # same-origin check; viser prints its own banner even with verbose=False
         server = viser.ViserServer(host=host, port=port, label="tpm-viz", verbose=False)
     disable_share_url(server)
-    share_serialization()  # a broadcast message is serialised once, not once per tab (ui/_viser.py)
+    share_serialization()  # a broadcast message is serialised once, not once per tab (viserkit/core.py)
     guard_executor(thread_pool(server))  # every callback's exception is logged
-    harden_server(server)  # one tab cannot freeze or fill the server (ui/limits.py)
+    harden_server(server)  # one tab cannot freeze or fill the server (viserkit/limits.py)
     server.gui.configure_theme(
         control_width="large", show_share_button=False, show_logo=False, brand_color=BRAND, dark_mode=False
     )

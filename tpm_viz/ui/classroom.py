@@ -4,7 +4,8 @@
   so that tests inject theirs); :func:`student_urls` turns the bound host into the URLs to hand out (never a
   loopback address: on a student's phone 127.0.0.1 is the phone itself); :func:`qr_text` / :func:`qr_data_uri`
   draw one of them as a QR code (``segno``) for the terminal and the lecturer's panel.
-- :class:`Handshakes` sees every HTTP request and websocket handshake (:func:`~._viser.hook_handshakes`): a
+- :class:`Handshakes` sees every HTTP request and websocket handshake
+(:func:`~tpm_viz.viserkit.core.hook_handshakes`): a
   websocket whose ``Origin`` is not the host the page was served under is refused with 403 (the same-origin check
   Jupyter's server makes: any page open in the lecturer's browser could otherwise drive the mechanism on
   127.0.0.1); a client without ``Origin`` (not a browser) may connect. The page's response sets a
@@ -166,7 +167,8 @@ def identity(remote: Any, headers: Any, keys: Keys = DEFAULT_KEYS) -> str | None
 
 
 class Handshakes:
-    """The hook of :func:`~._viser.hook_handshakes`: refuse cross-origin websockets, give pages an identity."""
+    """The hook of :func:`~tpm_viz.viserkit.core.hook_handshakes`: refuse cross-origin websockets, give pages an
+    identity."""
 
     def __init__(self, hosts: HostRules | None = None, keys: Keys | None = None) -> None:
         self.refused = 0

@@ -20,23 +20,23 @@ import viser
 
 from tpm_viz import meshes
 from tpm_viz.app import transitions
-from tpm_viz.app.pacing import watch_phase, watch_slot
 from tpm_viz.app.poses import DEMO_KINDS
 from tpm_viz.app.state import AppState
+from tpm_viz.classroom.dragging import Dragging
+from tpm_viz.classroom.guard import guarded
+from tpm_viz.classroom.pacing import watch_phase, watch_slot
+from tpm_viz.classroom.session import Hub, Session
+from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.params import Params
-from tpm_viz.ui._viser import widget_value
-from tpm_viz.ui.dragging import Dragging
 from tpm_viz.ui.fields import Place, Typing, control
-from tpm_viz.ui.guard import guarded
 from tpm_viz.ui.language import TabWords
 from tpm_viz.ui.login import LoginPanel
 from tpm_viz.ui.look import Look
 from tpm_viz.ui.panels import Panel
 from tpm_viz.ui.scene import MechanismScene
-from tpm_viz.ui.session import Hub, Session
-from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.tabscene import TabScene
 from tpm_viz.ui.teaching.tabs import Services, Teaching
+from tpm_viz.viserkit.core import widget_value
 from tpm_viz.words import Lang, Phrase, say
 
 __all__ = ["ClientView"]
@@ -124,7 +124,8 @@ class ClientView:
     # -- drawing -------------------------------------------------------------------------------------------
     def render(self, frame: Snapshot, *, dragging: bool = False) -> None:
         """Draw this tab's part of ``frame`` (called by the hub under its lock, after the session's mechanism) and
-        flush at once; another tab's intermediate frames once per watch slot (:func:`~tpm_viz.app.pacing.watch_slot`:
+        flush at once; another tab's intermediate frames once per watch slot
+        (:func:`~tpm_viz.classroom.pacing.watch_slot`:
         20 Hz, less in a lecture hall, the tabs in turn)."""
         if self.closed:
             return

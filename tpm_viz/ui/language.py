@@ -1,7 +1,8 @@
 """The language of one browser tab: the *Language* selector, and every text the tab is sent, in that language.
 
 The code writes its fixed texts in English (labels, hints, dropdown options, tab names, static markdown and HTML);
-:class:`TabWords` sits on the tab's connection (:func:`~._viser.reword`) and shows each of them in the tab's
+:class:`TabWords` sits on the tab's connection (:func:`~tpm_viz.viserkit.core.reword`) and shows each of them in the
+tab's
 language on the way out (:func:`tpm_viz.words.shown`: a whole text that is a template of the catalogue;
 :func:`tpm_viz.words.shown_html`: each text between two tags of HTML). The Python side keeps the English: a
 dropdown's value is still ``"static"`` for the callbacks, whatever the page shows, and the choice the page sends
@@ -21,8 +22,8 @@ from __future__ import annotations
 import threading
 from typing import Any
 
-from tpm_viz.ui._viser import reword
-from tpm_viz.ui.guard import guarded
+from tpm_viz.classroom.guard import guarded
+from tpm_viz.viserkit.core import reword
 from tpm_viz.words import Lang, preferred, shown, shown_html
 
 __all__ = ["LABEL", "TabWords", "show_text"]

@@ -14,8 +14,8 @@ from typing import Any, Protocol
 import viser
 
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES
+from tpm_viz.classroom.guard import guarded
 from tpm_viz.ui.classroom import qr_data_uri
-from tpm_viz.ui.guard import guarded
 
 __all__ = ["Lecture", "LecturerPanel", "join_html"]
 

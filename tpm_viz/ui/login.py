@@ -1,4 +1,4 @@
-"""The *Presenter login* folder of one tab (presenter mode: :mod:`tpm_viz.app.access`).
+"""The *Presenter login* folder of one tab (presenter mode: :mod:`tpm_viz.classroom.access`).
 
 viser 1.1.1 has no password input (its text field is a plain Mantine ``TextInput`` without an ``id`` or a
 ``type``), so the token field is masked by a style rule in the page (``-webkit-text-security: disc``, found by the
@@ -14,7 +14,7 @@ from typing import Any
 
 import viser
 
-from tpm_viz.ui._viser import widget_uuid
+from tpm_viz.viserkit.core import widget_uuid
 from tpm_viz.words import Lang, T, say
 
 __all__ = ["LoginPanel", "mask_css"]

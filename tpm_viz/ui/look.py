@@ -7,7 +7,7 @@ wide: viser's own breakpoint, where it shows the panel as a sheet along the bott
 above it (all but the sheet's handle while the sheet is collapsed), and makes every control at least :data:`TOUCH` CSS
 pixels across (wide equations scroll sideways in their own boxes).
 Either way the canvas is the free part of the screen, so the camera frames the mechanism in the whole canvas
-(:mod:`tpm_viz.app.framing`): the server only needs the canvas's aspect ratio, which each camera message carries.
+(:mod:`tpm_viz.ui.framing`): the server only needs the canvas's aspect ratio, which each camera message carries.
 The camera is framed again when that ratio changes (a rotated phone, a resized window, a collapsed panel), not
 when the viewer orbits or zooms.
 
@@ -32,9 +32,9 @@ import numpy as np
 import viser
 
 from tpm_viz import meshes
-from tpm_viz.app.framing import LIVE_BAND, frame_box
+from tpm_viz.classroom.guard import guarded
 from tpm_viz.params import Params
-from tpm_viz.ui.guard import guarded
+from tpm_viz.ui.framing import LIVE_BAND, frame_box
 from tpm_viz.ui.language import KEEP_ALL
 from tpm_viz.ui.scene import camera_pose
 from tpm_viz.words import Lang, T
@@ -79,7 +79,7 @@ LIVE_GAP = 12
 """Gap between that box and the canvas's left and bottom edges [CSS px]."""
 LIVE_CHROME = 64
 """Height of that box's frame [CSS px]: its grip, its tab and :data:`LIVE_GAP`; the box, frame included, stays
-within the bottom :data:`~tpm_viz.app.framing.LIVE_BAND` of the window that the framing keeps free."""
+within the bottom :data:`~tpm_viz.ui.framing.LIVE_BAND` of the window that the framing keeps free."""
 LIVE_LABEL = T("Warnings and forces")
 """Tab name of the box of banner and forces (presentation mode; shown in the tab's language on the way out)."""
 

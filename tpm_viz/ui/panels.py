@@ -4,7 +4,7 @@ No maths here: the numbers come from a :class:`~tpm_viz.app.readouts.Readout`, f
 Units in labels: mm, N, kg, s, degrees (SI inside; the scale factors come from ``PARAM_INFO``).
 
 Typed numbers (the platform and actuator positions, the load vectors, the parameters) are text fields read through
-:mod:`tpm_viz.app.typed` (:class:`~.fields.TypedBox`: scientific notation and decimal commas, applied on Enter, by
+:mod:`tpm_viz.ui.typed` (:class:`~.fields.TypedBox`: scientific notation and decimal commas, applied on Enter, by
 *Apply* or after a quiet time, never per keystroke; the value in use always shown). Their groups hold values in
 the units of their labels (mm, N, m/s, m/s², kg), as the transitions take them. Refusals and notes are shown next
 to the control that caused them (:class:`~.fields.Note`); the line at the top of the panel is for the others
@@ -21,17 +21,17 @@ import time
 
 import viser
 
-from tpm_viz.app.pacing import LIVE_NUMBERS_INTERVAL
 from tpm_viz.app.poses import DEMO_KINDS
 from tpm_viz.app.readouts import LOAD_MODES, Load
 from tpm_viz.app.state import AppState
 from tpm_viz.app.transitions import MAX_ACCEL, MAX_FORCE, MAX_POSITION, MAX_SPEED
-from tpm_viz.app.typed import QUIET, Quantity, TypedField, TypedGroup, force_note
+from tpm_viz.classroom.pacing import LIVE_NUMBERS_INTERVAL
+from tpm_viz.classroom.snapshot import Snapshot
+from tpm_viz.classroom.text import legend_html
 from tpm_viz.params import PARAM_INFO, Params
-from tpm_viz.ui._viser import widget_uuid
 from tpm_viz.ui.fields import Note, TypedBox
-from tpm_viz.ui.snapshot import Snapshot
-from tpm_viz.ui.text import legend_html
+from tpm_viz.ui.typed import QUIET, Quantity, TypedField, TypedGroup, force_note
+from tpm_viz.viserkit.core import widget_uuid
 from tpm_viz.words import Lang
 
 __all__ = ["ACTUATOR_HINT", "ACTUATOR_LABELS", "PARAM_LABELS", "Panel", "slider_css"]

@@ -16,12 +16,12 @@ from typing import Any
 from tpm_viz.app import sessions
 from tpm_viz.app.sessions import Document, Saved
 from tpm_viz.classroom.away import Away
+from tpm_viz.classroom.guard import guarded, log
 from tpm_viz.errors import TpmVizError
-from tpm_viz.ui._viser import connection_request
 from tpm_viz.ui.classroom import Classroom, identity, student_urls
 from tpm_viz.ui.continuity import LectureStore, lecture_store, reload, restore, saved_of
-from tpm_viz.ui.guard import guarded, log
 from tpm_viz.ui.lecturer import LecturerPanel
+from tpm_viz.viserkit.core import connection_request
 
 __all__ = ["BACK", "KEPT", "Room"]
 

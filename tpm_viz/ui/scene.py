@@ -22,9 +22,9 @@ from tpm_viz.app.overlays import arrow_length, arrow_vector, cached_map
 from tpm_viz.app.palette import PALETTE
 from tpm_viz.app.readouts import Readout
 from tpm_viz.app.state import AppState
+from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.paper.workspace import direct_singularity_locus, inverse_singularity_loci
 from tpm_viz.params import Params
-from tpm_viz.ui.snapshot import Snapshot
 
 __all__ = [
     "ARROW_SHORTEST",

@@ -24,10 +24,10 @@ from typing import Any
 import numpy as np
 import viser
 
+from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.params import Params
-from tpm_viz.ui._viser import drop_gizmo_echo
 from tpm_viz.ui.scene import FAMILIES, GIZMO_Z, LABEL_SCALE, LINE_SCALE, MechanismScene, line_width
-from tpm_viz.ui.snapshot import Snapshot
+from tpm_viz.viserkit.core import drop_gizmo_echo
 
 __all__ = ["PRIVATE_ROOT", "TabScene"]
 

@@ -4,7 +4,7 @@ viser's slider has a number box of its own beside it, which drops what it cannot
 blanks itself on ``abc`` and keeps showing ``-5`` while the slider's 100 Hz is used, and nothing says so. A
 :class:`TypedSlider` is the slider without that box (hidden by the style sheet :func:`row_css`) and, in the same
 row where the box was, a typed field of the app (:class:`~.fields.TypedBox` of one field, read by
-:mod:`tpm_viz.app.typed`: scientific notation, decimal commas, the unit after the number, the slider's range as
+:mod:`tpm_viz.ui.typed`: scientific notation, decimal commas, the unit after the number, the slider's range as
 the accepted range) with its note under the row: the same refusals and "in use" notes as every typed number.
 
 The slider's value is the value in use: a settled text is written into the slider (then ``on_change()`` runs, as
@@ -19,10 +19,10 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from tpm_viz.app.typed import QUIET, Quantity, TypedField, TypedGroup
-from tpm_viz.ui._viser import widget_uuid
+from tpm_viz.classroom.guard import guarded
 from tpm_viz.ui.fields import TypedBox
-from tpm_viz.ui.guard import guarded
+from tpm_viz.ui.typed import QUIET, Quantity, TypedField, TypedGroup
+from tpm_viz.viserkit.core import widget_uuid
 
 __all__ = ["FIELD_WIDTH", "SLIDER_HINT", "Setting", "TypedSlider", "add_sliders", "row_css"]
 

@@ -6,7 +6,7 @@ the wire, so:
 
 - the time marker is a series of its own on a hidden scale ``c`` fixed to ``[0, 1]``: ``-1`` (off the chart)
   everywhere except ``+1`` at the current sample, a spike that draws as a vertical line across the chart;
-- both axes are decided here, once per run (:func:`axes_for`, maths in :mod:`tpm_viz.app.chart_axes`): fixed
+- both axes are decided here, once per run (:func:`axes_for`, maths in :mod:`tpm_viz.ui.chart_axes`): fixed
   ranges, the tick positions and their labels (uPlot's static ``splits`` and ``values``), so the time axis always
   has its ticks whatever the duration, no label reads ``-0``, and the y axis is as wide as its widest label. The
   server does not know how wide the browser draws a chart, so the four charts share one time axis whose labels
@@ -33,9 +33,9 @@ from typing import Any
 import numpy as np
 import viser
 
-from tpm_viz.app.chart_axes import Ticks, text_width, time_ticks, value_ticks
 from tpm_viz.app.palette import hex_colour
 from tpm_viz.app.runs import Run
+from tpm_viz.ui.chart_axes import Ticks, text_width, time_ticks, value_ticks
 from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["CHART_POINTS", "LARGE", "NORMAL", "AxisLook", "Charts", "axes_for", "chart_height", "marker"]
@@ -142,7 +142,7 @@ def _axis(ticks: Ticks, label: str, size: float, look: AxisLook) -> dict[str, An
 
 def y_axis(values, look: AxisLook = NORMAL) -> tuple[Ticks, int]:
     """The ticks of a value axis around ``values`` (display units, any shape) and its width [px]: tick, gap and
-    the widest label (:func:`~tpm_viz.app.chart_axes.text_width`, an upper bound) with a third of an em to spare."""
+    the widest label (:func:`~tpm_viz.ui.chart_axes.text_width`, an upper bound) with a third of an em to spare."""
     y = value_ticks(values, most=5, resolution=RESOLUTION)
     widest = max(text_width(s, look.px) for s in y.labels)
     return y, math.ceil(TICK_PX + GAP_PX + widest + look.px / 3)

@@ -22,12 +22,13 @@ import viser
 from tpm_viz import meshes
 from tpm_viz.app.palette import hex_colour
 from tpm_viz.app.readouts import reason
+from tpm_viz.classroom.guard import guarded
+from tpm_viz.classroom.snapshot import Snapshot
+from tpm_viz.classroom.worker import Worker
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.multibody.control import ControlRun, ControlSetup
 from tpm_viz.paper.control import ControllerKind, axis_masses, model_with_errors
 from tpm_viz.params import Params
-from tpm_viz.ui.guard import guarded
-from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.teaching.control_run import (
     PAPER,
     ControlMotion,
@@ -52,7 +53,6 @@ from tpm_viz.ui.teaching.playing import RunHub
 from tpm_viz.ui.teaching.settings import CONTROL_SETTINGS
 from tpm_viz.ui.teaching.trace import TRACE_Z, segments
 from tpm_viz.ui.typed_sliders import TypedSlider, add_sliders
-from tpm_viz.ui.worker import Worker
 from tpm_viz.words import Phrase, T, say
 
 __all__ = ["CONTROLLERS", "MAGNIFY", "ControlView"]

@@ -8,9 +8,9 @@ from __future__ import annotations
 import html
 
 from tpm_viz.app.run_names import reference_words
+from tpm_viz.classroom.text import num
 from tpm_viz.multibody.control import ControlRun
 from tpm_viz.paper.control import ControllerKind, Gains
-from tpm_viz.ui.text import num
 from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["LABELS", "comparison_html", "gains_html", "label_of", "lesson_html", "run_html", "setup_phrase"]

@@ -25,12 +25,12 @@ import viser
 from tpm_viz import meshes
 from tpm_viz.app.overlays import MAP_KINDS, cached_map, colour_scale, ellipse_polylines, map_rgba
 from tpm_viz.app.readouts import reason
+from tpm_viz.classroom.guard import guarded
+from tpm_viz.classroom.snapshot import Snapshot
+from tpm_viz.classroom.text import num
+from tpm_viz.classroom.worker import Worker
 from tpm_viz.errors import BusyError
 from tpm_viz.params import Params
-from tpm_viz.ui.guard import guarded
-from tpm_viz.ui.snapshot import Snapshot
-from tpm_viz.ui.text import num
-from tpm_viz.ui.worker import Worker
 from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["ELLIPSE_COLOURS", "ELLIPSE_SCALE", "ExplorerView", "MapService"]

@@ -24,11 +24,11 @@ import viser
 from tpm_viz.app.lessons import DEMOS, PROBLEMS, Demo, demo_params, demo_pose, demo_source, effect
 from tpm_viz.app.readouts import Load
 from tpm_viz.app.state import TrajectorySample
+from tpm_viz.classroom.guard import guarded
+from tpm_viz.classroom.session import View
+from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.errors import TpmVizError
-from tpm_viz.ui.guard import guarded
 from tpm_viz.ui.scene import camera_pose
-from tpm_viz.ui.session import View
-from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.teaching.explorer import ExplorerView
 from tpm_viz.ui.teaching.playing import RunHub
 from tpm_viz.words import Lang, Phrase, T, say

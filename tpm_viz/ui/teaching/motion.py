@@ -23,9 +23,9 @@ import viser
 from tpm_viz.app.moves import place
 from tpm_viz.app.readouts import Load
 from tpm_viz.app.state import AppState, TrajectorySample
+from tpm_viz.classroom.guard import report
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.params import Params
-from tpm_viz.ui.guard import report
 from tpm_viz.ui.teaching.charts import LARGE, NORMAL, TICK_PX, AxisLook, marker
 from tpm_viz.words import Phrase
 

@@ -20,17 +20,17 @@ from tpm_viz import meshes
 from tpm_viz.app.palette import hex_colour
 from tpm_viz.app.planning import PATH_KINDS, PlanResult, solve
 from tpm_viz.app.readouts import reason
+from tpm_viz.classroom.guard import guarded
+from tpm_viz.classroom.snapshot import Snapshot
+from tpm_viz.classroom.worker import Worker
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.params import Params
-from tpm_viz.ui.guard import guarded
-from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.teaching.motion import MotionPlayer, TimeChart
 from tpm_viz.ui.teaching.planner_text import industry_html, result_html, sizing_html
 from tpm_viz.ui.teaching.player import SPEEDS
 from tpm_viz.ui.teaching.settings import PLANNER_SETTINGS
 from tpm_viz.ui.teaching.trace import TRACE_Z, segments
 from tpm_viz.ui.typed_sliders import TypedSlider, add_sliders
-from tpm_viz.ui.worker import Worker
 from tpm_viz.words import Phrase, T
 
 __all__ = ["BAR_HEIGHT", "PlanMotion", "PlannerView", "bar_segments", "floor_point"]

@@ -8,7 +8,7 @@ from __future__ import annotations
 import html
 
 from tpm_viz.app.planning import INDUSTRY, PlanResult
-from tpm_viz.ui.text import num
+from tpm_viz.classroom.text import num
 from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["industry_html", "result_html", "sizing_html"]

@@ -20,18 +20,18 @@ import viser
 
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES, read_number, read_upload
 from tpm_viz.app.runs import MAX_DURATION, MIN_DURATION, Source
-from tpm_viz.app.typed import QUIET, Quantity, TypedField, TypedGroup, duration_note, force_note
+from tpm_viz.classroom.guard import guarded
+from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.csvio import format_columns
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.figures import force_plot_png, force_plot_svg
 from tpm_viz.paper.trajectories import DEFAULT_DURATIONS
 from tpm_viz.ui.fields import Note, TypedBox
-from tpm_viz.ui.guard import guarded
-from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.ui.teaching.charts import Charts
 from tpm_viz.ui.teaching.player_text import summary_html
 from tpm_viz.ui.teaching.playing import RunHub, following
 from tpm_viz.ui.teaching.trace import PathTrace
+from tpm_viz.ui.typed import QUIET, Quantity, TypedField, TypedGroup, duration_note, force_note
 from tpm_viz.words import Phrase, T
 
 __all__ = ["CHART_HZ", "SPEEDS", "PlayerView"]

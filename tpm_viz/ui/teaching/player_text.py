@@ -7,7 +7,7 @@ from __future__ import annotations
 import html
 
 from tpm_viz.app.run_names import label_words
-from tpm_viz.ui.text import num
+from tpm_viz.classroom.text import num
 from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["summary_html"]

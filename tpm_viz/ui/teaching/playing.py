@@ -24,9 +24,9 @@ from tpm_viz.app.moves import place
 from tpm_viz.app.readouts import Load, reason
 from tpm_viz.app.runs import Run, Source, build_run
 from tpm_viz.app.state import AppState, TrajectorySample
+from tpm_viz.classroom.session import Hub, Session
+from tpm_viz.classroom.worker import Worker
 from tpm_viz.errors import InputError, TpmVizError
-from tpm_viz.ui.session import Hub, Session
-from tpm_viz.ui.worker import Worker
 from tpm_viz.words import Phrase, T
 
 __all__ = ["FPS", "PlayerSession", "RunHub", "following", "sampled"]

@@ -7,7 +7,7 @@ limit in N with 0 for none, rate in Hz, noise in µm; the planner: F_max in N, s
 
 from __future__ import annotations
 
-from tpm_viz.app.typed import Quantity
+from tpm_viz.ui.typed import Quantity
 from tpm_viz.ui.typed_sliders import Setting
 
 __all__ = ["CONTROL_SETTINGS", "PLANNER_SETTINGS"]

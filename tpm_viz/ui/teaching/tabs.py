@@ -15,8 +15,9 @@ from dataclasses import dataclass
 import viser
 
 from tpm_viz.app.lessons import DEMOS, PROBLEMS, Demo
-from tpm_viz.ui.session import Hub, Session, View
-from tpm_viz.ui.snapshot import Snapshot
+from tpm_viz.classroom.session import Hub, Session, View
+from tpm_viz.classroom.snapshot import Snapshot
+from tpm_viz.classroom.worker import Worker
 from tpm_viz.ui.teaching.control import ControlView
 from tpm_viz.ui.teaching.explorer import ExplorerView, MapService
 from tpm_viz.ui.teaching.lessons import DemosView
@@ -24,7 +25,6 @@ from tpm_viz.ui.teaching.planner import PlannerView
 from tpm_viz.ui.teaching.player import PlayerView
 from tpm_viz.ui.teaching.playing import RunHub
 from tpm_viz.ui.teaching.takeout import TakeOut, takeout_for
-from tpm_viz.ui.worker import Worker
 
 __all__ = ["Services", "Teaching"]
 

@@ -16,10 +16,10 @@ import datetime
 
 import viser
 
+from tpm_viz.classroom.guard import guarded
 from tpm_viz.clips import DEFAULT_FPS, SIZE_PRESETS
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.reports.report import report_html
-from tpm_viz.ui.guard import guarded
 from tpm_viz.ui.teaching.materials import control_material, planner_material, player_material
 from tpm_viz.ui.teaching.recording import SLOTS, Material, Recording
 from tpm_viz.words import Phrase, T, say

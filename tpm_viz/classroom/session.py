@@ -26,15 +26,15 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from tpm_viz.app.access import Access
 from tpm_viz.app.inputs import read_number, read_vec2
-from tpm_viz.app.pacing import BUSY_NUMBERS_INTERVAL, LIVE_NUMBERS_INTERVAL, Pacer
 from tpm_viz.app.readouts import Readout, Reference, evaluate, with_reference
 from tpm_viz.app.state import AppState
+from tpm_viz.classroom.access import Access
+from tpm_viz.classroom.drags import DragQueue
+from tpm_viz.classroom.guard import report
+from tpm_viz.classroom.pacing import BUSY_NUMBERS_INTERVAL, LIVE_NUMBERS_INTERVAL, Pacer
+from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.errors import InputError
-from tpm_viz.ui.drags import DragQueue
-from tpm_viz.ui.guard import report
-from tpm_viz.ui.snapshot import Snapshot
 from tpm_viz.words import Lang, Phrase
 
 __all__ = ["AppState", "Hub", "Session", "View", "read_number", "read_vec2"]
@@ -124,7 +124,8 @@ class Hub:
         self.arrivals = itertools.count()
         """Numbers gizmo events in arrival order (they arrive on the event loop, one at a time)."""
         self.pacer = Pacer()
-        """How often a dragged own copy may be redrawn (:mod:`tpm_viz.app.pacing`): every drag commit if the server
+        """How often a dragged own copy may be redrawn (:mod:`tpm_viz.classroom.pacing`): every drag commit if the
+        server
         keeps up, less often when thirty students drag their own copies at once."""
         self.drag_pool = ThreadPoolExecutor(max_workers=2, thread_name_prefix="tpm-viz-drag")
         """Where drags of a session shown by many tabs are committed: two threads (they serialise on the lock); a
@@ -138,7 +139,8 @@ class Hub:
         return evaluate(state.params, state.pose, state.load, None if live else self.reference)
 
     def frame(self, state: AppState, dragging: bool = False):
-        """The :class:`~tpm_viz.ui.snapshot.Snapshot` of ``state`` with the data every view draws, computed and checked
+        """The :class:`~tpm_viz.classroom.snapshot.Snapshot` of ``state`` with the data every view draws, computed
+        and checked
         before anything changes: raises :class:`~tpm_viz.InputError` if a drawn number is not finite."""
         frame = Snapshot(state, self.evaluate(state, live=dragging), in_drag=dragging)
         if dragging and self.reference is not None:  # both models, computed when displayed (the kinematics once)
@@ -147,10 +149,10 @@ class Hub:
         positions, wxyzs = frame.links
         if not (np.all(np.isfinite(positions)) and np.all(np.isfinite(wxyzs))):
             raise InputError("this pose cannot be drawn (non-finite geometry); the last good state stays")
-        return frame  # its texts print a dash for any non-finite number (tpm_viz.ui.text.num)
+        return frame  # its texts print a dash for any non-finite number (tpm_viz.classroom.text.num)
 
     def authorize(self, view: View, session: Session) -> None:
-        """Raise :class:`~tpm_viz.app.access.AccessDenied` unless ``view`` may change ``session``."""
+        """Raise :class:`~tpm_viz.classroom.access.AccessDenied` unless ``view`` may change ``session``."""
         self.access.check(view, session)
 
     def join(self, view: View, private: bool, session: Session | None = None, scene: Drawing | None = None) -> Session:

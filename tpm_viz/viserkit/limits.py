@@ -38,9 +38,9 @@ from typing import Any
 
 import viser
 
-from tpm_viz.ui._viser import ServerDoor, quiet_decoding, thread_pool, ws_server
-from tpm_viz.ui.guard import FAULTS, log_fault, report
-from tpm_viz.ui.transport import message_problem
+from tpm_viz.classroom.guard import FAULTS, log_fault, report
+from tpm_viz.viserkit.core import ServerDoor, quiet_decoding, thread_pool, ws_server
+from tpm_viz.viserkit.transport import message_problem
 
 __all__ = [
     "DEFAULT_MAX_CONNECTIONS",

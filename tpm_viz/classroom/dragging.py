@@ -3,7 +3,7 @@
 A gizmo event arrives on viser's event loop. It is queued in the session's :class:`~.drags.DragQueue` (latest value
 wins) and one drain per session is scheduled in the hub's drag pool: at once, or when the session's interval since
 its last commit is over (:data:`SHARED_DRAG_INTERVAL` for the shared mechanism, the load-dependent interval of
-:mod:`tpm_viz.app.pacing` for an own copy). The event loop itself never computes a commit: it stays free to read
+:mod:`tpm_viz.classroom.pacing` for an own copy). The event loop itself never computes a commit: it stays free to read
 every tab's messages and send every tab its updates (``benchmarks/bench_load.py --mode hall``: with commits of own
 copies on the loop, the watchers' updates waited behind them). The commit itself is the view's
 (:meth:`~.session.View.commit_drag`).
@@ -16,17 +16,18 @@ import time
 
 import numpy as np
 
+from tpm_viz.classroom.drags import PendingDrag
+from tpm_viz.classroom.guard import guarded
+from tpm_viz.classroom.session import Session, View
 from tpm_viz.errors import TpmVizError
-from tpm_viz.ui.drags import PendingDrag
-from tpm_viz.ui.guard import guarded
-from tpm_viz.ui.session import Session, View
 
 __all__ = ["SHARED_DRAG_INTERVAL", "Dragging"]
 
 SHARED_DRAG_INTERVAL = 0.025
 """Drags of the shared mechanism are committed at most once per this many seconds (40 Hz; latest value wins in
 between), however many students pull it at once: one dragger at the browser's 20 Hz is never delayed, thirty keep
-the server responsive (bench_load.py --mode shared). Own copies are paced by the load (:mod:`tpm_viz.app.pacing`)."""
+the server responsive (bench_load.py --mode shared). Own copies are paced by the load
+(:mod:`tpm_viz.classroom.pacing`)."""
 
 
 def _internal_error(drags: Dragging, exc: Exception) -> None:

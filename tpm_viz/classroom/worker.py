@@ -5,15 +5,15 @@ computation of 20-200 ms inside that lock would stall every other tab's drag. Jo
 :class:`tpm_viz.classroom.jobs.FairJobs`, *outside* the lock: one pending job per tab and kind (latest wins), tabs
 served in turns (the tab served longest ago first), bounded per tab and in all; a job's ``done`` callback publishes
 the result (taking the lock itself, briefly). This module is the thin adapter: the pool size, the log of bugs
-(:func:`~tpm_viz.ui.guard.report`), and the tab a job belongs to.
+(:func:`~tpm_viz.classroom.guard.report`), and the tab a job belongs to.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Hashable
 
+from tpm_viz.classroom.guard import report
 from tpm_viz.classroom.jobs import Done, FairJobs
-from tpm_viz.ui.guard import report
 
 __all__ = ["THREADS", "Worker"]
 

@@ -44,10 +44,10 @@ from viser.infra import _infra
 from viser.infra._async_message_buffer import AsyncMessageBuffer
 
 from tpm_viz.errors import TpmVizError
-from tpm_viz.ui import wire
-from tpm_viz.ui.wakeups import Wakeups, thread_safe_set
-from tpm_viz.ui.windows import Frames, Tick, encoder, producer, window_loop
-from tpm_viz.ui.wire import Malformed
+from tpm_viz.viserkit import wire
+from tpm_viz.viserkit.wakeups import Wakeups, thread_safe_set
+from tpm_viz.viserkit.windows import Frames, Tick, encoder, producer, window_loop
+from tpm_viz.viserkit.wire import Malformed
 
 ws_server = _infra.websockets.asyncio.server  # websockets' server, as viser imported it (not a tpm-viz dependency)
 

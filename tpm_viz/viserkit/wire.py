@@ -1,4 +1,4 @@
-"""Plain helpers of the door to viser's internals (:mod:`._viser`): the shapes of the handlers it swaps, the stand-in
+"""Plain helpers of the door to viser's internals (:mod:`.core`): the shapes of the handlers it swaps, the stand-in
 for an undecodable message, and small functions on messages. Nothing here touches a private viser name."""
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ loop thread, which then runs one wake-up and hands it back. A drag commit of an 
 its 2.9 ms, ``cProfile``), a presenter's commit one per watching tab drawn. :class:`Wakeups` stands in for the loop
 where viser's buffers call it: a call from another thread joins the wake-ups already waiting for the loop (the
 same callback once), a call on the loop thread needs no self-pipe at all. Nothing here touches a private viser
-name: :mod:`._viser` installs it.
+name: :mod:`.core` installs it.
 """
 
 from __future__ import annotations

@@ -84,7 +84,7 @@ class Pacer:
     134 / 242 ms and 0.1 gave 158 / 289 ms. With the cheaper commits of :data:`BUSY_NUMBERS_INTERVAL` and coalesced
     wake-ups (~2 ms), 0.1 gave 134-146 / 272-334 ms against 148-193 / 291-382 ms for 0.2 (runs alternated; the
     server then spends ~85 % of a core whatever the budget: the reading and sending of 150 tabs set it). With the
-    lean senders (:mod:`tpm_viz.ui.windows`) and a 0.5 ms GIL switch interval, 0.1 gives 40 / 61-67 ms (the host
+    lean senders (:mod:`tpm_viz.viserkit.windows`) and a 0.5 ms GIL switch interval, 0.1 gives 40 / 61-67 ms (the host
     taking 3-5 %) and 0.2 gave more queueing (median tab 152 ms against 113 ms in runs alternated before the switch
     interval)."""
     window: float = 0.5

@@ -17,11 +17,11 @@ from tpm_viz import meshes
 from tpm_viz.app.equations import errata_html, procedure_html
 from tpm_viz.app.readouts import Readout
 from tpm_viz.app.state import AppState
+from tpm_viz.classroom.text import dashboard_html
 from tpm_viz.errors import TpmVizError
 from tpm_viz.paper.dynamics import inverse_dynamics_detail
 from tpm_viz.paper.jacobians import jacobians
 from tpm_viz.paper.kinematics import MechanismPose, mechanism_pose
-from tpm_viz.ui.text import dashboard_html
 from tpm_viz.words import Lang, say
 
 __all__ = ["Snapshot"]
@@ -37,7 +37,8 @@ class Snapshot:
         """True for the intermediate frames of a gizmo drag (views may skip costly, non-essential parts)."""
         self.numbers_every: float | None = None
         """Mid-drag, the shortest time [s] between two refreshes of a panel's numbers, or None: the panel's own
-        (a busy server draws the mechanism at every commit and the numbers less often, :mod:`tpm_viz.app.pacing`)."""
+        (a busy server draws the mechanism at every commit and the numbers less often,
+        :mod:`tpm_viz.classroom.pacing`)."""
         self.complete_readout: Callable[[], Readout] | None = None
         """For a live frame whose ``readout`` lacks the reference forces: computes the readout with them."""
         self._dashboards: dict[Lang, str] = {}
@@ -49,7 +50,8 @@ class Snapshot:
     def follow(self, previous: Snapshot | None, within: float) -> None:
         """Mid-drag, let the dashboard show the numbers of ``previous``'s numbers frame if that frame is less than
         ``within`` [s] older than this one. A dashboard is refreshed a few times a second mid-drag, and each tab's
-        at its own commit (watching tabs in turn, :func:`~tpm_viz.app.pacing.watch_slot`): without this, nearly every
+        at its own commit (watching tabs in turn, :func:`~tpm_viz.classroom.pacing.watch_slot`): without this, nearly
+        every
         commit of a watched drag would compute the reference (Pinocchio) forces for some tab's dashboard."""
         if self.in_drag and previous is not None and previous.in_drag:
             if self.made_at - previous.numbers.made_at < within:

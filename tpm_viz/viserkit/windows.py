@@ -15,7 +15,7 @@ lecture hall that work is done 150 times per broadcast update, on the event loop
 The windows themselves are viser's: the same messages in the same order, at most ``max_window_size`` per window, none
 while an atomic block is open, a tab's own echo left out, the end-of-replay marker right after the backlog a new tab
 found, and each tab's cursor kept for viser's garbage collector of the shared buffer. Nothing here touches a private
-viser name: :mod:`._viser` installs it (``lean_senders``), with viser's own encoding.
+viser name: :mod:`.core` installs it (``lean_senders``), with viser's own encoding.
 """
 
 from __future__ import annotations
