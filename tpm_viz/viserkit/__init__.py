@@ -1,10 +1,14 @@
 """The adapter between tpm-viz and viser 1.1.x: every private name of viser or websockets, and every patch, lives here.
 
-- :mod:`.core`: the door (:func:`~.core.check_viser`, the patches installed on one server, handle values read
-  without callbacks);
+- :mod:`.adapter`: the entry point (:func:`~.adapter.new_server`, :func:`~.adapter.install` on one server,
+  :meth:`~.adapter.Installed.remove`);
+- :mod:`.core`: the door to one server's internals (:func:`~.core.check_viser`, handle values read without callbacks);
+- :mod:`.patches`: the few patches that act through a class, guarded to act for tpm-viz's own servers only;
 - :mod:`.wire`, :mod:`.windows`, :mod:`.wakeups`: outgoing messages serialised once, leaner senders, safe wakeups;
 - :mod:`.transport`: malformed or oversized incoming messages and uploads refused before viser handles them;
-- :mod:`.limits`: the websocket server's limits (frame size, URL length, connections per address).
+- :mod:`.limits`: the websocket server's limits (callbacks per tab, backlog, connections, malformed messages);
+- :mod:`.probe`: small public functions for tests and benchmarks (a widget's uuid, a tab's uploads, ...);
+- :mod:`.page`: tpm-viz's own script in viser's page.
 
 See ``PATCHES.md`` beside this file for each patch, why it is there and the test that shows it.
 """

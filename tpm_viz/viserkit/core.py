@@ -1,4 +1,5 @@
-"""The one door to viser's private internals (viser 1.1.x). No other module of tpm-viz touches a private viser name.
+"""The one door to viser's private internals on one server (viser 1.1.x); :mod:`.patches` holds the few patches
+that act through a class, :mod:`.adapter` installs both.
 
 tpm-viz needs these things viser's public API does not offer:
 
@@ -9,58 +10,53 @@ tpm-viz needs these things viser's public API does not offer:
 - a GUI handle's current value without running its callbacks (``handle._impl.value``);
 - a client-scoped gizmo's cross-client echo (``gizmo._impl_aux.sync_cb``), which costs CPU and reaches nobody;
 - the share-URL tunnel, which any client can request: ``server.request_share_url`` is replaced by a no-op;
-- the websocket server under viser (:class:`ServerDoor`, for :mod:`.limits`): each connection's message dispatch
-  (``_handle_incoming_message``, wrapped to drop malformed messages), its outgoing backlog
-  (``_client_state_from_id``), the raw connections (``_live_connections``, to refuse or drop a tab) and the
-  websockets module viser serves with (:data:`ws_server`; :mod:`.limits` replaces the ``ServerProtocol`` it builds per
-  connection: viser accepts 50 MiB frames and answers an over-long URL segment with HTTP 500), and viser's decoding of
-  incoming messages (:func:`quiet_decoding`); a tab's GUI texts and the values it sends (:func:`reword`);
-- outgoing messages: serialised once for every tab (:func:`share_serialization`), senders woken safely from any
-  thread (``AsyncMessageBuffer``'s event: :func:`safe_wakeups`), windows sent with less work per tab (viser's
-  ``_message_producer`` and ``AsyncMessageBuffer._window_loop``: :func:`lean_senders`).
+- the websocket server under viser (:class:`ServerDoor`, for :mod:`.limits` and :mod:`.adapter`): each connection's
+  message dispatch (``_handle_incoming_message``, wrapped to drop malformed messages), its message buffers (the
+  shared one and each tab's: :mod:`.patches` puts the senders' patches on them), its outgoing backlog
+  (``_client_state_from_id``), the raw connections (``_live_connections``, to refuse or drop a tab);
+- a tab's GUI texts and the values it sends (:func:`reword`).
 
 :func:`check_viser` runs when the server is built: the installed viser must be the tested minor version
 (:data:`TESTED`, pinned in ``pyproject.toml``) and every internal above must exist, else the app stops at start with
-one line saying what to install, instead of serving blank pages. ``tests/system/test_security.py`` pins the
-behaviour of each internal.
+one line saying what to install, instead of serving blank pages. ``tests/viserkit/`` shows what each patch is for.
 """
 
 from __future__ import annotations
 
 import asyncio
-import contextlib
 import copy
 import dataclasses
-import functools
-import threading
 import uuid
-import weakref
-from collections.abc import Callable, Iterator
-from typing import Any, cast, get_type_hints
+from collections.abc import Callable
+from typing import Any, cast
 
 import viser
-from viser import _assignable_props_api, _messages
+from viser import _messages
 from viser.infra import _infra
 from viser.infra._async_message_buffer import AsyncMessageBuffer
 
 from tpm_viz.errors import TpmVizError
 from tpm_viz.viserkit import wire
-from tpm_viz.viserkit.wakeups import Wakeups, thread_safe_set
-from tpm_viz.viserkit.windows import Frames, Tick, encoder, producer, window_loop
+from tpm_viz.viserkit.patches import skipped
 from tpm_viz.viserkit.wire import Malformed
 
 ws_server = _infra.websockets.asyncio.server  # websockets' server, as viser imported it (not a tpm-viz dependency)
 
 __all__ = ["TESTED", "ClientDoor", "IncompatibleViserError", "Malformed", "ServerDoor", "check_viser"]
-__all__ += ["connection_request", "disable_share_url", "drop_gizmo_echo", "hook_handshakes", "lean_senders"]
-__all__ += ["quiet_decoding", "reword"]
-__all__ += ["safe_wakeups", "share_serialization", "thread_pool", "widget_uuid", "widget_value", "ws_server"]
+__all__ += ["connection_request", "disable_share_url", "drop_gizmo_echo", "enable_share_url", "reword"]
+__all__ += ["thread_pool", "widget_uuid", "widget_value", "ws_server"]
 
 TESTED = "1.1"
 """The viser minor version tpm-viz is tested with (``pyproject.toml`` pins ``viser>=1.1.1,<1.2``)."""
 
 _SERVER_ATTRS = ("_thread_executor", "request_share_url", "_websock_server")
-_WEBSOCK_ATTRS = ("_client_state_from_id", "_live_connections", "_background_event_loop", "_handle_incoming_message")
+_WEBSOCK_ATTRS: tuple[str, ...] = (
+    "_client_state_from_id",
+    "_live_connections",
+    "_background_event_loop",
+    "_handle_incoming_message",
+)
+_WEBSOCK_ATTRS += ("_client_connect_cb", "_client_disconnect_cb")
 _GUI_METHODS = ("_handle_gui_updates", "_handle_file_transfer_start", "_handle_file_transfer_part")
 _MESSAGES = ("GuiUpdateMessage", "FileTransferStartUpload", "FileTransferPart")
 
@@ -81,7 +77,9 @@ def check_viser(version: str | None = None) -> None:
     missing += [f"_messages.{m}" for m in _MESSAGES if not hasattr(_messages, m)]
     missing += [f"WebsockServer.{a}" for a in _WEBSOCK_ATTRS if not wire.has_attr_or_init(viser.infra.WebsockServer, a)]
     missing += [
-        f"viser.infra._infra.{f}" for f in ("_message_producer", "_append_aligned_buffers") if not hasattr(_infra, f)
+        f"viser.infra._infra.{f}"
+        for f in ("_message_producer", "_message_consumer", "_append_aligned_buffers")
+        if not hasattr(_infra, f)
     ]
     missing += [] if hasattr(AsyncMessageBuffer, "_window_loop") else ["AsyncMessageBuffer._window_loop"]
     if not hasattr(ws_server, "ServerProtocol"):
@@ -96,8 +94,13 @@ def thread_pool(server: viser.ViserServer) -> Any:
 
 
 def disable_share_url(server: viser.ViserServer) -> None:
-    """Make ``server.request_share_url`` a no-op: no outside tunnel, whatever a client asks."""
+    """Make ``server.request_share_url`` a no-op: no outside tunnel, whatever a client asks (this server only)."""
     server.request_share_url = lambda *_args, **_kwargs: None  # type: ignore[method-assign]
+
+
+def enable_share_url(server: viser.ViserServer) -> None:
+    """Undo :func:`disable_share_url`: viser's own ``request_share_url`` again."""
+    server.__dict__.pop("request_share_url", None)
 
 
 def widget_value(handle: Any) -> Any:
@@ -113,6 +116,9 @@ def widget_uuid(handle: Any) -> str:
 def drop_gizmo_echo(gizmo: Any) -> None:
     """Drop viser's cross-client echo of a client-scoped gizmo's drags: it queues two messages per drag event
     addressed to every client but this one, i.e. to nobody (~5 % of the server's CPU with 30 tabs dragging)."""
+    owner = getattr(getattr(getattr(gizmo, "_impl", None), "api", None), "_owner", None)
+    if skipped(owner, "gizmo_echo"):
+        return
     aux = getattr(gizmo, "_impl_aux", None)
     if aux is not None and hasattr(aux, "sync_cb"):
         aux.sync_cb = None
@@ -164,6 +170,8 @@ class ServerDoor:
 
     def __init__(self, server: viser.ViserServer) -> None:
         self._ws: Any = server._websock_server
+        self.removers: list[Callable[[], None]] = []
+        """Undo the callbacks added by :meth:`on_connect` and :meth:`on_disconnect`."""
 
     @property
     def loop(self) -> asyncio.AbstractEventLoop | None:
@@ -179,6 +187,7 @@ class ServerDoor:
             cb(conn.client_id)
 
         self._ws.on_client_connect(connected)
+        self.removers.append(lambda: self._forget(self._ws._client_connect_cb, connected))
 
     def on_disconnect(self, cb: Callable[[int], None]) -> None:
         """Run ``cb(client_id)`` on the event loop when a websocket connection ends, after emptying its outgoing
@@ -193,10 +202,34 @@ class ServerDoor:
             cb(conn.client_id)
 
         self._ws.on_client_disconnect(disconnected)
+        self.removers.append(lambda: self._forget(self._ws._client_disconnect_cb, disconnected))
 
     def wrap_server_dispatch(self, wrap: wire.Wrapper) -> None:
         """Route the messages handled at the server level (server-scoped widgets and scene) through ``wrap``."""
         self._ws._handle_incoming_message = wrap(self._ws._handle_incoming_message)
+
+    def unwrap_server_dispatch(self) -> None:
+        """Undo :meth:`wrap_server_dispatch` (viser's own dispatch again)."""
+        self._ws.__dict__.pop("_handle_incoming_message", None)
+
+    def shared_buffer(self) -> Any:
+        """The message buffer every tab is sent (``AsyncMessageBuffer``, persistent)."""
+        return self._ws._broadcast_buffer
+
+    def on_new_buffer(self, cb: Callable[[Any], None]) -> Callable[[], None]:
+        """Run ``cb(buffer)`` on the event loop with each new connection's own message buffer, before any other
+        connect callback (viser's included) and before its sender starts. -> a function that stops it."""
+
+        async def connected(conn: Any) -> None:
+            cb(conn._state.message_buffer)
+
+        self._ws._client_connect_cb.insert(0, connected)
+        return lambda: self._forget(self._ws._client_connect_cb, connected)
+
+    @staticmethod
+    def _forget(callbacks: list[Any], cb: Any) -> None:
+        if cb in callbacks:
+            callbacks.remove(cb)
 
     def live(self) -> list[int]:
         """Ids of the open websocket connections."""
@@ -237,123 +270,6 @@ class ServerDoor:
         connection, loop = self._ws._live_connections.get(client_id), self.loop
         if connection is not None and loop is not None and not loop.is_closed():
             loop.call_soon_threadsafe(connection.transport.abort)
-
-
-_DESERIALIZE = _messages.Message.deserialize.__func__  # type: ignore[attr-defined]
-_SERIALIZE = _messages.Message.as_serializable_dict
-_WINDOW_LOOP = AsyncMessageBuffer._window_loop  # viser's own (tests compare :mod:`.windows` with it)
-_BIG_MESSAGE = 64 << 10
-"""Incoming messages larger than this [bytes] must be upload parts (nothing else a browser sends is that big): a
-big map or list in any other message would hold the event loop while it is decoded."""
-
-
-class _UploadPart(_infra.msgspec.Struct, forbid_unknown_fields=True):
-    """The one big message a browser sends, decoded strictly (fails at the first unexpected field)."""
-
-    type: str
-    source_component_uuid: str | None
-    transfer_uuid: str
-    part_index: int
-    content: bytes
-
-
-def quiet_decoding(on_garbage: Callable[[str], object]) -> None:
-    """Make viser's decoding of incoming messages forgiving (process-wide, once): a message whose fields cannot be
-    cast (``float("a")`` in a position, a missing field) becomes a :class:`Malformed` instead of an exception that
-    closes the connection with a traceback in the log; bytes that are not a message at all (not msgpack, no known
-    type) still close the connection, quietly (``on_garbage(text)`` is told)."""
-    if getattr(_messages.Message, "_tpm_viz_quiet", False):
-        return
-
-    def deserialize(cls: Any, raw: bytes) -> Any:
-        if len(raw) > _BIG_MESSAGE:
-            try:
-                big = _infra.msgspec.msgpack.decode(raw, type=_UploadPart)
-            except _infra.msgspec.MsgspecError:
-                big = None
-            if big is None or big.type != "FileTransferPart":
-                on_garbage(f"connection closed: a message of {len(raw)} bytes that is not an upload part")
-                raise _infra.websockets.exceptions.ConnectionClosedError(None, None)
-        try:
-            return _DESERIALIZE(cls, raw)
-        except (_infra.msgspec.DecodeError, KeyError, AttributeError) as exc:
-            on_garbage(f"connection closed: not a viser message ({type(exc).__name__})")
-            raise _infra.websockets.exceptions.ConnectionClosedError(None, None) from None
-        except (ValueError, TypeError, IndexError) as exc:
-            return Malformed(f"{type(exc).__name__}: {str(exc)[:120]}")
-
-    _messages.Message.deserialize = classmethod(deserialize)  # type: ignore[method-assign,assignment]
-    _messages.Message._tpm_viz_quiet = True  # type: ignore[attr-defined]
-
-
-def safe_wakeups() -> None:
-    """Wake viser's senders safely and once per loop turn (process-wide; before the server is built; :mod:`.wakeups`):
-    each ``AsyncMessageBuffer`` sees its loop through one shared :class:`~.wakeups.Wakeups` (its self-pipe writes
-    coalesced), and its message event's ``set`` is safe from the callback threads."""
-    if getattr(AsyncMessageBuffer, "_tpm_viz_safe", False):
-        return
-    init = AsyncMessageBuffer.__init__
-    shared: weakref.WeakKeyDictionary[Any, Wakeups] = weakref.WeakKeyDictionary()
-
-    def __init__(self: Any, *args: Any, **kwargs: Any) -> None:
-        init(self, *args, **kwargs)
-        loop = self.event_loop
-        self.event_loop = shared.get(loop) or shared.setdefault(loop, Wakeups(loop))
-        self.message_event.set = thread_safe_set(self.message_event, self.event_loop)
-
-    AsyncMessageBuffer.__init__ = __init__  # type: ignore[method-assign]
-    AsyncMessageBuffer._tpm_viz_safe = True  # type: ignore[attr-defined]
-
-
-def lean_senders() -> None:
-    """Send the tabs their windows with less work per tab (process-wide, once, before the server is built;
-    :mod:`.windows`): a window of the shared buffer encoded once for every tab, one pause timer per buffer."""
-    if getattr(AsyncMessageBuffer, "_tpm_viz_lean", False):
-        return
-    init, zstd = AsyncMessageBuffer.__init__, _infra.zstandard.ZstdCompressor(level=1)  # used on the loop only
-    encode = encoder(_infra.msgspec.msgpack.encode, zstd.compress, _infra._append_aligned_buffers)
-
-    def __init__(self: Any, *args: Any, **kwargs: Any) -> None:
-        init(self, *args, **kwargs)
-        self.tick = Tick(self.event_loop, self.window_duration_sec)
-        self.frames = Frames(encode) if self.persistent_messages else None  # only the shared buffer's are shared
-        self.flush_event.set = self.tick.after(self.flush_event.set)  # viser sets it on the loop
-
-    AsyncMessageBuffer.__init__ = __init__  # type: ignore[method-assign]
-    AsyncMessageBuffer._window_loop = window_loop  # type: ignore[assignment,method-assign]
-    _infra._message_producer = producer(encode)
-    AsyncMessageBuffer._tpm_viz_lean = True  # type: ignore[attr-defined]
-
-
-def share_serialization() -> None:
-    """Make each outgoing message's wire dict once, not once per tab (process-wide): a broadcast update reaching 150
-    tabs was serialised 150 times (a fifth of the server's time, ``bench_load.py --mode hall --profile``). Queued
-    messages are not changed (viser fills them first; :func:`reword` changes copies, which a copied entry does not
-    match: it holds its message's id); array buffers are shared, their placeholders renumbered per window."""
-    if getattr(_messages.Message, "_tpm_viz_shared", False):
-        return
-    hints = functools.cache(get_type_hints)  # a handle's property types once per props class (a sixth of a storm)
-    _assignable_props_api.AssignablePropsBase._prop_hints = property(lambda h: hints(type(h._impl.props)))  # type: ignore
-    _messages.Message.as_serializable_dict = wire.shared_serializer(_SERIALIZE)  # type: ignore[method-assign]
-    _messages.Message._tpm_viz_shared = True  # type: ignore[attr-defined]
-
-
-# -- handshakes (ui/classroom.py: same-origin check, the browser's identity cookie) ----------------------------------
-_HANDSHAKE_LOCK = threading.Lock()
-
-
-@contextlib.contextmanager
-def hook_handshakes(hook: wire.Handshake) -> Iterator[None]:
-    """While a ``ViserServer`` is built inside this block, every HTTP request and websocket handshake of the server
-    it starts goes through ``hook`` first (viser passes its page server to websockets' ``serve(process_request=)``;
-    ``ViserServer()`` returns once ``serve`` was entered, so the block covers it)."""
-    with _HANDSHAKE_LOCK:
-        original = ws_server.serve
-        ws_server.serve = wire.hooked_serve(original, hook)  # type: ignore[assignment]
-        try:
-            yield
-        finally:
-            ws_server.serve = original
 
 
 def connection_request(server: viser.ViserServer, client_id: int) -> tuple[Any, Any] | None:

@@ -1,13 +1,14 @@
 """Server-level limits: one tab cannot freeze or fill the server.
 
-:func:`harden_server` (called once by ``build_server``) installs, on one viser server:
+:func:`harden_server` (called once by :func:`~.adapter.install`) installs, on one viser server:
 
 - **Bounded work per tab** (:class:`Gate`, in front of viser's callback thread pool): a tab's callbacks run one at a
   time (a flooding tab holds one pool thread, not 32); meanwhile each callback has at most one call waiting
   (repeated clicks on an export coalesce into it, latest event wins), at most :attr:`Limits.max_callbacks_per_tab`
   in all, the rest are dropped with a rate-limited log line. Connect and disconnect callbacks are never gated.
 - **Bounded memory**: websocket messages over :attr:`Limits.max_frame_bytes` close that connection (viser accepts
-  50 MiB; the largest thing a browser sends is a 512 KiB upload part); a watchdog thread drops a connection whose
+  50 MiB; the largest thing a browser sends is a 512 KiB upload part; :class:`~.patches.GuardedProtocol`,
+  installed by :mod:`.adapter`); a watchdog thread drops a connection whose
   outgoing backlog (messages queued and not yet written: a tab that stopped reading) stays over
   :attr:`Limits.max_backlog_bytes` for :attr:`Limits.backlog_grace` seconds, and meanwhile runs none of its callbacks;
   after tabs leave it returns freed heap to the system (``malloc_trim``); at most :attr:`Limits.max_connections`
@@ -16,31 +17,29 @@
   (:func:`~.transport.message_problem`) before viser dispatches it; a handler that still fails is one log line. A
   tab that sends more than :attr:`Limits.max_malformed` malformed messages within :attr:`Limits.malformed_window`
   seconds is dropped.
-- **HTTP**: a path the app does not serve is a 404 (414 for an over-long one), never a 500.
+- **HTTP**: a path the app does not serve is a 404 (414 for an over-long one), never a 500 (with the frame limit).
 
 All drops are logged through :func:`~.guard.log_fault` (one line per second per tab and kind, with counts).
 """
 
 from __future__ import annotations
 
-import asyncio
 import collections
 import concurrent.futures
 import ctypes
 import dataclasses
-import errno
 import functools
-import http
 import threading
 import time
-import weakref
+from collections.abc import Callable
 from typing import Any
 
 import viser
 
 from tpm_viz.classroom.guard import FAULTS, log_fault, report
-from tpm_viz.viserkit.core import ServerDoor, quiet_decoding, thread_pool, ws_server
+from tpm_viz.viserkit.core import ServerDoor, thread_pool
 from tpm_viz.viserkit.transport import message_problem
+from tpm_viz.viserkit.wire import Incoming, Wrapper
 
 __all__ = [
     "DEFAULT_MAX_CONNECTIONS",
@@ -91,7 +90,7 @@ class Gate:
     time; while it runs, each callback of that tab has at most one call waiting (a repeated call replaces the
     waiting one's event: latest wins), at most ``max_per_tab`` waiting in all; waiting calls run in arrival order."""
 
-    def __init__(self, submit, max_per_tab: int = 8) -> None:
+    def __init__(self, submit: Callable[..., concurrent.futures.Future[Any]], max_per_tab: int = 8) -> None:
         self._submit, self.max_per_tab = submit, max_per_tab
         self._lock = threading.Lock()
         self._waiting: dict[int, dict[Any, tuple]] = {}  # tab -> callback -> (args, kwargs); present = one running
@@ -99,7 +98,7 @@ class Gate:
         self.merged = 0
         self.dropped = 0
 
-    def submit(self, fn, /, *args, **kwargs) -> concurrent.futures.Future:
+    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> concurrent.futures.Future[Any]:
         client_id = _client_of(args)
         if client_id is None:  # connect and disconnect callbacks: never gated
             try:
@@ -129,9 +128,11 @@ class Gate:
             return _done()
         return self._start(client_id, fn, args, kwargs)
 
-    def _start(self, client_id: int, fn, args, kwargs) -> concurrent.futures.Future:
+    def _start(
+        self, client_id: int, fn: Callable[..., Any], args: tuple[Any, ...], kwargs: dict[str, Any]
+    ) -> concurrent.futures.Future[Any]:
         @functools.wraps(fn)
-        def run(*a, **k):
+        def run(*a: Any, **k: Any) -> Any:
             try:
                 return fn(*a, **k)
             finally:
@@ -189,7 +190,8 @@ class ServerGuard:
     def __init__(self, server: viser.ViserServer, limits: Limits) -> None:
         self.limits = limits
         self.door = ServerDoor(server)
-        pool = thread_pool(server)
+        self._pool = pool = thread_pool(server)
+        self._submit = pool.__dict__.get("submit")  # an instance's own (the callbacks' guard), or None: the class's
         self.gate = Gate(pool.submit, limits.max_callbacks_per_tab)
         pool.submit = self.gate.submit
         self.accepted: set[int] = set()
@@ -199,8 +201,6 @@ class ServerGuard:
         self.dropped = 0
         self.aborted = 0
         self.trims = 0
-        limit_frames(server, limits.max_frame_bytes)
-        quiet_decoding(lambda text: log_fault("server", "garbage", text))
         self.door.on_connect(self._connected, self._wrap(log=True))
         self.door.on_disconnect(self._disconnected)
         self.door.wrap_server_dispatch(self._wrap(log=False))
@@ -228,9 +228,9 @@ class ServerGuard:
         self.gate.forget(client_id)
         FAULTS.forget(client_id)
 
-    def _wrap(self, log: bool):
-        def wrap(dispatch):
-            async def handle(client_id, message) -> None:
+    def _wrap(self, log: bool) -> Wrapper:
+        def wrap(dispatch: Incoming) -> Incoming:
+            async def handle(client_id: int, message: Any) -> None:
                 if client_id in self.refused:
                     return
                 problem = message_problem(message)
@@ -313,56 +313,19 @@ class ServerGuard:
         return size < 0 or size > self.limits.max_backlog_bytes
 
     def stop(self) -> None:
+        """Stop the watchdog."""
         self._stop.set()
 
-
-_FRAME_LIMITS: weakref.WeakKeyDictionary[asyncio.AbstractEventLoop, int] = weakref.WeakKeyDictionary()
-
-
-class _LimitedServerProtocol(ws_server.ServerProtocol):
-    """viser's per-connection websocket protocol with, on the event loops of hardened servers, a smaller frame limit
-    and no HTTP 500: a path the file server cannot even look up (a segment too long for the file system) is a 414
-    or a 404."""
-
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
-        try:
-            limit = _FRAME_LIMITS.get(asyncio.get_running_loop())
-        except RuntimeError:
-            limit = None
-        if limit is not None:
-            size = kwargs.get("max_size")
-            kwargs["max_size"] = limit if not isinstance(size, int) else min(size, limit)
-        super().__init__(*args, **kwargs)
-
-    def fail(self, code: Any, reason: str = "") -> None:
-        super().fail(code, reason)
-        self.failed = True
-
-    def receive_data(self, data: bytes | bytearray) -> None:
-        if getattr(self, "failed", False):
-            return  # the rest of a refused 50 MiB frame: dropped as it arrives, not parsed
-        super().receive_data(data)
-
-    def reject(self, status: Any, text: str) -> Any:
-        exc = self.handshake_exc
-        if int(status) == http.HTTPStatus.INTERNAL_SERVER_ERROR and isinstance(exc, (OSError, ValueError)):
-            too_long = isinstance(exc, OSError) and exc.errno == errno.ENAMETOOLONG
-            status = http.HTTPStatus.REQUEST_URI_TOO_LONG if too_long else http.HTTPStatus.NOT_FOUND
-            text = "URI TOO LONG\n" if too_long else "NOT FOUND\n"
-            self.handshake_exc = None  # not a server fault: no traceback in the log
-        return super().reject(status, text)
-
-
-def limit_frames(server: viser.ViserServer, max_bytes: int) -> None:
-    """Refuse websocket messages over ``max_bytes`` on ``server`` (the connection is closed with code 1009), and
-    answer unservable HTTP paths with 404/414 instead of 500. viser builds its ``serve()`` once with a 50 MiB limit;
-    the protocol class it instantiates per connection is looked up at each connection, so the limit applies to
-    every later connection of this server (and only this server: it is keyed by the server's event loop)."""
-    loop = ServerDoor(server).loop
-    if loop is None:
-        raise RuntimeError("the viser server has no event loop yet")
-    _FRAME_LIMITS[loop] = int(max_bytes)
-    ws_server.ServerProtocol = _LimitedServerProtocol
+    def remove(self) -> None:
+        """Stop the watchdog and take the limits off the server (connections already open keep their filter)."""
+        self.stop()
+        if self._submit is None:
+            self._pool.__dict__.pop("submit", None)
+        else:
+            self._pool.submit = self._submit
+        for remove in self.door.removers:
+            remove()
+        self.door.unwrap_server_dispatch()
 
 
 _ATTR = "tpm_viz_limits"

@@ -50,6 +50,7 @@ import viser
 from tpm_viz.app.inputs import MAX_TEXT, MAX_UPLOAD_BYTES, TOO_LARGE, value_problem
 from tpm_viz.classroom.guard import log_fault
 from tpm_viz.viserkit.core import ClientDoor, Malformed, widget_value
+from tpm_viz.viserkit.patches import skipped
 from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["MAX_UPLOADS", "UPLOAD_TIMEOUT", "harden", "message_problem", "update_problem"]
@@ -63,7 +64,7 @@ _MAX_FIELD_TEXT = 4096
 _SKIP = {"excluded_self_client"}
 
 
-def update_problem(current, updates, handle=None, max_text: int = MAX_TEXT) -> str | None:
+def update_problem(current: Any, updates: Any, handle: Any = None, max_text: int = MAX_TEXT) -> str | None:
     """Why a GUI update would be refused, or None. ``current`` is the widget's value, ``handle`` the widget (its
     kind and options; None: judged by the value's type only, as viser casts it)."""
     if not isinstance(updates, dict) or set(updates) != {"value"}:
@@ -82,12 +83,15 @@ def harden(
     client: viser.ClientHandle, max_upload_bytes: int = MAX_UPLOAD_BYTES, lang: Callable[[], Lang] | None = None
 ) -> None:
     """Install the filters of the module docstring on ``client``'s connection (call once, on connect). ``lang``
-    returns the tab's language at the time of a refusal (None: English), e.g. ``lambda: view.lang``."""
+    returns the tab's language at the time of a refusal (None: English), e.g. ``lambda: view.lang``. Nothing is
+    installed if the ``transport`` patch is skipped on the client's server (:func:`~.adapter.install`)."""
+    if skipped(client, "transport"):
+        return
     door = ClientDoor(client)
     cid = client.client_id
     in_flight: dict[str, tuple[float, str, int]] = {}  # transfer uuid -> (start time, button, size): unfinished
 
-    async def gui_update(client_id, message) -> None:
+    async def gui_update(client_id: Any, message: Any) -> None:
         handle = door.widget(message.uuid)
         if handle is not None:
             problem = update_problem(widget_value(handle), message.updates, handle)
@@ -113,7 +117,7 @@ def harden(
             late = Phrase("the upload did not finish within {seconds:g} s", seconds=UPLOAD_TIMEOUT)
             refuse_upload(late, entry[1], transfer, entry[2])
 
-    def upload_start(client_id, message) -> None:
+    def upload_start(client_id: Any, message: Any) -> None:
         size, parts = message.size_bytes, message.part_count
         for transfer in [t for t in in_flight if door.upload_state(t) is None]:  # finished ones
             del in_flight[transfer]
@@ -134,7 +138,7 @@ def harden(
             door.end_upload(str(button), transfer)
         door.upload_start(client_id, message)
 
-    def upload_part(client_id, message) -> None:
+    def upload_part(client_id: Any, message: Any) -> None:
         state = door.upload_state(message.transfer_uuid)
         if state is None or message.transfer_uuid not in in_flight:
             return  # not this tab's upload in progress (or already refused): nothing is buffered

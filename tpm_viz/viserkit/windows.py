@@ -15,7 +15,7 @@ lecture hall that work is done 150 times per broadcast update, on the event loop
 The windows themselves are viser's: the same messages in the same order, at most ``max_window_size`` per window, none
 while an atomic block is open, a tab's own echo left out, the end-of-replay marker right after the backlog a new tab
 found, and each tab's cursor kept for viser's garbage collector of the shared buffer. Nothing here touches a private
-viser name: :mod:`.core` installs it (``lean_senders``), with viser's own encoding.
+viser name: :mod:`.patches` puts it on one server's buffers, with viser's own encoding.
 """
 
 from __future__ import annotations
@@ -33,13 +33,22 @@ Encode = Callable[[Sequence[Any]], bytes]
 """Turns a window of messages into the bytes of one websocket frame (viser's wire format)."""
 
 
-def encoder(msgpack: Callable[[Any], bytes], compress: Callable[[bytes], bytes], align: Callable[..., None]) -> Encode:
+def encoder(
+    msgpack: Callable[[Any], bytes],
+    compress: Callable[[bytes], bytes],
+    align: Callable[..., None],
+    serialize: Callable[[Any, list[Any]], Any] | None = None,
+) -> Encode:
     """viser's wire format (its ``_message_producer``), from its own msgpack encoder, zstd compressor and buffer
-    alignment: the lengths of the msgpack and of its compressed bytes (8 bytes each), those bytes, the arrays."""
+    alignment: the lengths of the msgpack and of its compressed bytes (8 bytes each), those bytes, the arrays.
+    ``serialize(message, buffers)``: a message's wire dict (default: its ``as_serializable_dict``)."""
 
     def encode(window: Sequence[Any]) -> bytes:
         buffers: list[Any] = []
-        messages = tuple(message.as_serializable_dict(buffers) for message in window)
+        if serialize is None:
+            messages = tuple(message.as_serializable_dict(buffers) for message in window)
+        else:
+            messages = tuple(serialize(message, buffers) for message in window)
         lengths = tuple(b.nbytes for b in buffers)
         inner = msgpack({"messages": messages, "timestampSec": time.perf_counter(), "binaryBufferLengths": lengths})
         compressed = compress(inner)
@@ -160,7 +169,7 @@ def producer(encode: Encode) -> Callable[..., Any]:
 
     async def produce(websocket: Any, buffer: Any, client_id: int, backlog_done_message: Any = None) -> None:
         windows = buffer.window_generator(client_id, backlog_done_message=backlog_done_message)
-        frames: Frames | None = buffer.frames  # the shared buffer's (None for a tab's own buffer)
+        frames: Frames | None = getattr(buffer, "frames", None)  # the shared buffer's (None for a tab's own buffer)
         try:
             while not buffer.done:
                 try:
