@@ -33,6 +33,8 @@ def test_a_paced_own_copy_moves_at_every_commit_and_refreshes_its_numbers_once_a
     client, view = connect()
     client.set_value(view.panel.own_copy, True)
     wait_for(lambda: not view.session.shared, what="the own copy")
+    with view.hub.lock:  # the switch is over (it joins the copy, then draws it, under the lock)
+        pass
     clock = Clock()
     monkeypatch.setattr(panels, "time", clock)
     monkeypatch.setattr(view.hub.pacer, "interval", lambda now: 0.2 if busy else 0.0)

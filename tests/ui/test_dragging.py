@@ -49,3 +49,18 @@ def test_a_drain_scheduled_for_the_shared_mechanism_stays_its_own_after_the_tab_
     c2.drag(v2.scene.gizmo, str(v2.client.client_id), [(-0.03, 0.02, 0.09)])
     wait_for(lambda: np.allclose(_state(v2).pose.p, (-0.03, 0.02)), what="the next drag of the shared mechanism")
     assert not np.allclose(_state(v1).pose.p, (-0.03, 0.02))  # the own copy did not follow
+
+
+def test_a_drag_asks_whether_the_tab_may_change_its_session_once_per_commit(connect, monkeypatch):
+    """Permission is checked where the commit happens, not on arrival, in the drain and again in the commit."""
+    client, view = connect()
+    hub = view.hub
+    asked: list[object] = []
+    commits: list[object] = []
+    may_change, commit = hub.access.may_change, hub.commit
+    monkeypatch.setattr(hub.access, "may_change", lambda v, s: asked.append(v) or may_change(v, s))
+    monkeypatch.setattr(hub, "commit", lambda *a, **k: commits.append(a[0]) or commit(*a, **k))
+    client.drag(view.scene.gizmo, str(view.client.client_id), [(0.03, 0.02, 0.09), (0.04, 0.01, 0.09)])
+    wait_for(lambda: np.allclose(_state(view).pose.p, (0.04, 0.01)), what="the last drag applied")
+    with hub.lock:
+        assert commits and asked == [view] * len(commits)

@@ -7,6 +7,7 @@ import gc
 import weakref
 
 import numpy as np
+import pytest
 
 from tpm_viz.classroom.drags import DragQueue, PendingDrag
 
@@ -93,3 +94,28 @@ def test_a_tab_that_left_is_not_kept_alive_by_a_late_drag():
     del gone
     gc.collect()
     assert ref() is None and q.waiting() == []
+
+
+def test_the_queue_schedules_one_drain_at_a_time_and_paces_the_rounds():
+    q: DragQueue[Tab] = DragQueue()
+    a, b = _tabs("a", "b")
+    assert q.push(a, _drag(1), now=10.0) == 0.0  # the first drag: a drain at once
+    assert q.push(b, _drag(2), now=10.001) is None  # one is scheduled: it takes this drag too
+    q.begin(now=10.002, interval=0.025)  # the drain starts: the next round not before 10.027
+    assert q.push(a, _drag(3), now=10.010) == pytest.approx(0.017)
+    assert q.push(a, _drag(4), now=10.011) is None
+    q.begin(now=10.030, interval=0.0)
+    assert q.push(a, _drag(5), now=10.040) == 0.0  # the interval is over: at once
+    assert q.push(b, _drag(6)) is None  # without ``now``: only queued (nothing scheduled by it)
+
+
+def test_the_next_tab_to_drain_is_the_one_with_the_oldest_drag():
+    q: DragQueue[Tab] = DragQueue()
+    a, b = _tabs("a", "b")
+    assert q.first() is None
+    q.push(a, _drag(7))
+    q.push(b, _drag(3))
+    q.push(a, _drag(9))
+    assert q.first() is b
+    q.take(b, lambda v: False)  # b may not merge: only its own drags taken
+    assert q.first() is a

@@ -138,12 +138,13 @@ class Away:
             return False
         return 0.0 <= self._clock() - float(record["left_at"]) <= PRESENTER_SECONDS
 
-    def end_presenters(self) -> None:
-        """No record brings the presenter's right back any more (a new login, a logout)."""
+    def end_presenters(self, address: str | None = None) -> None:
+        """No record (of ``address``; default: of any address) brings the presenter's right back any more (a new
+        login, a logout)."""
         with self._lock:
             for records in self._tabs.values():
                 for r in records:
-                    if r.get("presenter"):
+                    if r.get("presenter") and (address is None or r.get("address") == address):
                         r["presenter"] = False
                         self.changed += 1
 

@@ -26,11 +26,19 @@ import inspect
 import logging
 import threading
 import time
+from collections.abc import Callable
+from concurrent.futures import Executor, Future
+from typing import Any, TypeVar, overload
 
 __all__ = ["ACTIVITY", "FAULTS", "TRACEBACK_INTERVAL", "Activity", "Faults", "guard_executor", "guarded", "log"]
 __all__ += ["log_fault", "report"]
 
 log = logging.getLogger("tpm_viz.ui")
+
+F = TypeVar("F", bound=Callable[..., Any])
+"""A guarded callback (``def`` or ``async def``): the wrapper has its signature (it returns None on an error)."""
+OnError = Callable[[Any, Exception], object]
+"""``on_error(owner, exc)``: ``owner`` is the callback's first argument (``self`` or the event)."""
 
 
 class Activity:
@@ -82,10 +90,10 @@ class Faults:
     MAX_KEYS = 10_000
     """Most ``(tab, kind)`` pairs remembered (older ones are forgotten first: tabs that left)."""
 
-    def __init__(self, interval: float = 1.0, clock=time.monotonic) -> None:
+    def __init__(self, interval: float = 1.0, clock: Callable[[], float] = time.monotonic) -> None:
         self.interval, self._clock = interval, clock
         self._lock = threading.Lock()
-        self._last: dict[tuple[object, str], list] = {}  # key -> [time of the last line, suppressed since]
+        self._last: dict[tuple[object, str], list[float]] = {}  # key -> [time of the last line, suppressed since]
         self.lines = 0
         self.suppressed = 0
 
@@ -149,7 +157,7 @@ def report(exc: BaseException, what: str, client: object = None) -> None:
     ACTIVITY.error()
 
 
-def _client_of(args: tuple) -> object:
+def _client_of(args: tuple[Any, ...]) -> object:
     """The tab a callback ran for (its event's ``client_id`` or client's), or None."""
     first = args[0] if args else None
     client = getattr(first, "client", None)
@@ -157,7 +165,7 @@ def _client_of(args: tuple) -> object:
     return found if isinstance(found, int) else None
 
 
-def _notify(on_error, args, exc: Exception, what: str) -> None:
+def _notify(on_error: OnError | None, args: tuple[Any, ...], exc: Exception, what: str) -> None:
     if on_error is None or not args:
         return
     try:
@@ -166,19 +174,27 @@ def _notify(on_error, args, exc: Exception, what: str) -> None:
         report(inner, f"{what} (error report)")
 
 
-def guarded(func=None, *, on_error=None):
+@overload
+def guarded(func: F, *, on_error: OnError | None = None) -> F: ...
+
+
+@overload
+def guarded(func: None = None, *, on_error: OnError | None = None) -> Callable[[F], F]: ...
+
+
+def guarded(func: F | None = None, *, on_error: OnError | None = None) -> F | Callable[[F], F]:
     """Decorator: run ``func``; on any :class:`Exception` log it, call ``on_error(args[0], exc)``, return None.
 
     Usable bare (``@guarded``) or with an error hook (``@guarded(on_error=...)``), on ``def`` and
     ``async def`` functions alike.
     """
 
-    def decorate(fn):
+    def decorate(fn: F) -> F:
         what = getattr(fn, "__qualname__", repr(fn))
         if inspect.iscoroutinefunction(fn):
 
             @functools.wraps(fn)
-            async def async_wrapper(*args, **kwargs):
+            async def async_wrapper(*args: Any, **kwargs: Any) -> Any:
                 ACTIVITY.enter()
                 try:
                     return await fn(*args, **kwargs)
@@ -189,10 +205,10 @@ def guarded(func=None, *, on_error=None):
                 finally:
                     ACTIVITY.leave()
 
-            return async_wrapper
+            return async_wrapper  # type: ignore[return-value]  # same signature, None on an error
 
         @functools.wraps(fn)
-        def wrapper(*args, **kwargs):
+        def wrapper(*args: Any, **kwargs: Any) -> Any:
             ACTIVITY.enter()
             try:
                 return fn(*args, **kwargs)
@@ -203,17 +219,17 @@ def guarded(func=None, *, on_error=None):
             finally:
                 ACTIVITY.leave()
 
-        return wrapper
+        return wrapper  # type: ignore[return-value]  # same signature, None on an error
 
     return decorate if func is None else decorate(func)
 
 
-def guard_executor(executor) -> None:
+def guard_executor(executor: Executor) -> None:
     """Guard every task later submitted to ``executor`` (viser's callback pool): a callback registered without
     :func:`guarded` still has its exception logged and counted here instead of only printed by viser."""
     submit = executor.submit
 
-    def guarded_submit(fn, /, *args, **kwargs):
+    def guarded_submit(fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Future[Any]:
         return submit(guarded(fn), *args, **kwargs)
 
-    executor.submit = guarded_submit
+    executor.submit = guarded_submit  # type: ignore[method-assign]  # this pool's tasks only

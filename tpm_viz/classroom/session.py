@@ -43,7 +43,7 @@ __all__ = ["AppState", "Hub", "Session", "View", "read_number", "read_vec2"]
 class Drawing(Protocol):
     """The 3D drawing of a session's mechanism (:class:`~tpm_viz.ui.scene.MechanismScene`)."""
 
-    def update(self, frame) -> None:
+    def update(self, frame: Snapshot) -> None:
         """Draw ``frame`` (a no-op if it is the frame last drawn)."""
 
 
@@ -76,9 +76,6 @@ class View(Protocol):
 
     def commit_drag(self, phase: str, position: np.ndarray) -> None:
         """Commit this tab's drag to ``position`` [m] (under the hub's lock; it may be merged from other tabs)."""
-
-    def drain_drags(self) -> None:
-        """Commit the session's pending drags (a tab that leaves hands the session's drain on to another)."""
 
     def tell(self, text: str | Phrase) -> None:
         """Show ``text`` in this tab's message line (empty: clear it)."""
@@ -138,7 +135,7 @@ class Hub:
         numbers beside it."""
         return evaluate(state.params, state.pose, state.load, None if live else self.reference)
 
-    def frame(self, state: AppState, dragging: bool = False):
+    def frame(self, state: AppState, dragging: bool = False) -> Snapshot:
         """The :class:`~tpm_viz.classroom.snapshot.Snapshot` of ``state`` with the data every view draws, computed
         and checked
         before anything changes: raises :class:`~tpm_viz.InputError` if a drawn number is not finite."""
@@ -157,9 +154,10 @@ class Hub:
 
     def join(self, view: View, private: bool, session: Session | None = None, scene: Drawing | None = None) -> Session:
         """Attach ``view`` to the shared session, or to a new private copy of ``session``'s state drawn in
-        ``scene``; draws it.
+        ``scene``: sets ``view.session``, then draws it. A tab joins once it is fully built (and switches by
+        leaving and joining again).
 
-        The caller stores the returned session in the view, then calls :meth:`membership_changed`."""
+        The caller then calls :meth:`membership_changed`."""
         with self.lock:
             source = session if session is not None else self.shared
             if private:
@@ -168,6 +166,7 @@ class Hub:
             else:
                 target = self.shared
             target.views.append(view)
+            view.session = target
             self._draw(target, [view], origin=None, dragging=False)
         return target
 
@@ -182,8 +181,9 @@ class Hub:
     def commit(self, session: Session, state: AppState, origin: View | None = None, dragging: bool = False) -> None:
         """Make ``state`` current in ``session`` and draw it in every view, ``origin`` first.
 
-        Refused (nothing changes) if ``origin`` may not change ``session`` or the state cannot be drawn. A view
-        that fails to draw is logged and skipped; the others are drawn."""
+        Refused (nothing changes) if ``origin`` may not change ``session`` (the one permission check of a tab's
+        change) or the state cannot be drawn. A view that fails to draw is logged and skipped; the others are
+        drawn."""
         with self.lock:
             if origin is not None:
                 self.authorize(origin, session)

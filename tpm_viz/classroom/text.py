@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import html
 import math
+from collections.abc import Iterable
 
 import numpy as np
 
@@ -32,12 +33,12 @@ COLORS_CSS = {
 TAU_POS, TAU_NEG = hex_colour("tau_pos"), hex_colour("tau_neg")
 
 
-def num(x, fmt: str = ".1f", scale: float = 1.0) -> str:
+def num(x: object, fmt: str = ".1f", scale: float = 1.0) -> str:
     """``x * scale`` formatted with ``fmt``; a dash for None, NaN or infinity."""
     if x is None:
         return DASH
     try:
-        v = float(x) * scale
+        v = float(x) * scale  # type: ignore[arg-type]  # anything float() takes; the rest prints a dash
     except (TypeError, ValueError):
         return DASH
     if not math.isfinite(v):
@@ -55,7 +56,7 @@ def banner_level(readout: Readout) -> str:
     return "ok"
 
 
-def force_scale(values) -> float:
+def force_scale(values: Iterable[float | None]) -> float:
     """Full scale [N] of the force bars: the next of 1-2-5 x 10^k at or above the largest ``|τ|`` (min 10 N)."""
     finite = [abs(float(v)) for v in values if v is not None and math.isfinite(float(v))]
     top = max([10.0, *finite])
@@ -122,7 +123,7 @@ ROW_LABELS = (
 """The dashboard's row labels (the others are formulas, the same in every language)."""
 
 
-def _bar(value, scale: float) -> str:
+def _bar(value: float | None, scale: float) -> str:
     if value is None or not math.isfinite(float(value)):
         return '<div style="height:10px"></div>'
     frac = min(abs(float(value)) / scale, 1.0) * 50.0
@@ -168,9 +169,9 @@ def _forces(state: AppState, readout: Readout, lang: Lang) -> str:
     rows = []
     for i in range(2):
         rows.append(
-            f'<div style="display:grid;grid-template-columns:1.6em 1fr 4.6em;gap:4px;align-items:center">'
+            f'<div style="display:grid;grid-template-columns:1.6em 1fr 5.6em;gap:4px;align-items:center">'
             f"<b>τ{'₁₂'[i]}</b>{_bar(tau[i], scale)}"
-            f'<span style="text-align:right">{_q(f"tau{i + 1}", num(tau[i], ".2f"))} N</span></div>'
+            f'<span style="text-align:right;white-space:nowrap">{_q(f"tau{i + 1}", num(tau[i], ".2f"))} N</span></div>'
             f'<div style="font-size:0.9em;color:#475569;margin:0 0 3px 1.9em">'
             + say(
                 lang,
