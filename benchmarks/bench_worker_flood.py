@@ -37,7 +37,7 @@ from timing import p95
 
 from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz.app.overlays import MAP_KINDS
-from tpm_viz.ui import worker
+from tpm_viz.classroom import worker
 from tpm_viz.ui.app import TpmApp, build_server
 
 FLOODERS = 10

@@ -67,9 +67,11 @@ def reload(runs: RunHub, session: Session, saved: Saved) -> None:
     runs.load(session, saved.source, on_done=done)
 
 
-def restore(view: Any, saved: Saved | None, private: bool) -> None:
+def restore(view: Any, saved: Saved | None, private: bool, built: bool = False) -> None:
     """Give a tab back what it had before a drop: its own copy of ``saved`` (parameters, pose, load, loaded
-    trajectory and player time) or the shared mechanism, its view options and its language (under the hub's lock)."""
+    trajectory and player time) or the shared mechanism, its view options and its language (under the hub's lock).
+    ``built``: the tab was built on its own copy of ``saved`` already (:meth:`.room.Room.build`); only the
+    trajectory is loaded again."""
     if saved is not None:
         view.words.set(Lang.parse(saved.lang, default=view.lang))
         if saved.show.get(PRESENTATION, False) != view.look.presentation:
@@ -82,9 +84,10 @@ def restore(view: Any, saved: Saved | None, private: bool) -> None:
                 view.scene.set_visible(what, visible)
     if private and saved is not None:
         runs = view.teaching.services.runs
-        source = Session(saved.state, shared=False)
-        runs.of(source)  # an empty player: the copy does not inherit the shared run
-        view.switch(True, source=source)
-        view.panel.own_copy.value = True
+        if not built:
+            source = Session(saved.state, shared=False)
+            runs.of(source)  # an empty player: the copy does not inherit the shared run
+            view.switch(True, source=source)
+            view.panel.own_copy.value = True
         reload(runs, view.session, saved)
     view.client.flush()

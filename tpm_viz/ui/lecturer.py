@@ -10,12 +10,14 @@ from __future__ import annotations
 
 import html
 from typing import Any, Protocol
+from urllib.parse import urlsplit
 
 import viser
 
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES
 from tpm_viz.classroom.guard import guarded
-from tpm_viz.ui.classroom import qr_data_uri
+from tpm_viz.ui.classroom import is_loopback_address, qr_data_uri
+from tpm_viz.words import T
 
 __all__ = ["Lecture", "LecturerPanel", "join_html"]
 
@@ -32,6 +34,12 @@ class Lecture(Protocol):
     def hand_to_class(self, view: Any, open_: bool) -> None:
         """Let everybody change the shared mechanism (True) or only the presenter (False)."""
 
+    def log_out(self, view: Any) -> None:
+        """End ``view``'s presenter right (and any dropped presenter tab's way back from its address)."""
+
+
+LOOPBACK_ONLY = T("Served on this computer only: students cannot connect. Restart with --host 0.0.0.0.")
+
 
 def join_html(urls: list[str]) -> str:
     """The URLs students type and a QR code of the first one (HTML for the panel)."""
@@ -41,6 +49,8 @@ def join_html(urls: list[str]) -> str:
             "(students use the same wifi), then restart the app.</p>"
         )
     links = "".join(f"<div style='font-size:1.1em'><b>{html.escape(u)}</b></div>" for u in urls)
+    if all(is_loopback_address(urlsplit(u).hostname or "") for u in urls):
+        links += f"<p style='color:#b91c1c'><b>{LOOPBACK_ONLY.template}</b></p>"
     image = f"<img alt='QR code of {html.escape(urls[0])}' src='{qr_data_uri(urls[0])}' style='width:180px'>"
     return f"<div>Students open (same network):{links}{image}</div>"
 
@@ -50,7 +60,8 @@ class LecturerPanel:
 
     def __init__(self, gui: viser.GuiApi, lecture: Lecture, view: Any, urls: list[str] | None, presenter: bool):
         self._lecture, self._view = lecture, view
-        with gui.add_folder("Lecturer", expand_by_default=urls is not None):
+        self.folder = gui.add_folder("Lecturer", expand_by_default=urls is not None)
+        with self.folder:
             self.join = gui.add_html(join_html(urls) if urls is not None else "")
             self.join.visible = urls is not None
             self.notice = gui.add_markdown("")
@@ -65,7 +76,14 @@ class LecturerPanel:
             self.open = gui.add_upload_button(
                 "Open session (JSON)", icon=viser.Icon.UPLOAD, mime_type=".json,application/json"
             )
+            self.log_out = gui.add_button(
+                "Log out as presenter",
+                icon=viser.Icon.LOGOUT,
+                hint="This tab becomes a student's; a dropped presenter tab no longer comes back as the presenter",
+                visible=presenter,
+            )
         self.open_to_class.on_update(self._on_open_to_class)
+        self.log_out.on_click(self._on_log_out)
         self.save.on_click(self._on_save)
         self.open.on_upload(self._on_open)
 
@@ -78,6 +96,15 @@ class LecturerPanel:
     def _on_open_to_class(self, event) -> None:
         if getattr(event, "client", None) is not None:
             self._lecture.hand_to_class(self._view, bool(self.open_to_class.value))
+
+    def remove(self) -> None:
+        """Take the folder out of the tab (the presenter logged out)."""
+        self.folder.remove()
+
+    @guarded
+    def _on_log_out(self, event: viser.GuiEvent) -> None:
+        if getattr(event, "client", None) is not None:
+            self._lecture.log_out(self._view)
 
     @guarded
     def _on_save(self, event) -> None:

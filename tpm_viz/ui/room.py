@@ -11,7 +11,8 @@ from __future__ import annotations
 import sys
 import time
 import weakref
-from typing import Any
+from collections.abc import Callable
+from typing import Any, TypeVar
 
 from tpm_viz.app import sessions
 from tpm_viz.app.sessions import Document, Saved
@@ -22,10 +23,16 @@ from tpm_viz.ui.classroom import Classroom, identity, student_urls
 from tpm_viz.ui.continuity import LectureStore, lecture_store, reload, restore, saved_of
 from tpm_viz.ui.lecturer import LecturerPanel
 from tpm_viz.viserkit.core import connection_request
+from tpm_viz.words import Lang, T, say
 
-__all__ = ["BACK", "KEPT", "Room"]
+__all__ = ["BACK", "KEPT", "LOGGED_OUT", "Room"]
+
+V = TypeVar("V")
 
 BACK = "Welcome back: your own copy from before the connection dropped is restored."
+STUDENT = T("Students: you watch the presenter here, or work on your own copy.")
+"""The login folder's line for a tab that is not the presenter's (:class:`~.login.LoginPanel`)."""
+LOGGED_OUT = "You logged out as presenter: the shared mechanism is no longer yours to change."
 KEPT = (
     "The connection dropped and you are now on the shared mechanism. Your own copy from before is kept for "
     "30 minutes: press 'Restore my own copy from before the drop'."
@@ -49,6 +56,8 @@ class Room:
         self._lecturers: weakref.WeakKeyDictionary[Any, LecturerPanel] = weakref.WeakKeyDictionary()
         self.ready: weakref.WeakSet[Any] = weakref.WeakSet()
         """The tabs :meth:`connected` has finished with (tests wait for it)."""
+        self._back: weakref.WeakKeyDictionary[Any, dict[str, Any]] = weakref.WeakKeyDictionary()
+        """Tabs that are back (built by :meth:`build`) -> the record they left, until :meth:`connected`."""
 
     # -- start and stop ---------------------------------------------------------------------------------------------
     def start(self) -> None:
@@ -90,20 +99,37 @@ class Room:
             camera = None
         return identity(remote, headers, self.store.keys), str(host), camera
 
+    def build(self, who: tuple[str | None, str, Any], make: Callable[[Saved | None], V]) -> V:
+        """Build a connecting tab's view with ``make(saved)``: a browser known by its cookie that left an own copy
+        (:meth:`identify`'s ``who``) is built on that copy from its first draw (``saved``), any other on the shared
+        mechanism (None). What it left is taken back here, and kept again if the build fails."""
+        key, host, camera = who
+        record = self.away.take(key, camera) if key is not None and key.startswith("c:") else None  # its own lock
+        own = record is not None and record["private"] and record["saved"] is not None
+        try:
+            view = make(record["saved"] if own and record is not None else None)
+        except BaseException:
+            if record is not None:  # not lost: the next tab of this browser finds it (never as the presenter)
+                self.away.park(key or "", record["private"], record["saved"], record.get("camera"), address=host)
+            raise
+        if record is not None:
+            self._back[view] = record
+        return view
+
     def source(self, view: Any) -> str | None:
         """The address a tab connected from (the key of the presenter-login limits)."""
         return getattr(view, "address", None)
 
     def connected(self, view: Any, who: tuple[str | None, str, Any]) -> None:
-        """A tab's view is built (on the shared mechanism): presenter or not, and what it had before a drop (a
-        browser known by its cookie gets it back by itself; one that blocks cookies is offered its own copy)."""
-        key, host, camera = who
+        """A tab's view is built (by :meth:`build`): presenter or not, and what it had before a drop (a browser known
+        by its cookie gets it back by itself; one that blocks cookies is offered its own copy)."""
+        key, host, _camera = who
         if key is not None:
             self._keys[view] = key
         view.address = host
         hub = self.app.hub
         with hub.lock:
-            record = self.away.take(key, camera) if key is not None and key.startswith("c:") else None
+            record = self._back.pop(view, None)
             here = self.classroom is not None and self.classroom.presenter_address(host)
             back = self.away.presenter(record, host)  # same address, within 2 minutes: never the cookie alone
             if self.app.access.enabled and (here or back):
@@ -115,7 +141,7 @@ class Room:
             self._set_lesson_step(view)
             view.panel.restore.on_click(lambda event, view=view: self._on_restore(event, view))
             if record is not None:
-                restore(view, record["saved"], record["private"] and record["saved"] is not None)
+                restore(view, record["saved"], record["private"] and record["saved"] is not None, built=True)
                 if record["private"]:
                     view.tell(BACK)
             elif key is not None and self.away.offer(key) is not None:
@@ -166,6 +192,25 @@ class Room:
         if view not in self._lecturers:
             self._add_lecturer(view)
 
+    def log_out(self, view: Any) -> None:
+        """*Log out as presenter*: ``view`` is a student's tab from now on (its *Lecturer* folder goes), and no
+        presenter tab that dropped from its address comes back as the presenter."""
+        access = self.app.access
+        with self.app.hub.lock:
+            if view.closed or not access.is_presenter_tab(view):
+                return
+            access.logout(view)
+            self.away.end_presenters(address=getattr(view, "address", None))
+            panel = self._lecturers.pop(view, None)
+            if panel is not None:
+                panel.remove()
+            if view.login is not None:
+                view.login.show(say(Lang.EN, STUDENT))  # shown in the tab's language on the way out
+            view.tell(LOGGED_OUT)
+            view.client.flush()
+            log.info("client %s logged out as presenter", view.client.client_id)
+        self.app.hub.membership_changed()
+
     def _add_lecturer(self, view: Any) -> None:
         panel = LecturerPanel(view.client.gui, self, view, self.urls, presenter=self.app.access.enabled)
         panel.show_notice(self.notice)
@@ -194,8 +239,8 @@ class Room:
             ps = runs.of(hub.shared)
             source = ps.run.source if ps.run is not None else ps.loading
             shared = Saved(hub.shared.state, source, hub.shared.state.trajectory.t)
-            for view in list(hub.shared.views):
-                if app.access.is_presenter(view):
+            for view in list(hub.shared.views):  # a tab still connecting shows step 0 until connected() sets it
+                if view in self.ready and app.access.is_presenter(view):
                     self.lesson_step = int(getattr(view.teaching.demos, "index", self.lesson_step))
                     break
             tabs = self.away.snapshot()
