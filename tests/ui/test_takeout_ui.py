@@ -1,20 +1,26 @@
 """*Record clip* and *Download report* in the Player, Control and Planner tabs, without a browser: a protocol-level
-client clicks, the downloads viser would send are caught and decoded (frames, size, rate, the forces drawn), the
-page answers while a clip records, and the bounds (one clip per tab, the server's slots) refuse with one line."""
+client sets its camera and clicks, the downloads viser would send are caught and decoded (frames, size, rate, the
+forces drawn, the platform where the tab's camera sees it), the page answers while a clip records, and the bounds
+(one clip per tab, the server's slots) refuse with one line."""
 
 from __future__ import annotations
 
 import html.parser
 import io
+import math
 
 import av
 import numpy as np
 import pytest
+import scipy.ndimage
 from PIL import Image
 
-from tests.support.protocol import wait_for
-from tpm_viz.clips import ClipRenderer
-from tpm_viz.ui.teaching.recording import APP_FRAMES, SLOTS, frames_of
+from tests.support.protocol import CAMERA, wait_for
+from tpm_viz.app.palette import PALETTE
+from tpm_viz.meshes import PLATFORM_Z
+from tpm_viz.ui.teaching.recording import APP_FRAMES, SCENE_COLOURS, SLOTS, frames_of
+from tpm_viz.ui.teaching.takeout import tab_camera
+from tpm_viz.views3d import Camera, View3dRenderer
 from tpm_viz.words import Lang, say
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
@@ -45,20 +51,52 @@ def _takeout(view, where: str):
     return next(t for t in view.teaching.takeouts if t.where == where)
 
 
-def _bar(frame: np.ndarray, row: int, colour, zero_x: float) -> float:
-    cols = np.flatnonzero(np.abs(frame[row].astype(int) - np.array(colour)).sum(axis=1) < 90)
+def _bar(frame: np.ndarray, row: int, colour, zero_x: float, half: float) -> float:
+    lo = round(zero_x - half)  # only the bar's own columns: the 3D view may hold a colour like the bar's
+    cols = np.flatnonzero(np.abs(frame[row, lo : round(zero_x + half)].astype(int) - np.array(colour)).sum(axis=1) < 90)
     if cols.size == 0:
         return 0.0
+    cols = cols + lo
     left, right = cols.min(), cols.max() + 1
     return float(right - zero_x) if abs(right - zero_x) > abs(left - zero_x) else float(left - zero_x)
 
 
-def _check_bars(frames, clip, size, tol_px: float) -> None:
-    geometry = ClipRenderer(clip, "geometry", size).geometry()
+def _check_bars(frames, clip, size, camera, tol_px: float) -> None:
+    renderer = View3dRenderer(clip, "geometry", size, camera, SCENE_COLOURS)
+    geometry = renderer.geometry()
+    half = renderer.scale * geometry.px_per_newton
     for k in range(0, len(frames), 40):
         for i, colour in enumerate((BLUE, RED)):
-            drawn = _bar(frames[k], geometry.rows[i], colour, geometry.zero_x) / geometry.px_per_newton
+            drawn = _bar(frames[k], geometry.rows[i], colour, geometry.zero_x, half) / geometry.px_per_newton
             assert drawn == pytest.approx(clip.tau[k, i], abs=tol_px / geometry.px_per_newton), (k, i)
+
+
+def _look(client, view, position, look_at, up) -> Camera:
+    """Send the camera a browser sends after an orbit (the same canvas: the app does not frame it again)."""
+    aspect = CAMERA["image_width"] / CAMERA["image_height"]
+    camera = Camera.looking_at(position, look_at, up, CAMERA["fov"], aspect)
+    client.send(**{**CAMERA, "position": position, "look_at": look_at, "up_direction": up, "wxyz": camera.wxyz})
+    wait_for(lambda: np.allclose(view.client.camera.position, position), what="the tab's camera")
+    return camera
+
+
+def _top_view_pixel(p, camera_xy, height: float, size) -> tuple[float, float]:
+    """Where a camera ``height`` [m] over ``camera_xy`` looking straight down (+y up on the screen, the vertical
+    field of view of :data:`CAMERA`) sees the platform's top face centre over ``p`` [px], by the pinhole formula."""
+    f = size[1] / 2 / math.tan(CAMERA["fov"] / 2)
+    depth = height - PLATFORM_Z[1]
+    return size[0] / 2 + f * (p[0] - camera_xy[0]) / depth, size[1] / 2 - f * (p[1] - camera_xy[1]) / depth
+
+
+def _platform(frame: np.ndarray) -> tuple[float, float]:
+    """Centre [px] of the box around the platform's top face: the largest patch of its colour (lit from above; the
+    sides are darker, anti-aliased text may pass through that colour)."""
+    near = np.abs(frame.astype(int) - np.array(PALETTE["platform"])).sum(axis=2) < 40
+    patches, count = scipy.ndimage.label(near)
+    assert count > 0, "the platform is not in the frame"
+    rows, cols = np.nonzero(patches == 1 + np.argmax(np.bincount(patches.ravel())[1:]))
+    assert rows.size > 100, "the platform is not in the frame"
+    return (cols.min() + cols.max() + 1) / 2, (rows.min() + rows.max() + 1) / 2
 
 
 class _Numbers(html.parser.HTMLParser):
@@ -79,7 +117,7 @@ class _Numbers(html.parser.HTMLParser):
                 self.values[self._key] = float(a["data-value"])
 
 
-def test_player_records_a_gif_of_its_run_and_stays_usable(connect):
+def test_player_records_a_gif_through_the_tabs_camera_and_stays_usable(connect):
     client, view = connect()
     client.set_value(view.teaching.player.choice, "line (Fig. 4)")
     wait_for(lambda: view.teaching.services.runs.of(view.session).run is not None, what="the line")
@@ -89,8 +127,11 @@ def test_player_records_a_gif_of_its_run_and_stays_usable(connect):
     client.set_value(take.size, "640×360")
     client.set_value(take.rate, "10")
     wait_for(lambda: take.size.value == "640×360" and take.rate.value == "10", what="the clip settings")
+    over = (0.02, -0.01)  # the tab looks straight down from 0.9 m over this point
+    camera = _look(client, view, (*over, 0.9), (*over, 0.0), (0.0, 1.0, 0.0))
     client.click(take.record)
     wait_for(lambda: take.recording is not None and take.recording.done > 0, timeout=60, what="the first frames")
+    _look(client, view, (0.3, -0.6, 0.5), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0))  # the view moves: the clip does not
     client.click(take.record)  # one recording per tab
     wait_for(lambda: any("already being recorded" in t for t in told), what="the refusal")
     client.set_value(view.teaching.player.time, 0.1)  # the page answers meanwhile
@@ -108,7 +149,9 @@ def test_player_records_a_gif_of_its_run_and_stays_usable(connect):
         frames.append(np.asarray(im.convert("RGB")))
         assert im.info["duration"] == 100
     assert np.abs(frames[0].astype(int) - frames[-1]).sum() > 0
-    _check_bars(frames, run, (640, 360), tol_px=1.5)
+    for k in (0, 200, 400):  # the platform moves along the line, where the tab's camera at the click sees it
+        assert _platform(frames[k]) == pytest.approx(_top_view_pixel(run.p[k], over, 0.9, (640, 360)), abs=1.0)
+    _check_bars(frames, run, (640, 360), camera, tol_px=1.5)
     assert take.recording is None and SLOTS._value == 3  # the slot came back
 
 
@@ -122,6 +165,13 @@ def test_control_records_an_mp4_of_the_actual_motion(connect):
     client.set_value(take.format, "MP4 (H.264)")
     client.set_value(take.size, "640×360")
     wait_for(lambda: take.format.value == "MP4 (H.264)" and take.size.value == "640×360", what="the settings")
+    with view.hub.lock:  # the server points the tab's camera (viser works out its orientation)
+        view.client.camera.up_direction = (0.0, 0.0, 1.0)
+        view.client.camera.position = (0.25, -0.5, 0.45)
+        view.client.camera.look_at = (0.02, 0.03, 0.0)
+    camera = tab_camera(view.client)
+    mine = Camera.looking_at((0.25, -0.5, 0.45), (0.02, 0.03, 0.0), (0.0, 0.0, 1.0), camera.fov, camera.aspect)
+    assert abs(float(np.dot(camera.wxyz, mine.wxyz))) == pytest.approx(1.0, abs=1e-9)  # viser's convention is ours
     client.click(take.record)
     wait_for(lambda: sent, timeout=300, what="the clip")
     name, data = sent[0]
@@ -133,7 +183,7 @@ def test_control_records_an_mp4_of_the_actual_motion(connect):
         assert float(stream.average_rate) == 20.0 and stream.codec_context.name == "h264"
     assert len(frames) == len(clip.t) == min(len(cv.run.t), APP_FRAMES)
     assert frames[0].shape == (360, 640, 3)
-    _check_bars(frames, clip, (640, 360), tol_px=3.0)
+    _check_bars(frames, clip, (640, 360), camera, tol_px=3.0)
 
 
 def test_reports_of_the_player_and_the_planner(connect):

@@ -9,8 +9,10 @@ fair worker serves the other tabs between two steps (a whole clip is 5-30 s of c
 :data:`MAX_RECORDINGS` recordings run in the whole server at once (:data:`SLOTS`); each is bounded in frames
 (:data:`APP_FRAMES`), size (the presets up to 1920×1080) and bytes (:data:`tpm_viz.videos.MAX_CLIP_BYTES`).
 
-The clip is drawn by the server-side renderer of ``tpm-viz clip`` (:mod:`tpm_viz.clips`, the top view and the
-force strip), not by the tab's 3D camera.
+The clip is seen through the tab's own 3D camera (its :class:`~tpm_viz.views3d.Camera` when *Record clip* was
+clicked): :class:`tpm_viz.views3d.View3dRenderer` draws the scene's parts in the scene's colours
+(:data:`SCENE_COLOURS`) on the server, deterministically, without moving the tab's view. ``tpm-viz clip`` keeps the
+top view (:mod:`tpm_viz.clips`).
 """
 
 from __future__ import annotations
@@ -21,19 +23,23 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tpm_viz.app.palette import PALETTE
 from tpm_viz.app.runs import Run, Source, build_run
-from tpm_viz.clips import ClipRenderer, ClipRun
+from tpm_viz.clips import ClipRun
 from tpm_viz.multibody import inverse_dynamics
 from tpm_viz.paper.kinematics import inverse_kinematics
 from tpm_viz.paper.trajectories import trajectory_from_samples
 from tpm_viz.params import Params
 from tpm_viz.reports.report import Section
+from tpm_viz.ui.teaching.trace import PATH_COLOUR, TRACE_COLOUR
 from tpm_viz.videos import ClipWriter, clip_writer
+from tpm_viz.views3d import Camera, View3dRenderer
 
 __all__ = [
     "APP_FRAMES",
     "CHUNK_FRAMES",
     "MAX_RECORDINGS",
+    "SCENE_COLOURS",
     "SLOTS",
     "Frames",
     "Material",
@@ -45,11 +51,14 @@ __all__ = [
 APP_FRAMES = 401
 """Most frames of a clip recorded in the app (a run's samples, evenly thinned to this many)."""
 CHUNK_FRAMES = 4
-"""Frames rendered and encoded per worker job (~0.2 s at 800×450, `benchmarks/bench_clip.py`)."""
+"""Frames rendered and encoded per worker job (`benchmarks/bench_clip.py`: one job's time is what another tab's
+job may wait behind it)."""
 MAX_RECORDINGS = 3
 """Clips recorded at once in the whole server (each holds a canvas and its encoder)."""
 SLOTS = threading.BoundedSemaphore(MAX_RECORDINGS)
 """The server's recording slots: a tab takes one for its clip and gives it back when the clip ends in any way."""
+SCENE_COLOURS = {**PALETTE, "path": PATH_COLOUR, "trace": TRACE_COLOUR}
+"""The 3D scene's colours (RGB) of the parts, the force arrows and the player's path and trace."""
 
 
 @dataclass(frozen=True)
@@ -92,14 +101,15 @@ def report_of_path(params: Params, t, p, label: str) -> Run:
 
 
 class Recording:
-    """One clip being recorded: :meth:`step` until it returns True, then :attr:`data` holds the file."""
+    """One clip being recorded through ``camera`` (the tab's, when it was asked for): :meth:`step` until it returns
+    True, then :attr:`data` holds the file."""
 
-    def __init__(self, material: Material, size: tuple[int, int], fmt: str, fps: int) -> None:
-        self.material, self.size, self.fmt, self.fps = material, size, fmt, fps
+    def __init__(self, material: Material, size: tuple[int, int], fmt: str, fps: int, camera: Camera) -> None:
+        self.material, self.size, self.fmt, self.fps, self.camera = material, size, fmt, fps, camera
         self.total = len(material.clip.t)
         self.done = 0
         self.data: bytes | None = None
-        self._renderer: ClipRenderer | None = None
+        self._renderer: View3dRenderer | None = None
         self._writer: ClipWriter | None = None
 
     @property
@@ -111,7 +121,8 @@ class Recording:
         """Render and encode the next :data:`CHUNK_FRAMES` frames (the first step also sets up); True when the
         clip is finished (:attr:`data`)."""
         if self._renderer is None:
-            self._renderer = ClipRenderer(self.material.clip, self.material.title, self.size)
+            clip, title = self.material.clip, self.material.title
+            self._renderer = View3dRenderer(clip, title, self.size, self.camera, SCENE_COLOURS)
             self._writer = clip_writer(self.fmt, self.fps, self._renderer.frame, self.total)
             return False
         assert self._writer is not None

@@ -2,17 +2,19 @@
 
 A folder of widgets (clip size from :data:`tpm_viz.clips.SIZE_PRESETS`, GIF or MP4, frame rate) with the two
 buttons and a progress line. The tab's view passes a function that returns its current :class:`Material` (or None:
-nothing to take out yet). *Record clip* takes one of the server's recording slots and records in the fair worker,
-a few frames per job (:class:`~.recording.Recording`), writing its progress under the buttons; the file goes to
-this browser as a download (viser's ``send_file_download``). The page stays usable meanwhile; one clip per tab at
-a time (a second click is refused with one line, so is a click when every slot of the server is busy). *Download
-report* writes the lab report (:func:`tpm_viz.reports.report.report_html`) in the tab's language, in the worker.
-A tab that closes drops its pending job; the slot comes back when the recording ends in any way.
+nothing to take out yet). *Record clip* takes the tab's camera as it is at the click (:func:`tab_camera`: the clip
+is the tab's own 3D view, whatever the view does meanwhile), one of the server's recording slots, and records in the
+fair worker, a few frames per job (:class:`~.recording.Recording`), writing its progress under the buttons; the
+file goes to this browser as a download (viser's ``send_file_download``). The page stays usable meanwhile; one clip
+per tab at a time (a second click is refused with one line, so is a click when every slot of the server is busy).
+*Download report* writes the lab report (:func:`tpm_viz.reports.report.report_html`) in the tab's language, in the
+worker. A tab that closes drops its pending job; the slot comes back when the recording ends in any way.
 """
 
 from __future__ import annotations
 
 import datetime
+import math
 
 import viser
 
@@ -22,15 +24,29 @@ from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.reports.report import report_html
 from tpm_viz.ui.teaching.materials import control_material, planner_material, player_material
 from tpm_viz.ui.teaching.recording import SLOTS, Material, Recording
+from tpm_viz.views3d import Camera
 from tpm_viz.words import Phrase, T, say
 
-__all__ = ["FORMATS", "MATERIALS", "RATES", "TakeOut", "takeout_for"]
+__all__ = ["FORMATS", "MATERIALS", "RATES", "TakeOut", "tab_camera", "takeout_for"]
 
 FORMATS = {"GIF": "gif", "MP4 (H.264)": "mp4"}
 RATES = ("10", "20", "25", "30")
 """Frame rates offered [frames/s]: each frame is one run sample, played at this rate."""
 MATERIALS = {"player": player_material, "control": control_material, "planner": planner_material}
 """The material of each teaching tab's view (:mod:`.materials`)."""
+
+
+def tab_camera(client: viser.ClientHandle) -> Camera:
+    """The tab's camera as its page last reported it (viser's ``client.camera``: pose, vertical field of view and
+    the canvas's aspect ratio); one-line :class:`InputError` while it is not known."""
+    try:
+        camera = client.camera
+        width, height = camera.image_width, camera.image_height
+        aspect = width / height if width > 0 and height > 0 else math.nan
+        position, wxyz, fov = tuple(camera.position.tolist()), tuple(camera.wxyz.tolist()), float(camera.fov)
+    except AssertionError:  # no camera message yet
+        position, wxyz, fov, aspect = (math.nan,) * 3, (math.nan,) * 4, math.nan, math.nan
+    return Camera(position, wxyz, fov, aspect)
 
 
 def _internal_error(owner, exc: Exception) -> None:
@@ -99,9 +115,10 @@ class TakeOut:
             fmt = FORMATS.get(self.format.value, "gif")
             fps = int(self.rate.value) if self.rate.value in RATES else DEFAULT_FPS
             material = self._current()
+            camera = tab_camera(self.view.client)
             if not SLOTS.acquire(blocking=False):
                 raise InputError(T("the server is recording other clips: try again in a moment"))
-            self.recording = Recording(material, size, fmt, fps)
+            self.recording = Recording(material, size, fmt, fps, camera)
         self._tell(T("Recording the clip…"))
         self._next(self.recording)
 
