@@ -14,7 +14,11 @@ through ``put_blob`` (the classroom store's ``put_blob(data) -> sha256 hex``); t
 and a server that does not hold it (``get_blob(digest) -> bytes | None``) refuses the link with one line that says
 to open it on the server that made it or to upload the CSV there.
 
-Status: the codec only; the *Copy share link* button and opening a link on page load are not wired yet.
+A link is ``http://HOST:PORT/?share=TOKEN`` (:func:`share_url`). The page request is the only request that sees the
+query (viser's websocket URL has none): :class:`PendingLinks` keeps its token under a random nonce for
+:data:`PENDING_SECONDS`, the page's response puts the nonce in a cookie, and the tab's websocket handshake brings it
+back (:mod:`tpm_viz.ui.classroom`, :mod:`tpm_viz.ui.share`). Bounded: :data:`MAX_PENDING` tokens in all,
+:data:`MAX_PENDING_PER_ADDRESS` per client address, each read once.
 """
 
 from __future__ import annotations
@@ -24,9 +28,14 @@ import binascii
 import hashlib
 import json
 import re
+import secrets
+import threading
+import time
 import zlib
+from collections import OrderedDict
 from collections.abc import Callable
 from typing import Any
+from urllib.parse import parse_qs
 
 import numpy as np
 
@@ -35,7 +44,20 @@ from tpm_viz.app.sessions import Saved, decode_saved, encode_saved
 from tpm_viz.errors import InputError
 from tpm_viz.words import Phrase, T
 
-__all__ = ["LINK_VERSION", "MAX_STATE_BYTES", "MAX_TOKEN_CHARS", "decode_link", "encode_link"]
+__all__ = [
+    "LINK_VERSION",
+    "MAX_PENDING",
+    "MAX_PENDING_PER_ADDRESS",
+    "MAX_STATE_BYTES",
+    "MAX_TOKEN_CHARS",
+    "PENDING_SECONDS",
+    "SHARE_PARAMETER",
+    "PendingLinks",
+    "decode_link",
+    "encode_link",
+    "share_url",
+    "token_of_query",
+]
 
 LINK_VERSION = 1
 """Version of the token's layout and of its state's schema."""
@@ -151,3 +173,79 @@ def _stored(ref: dict[str, Any], get_blob: GetBlob | None) -> Any:
     if hashlib.sha256(data).hexdigest() != digest or len(data) > MAX_STATE_BYTES:
         raise InputError(T("the share link's stored trajectory is damaged on this server: upload the CSV again"))
     return _json(data)
+
+
+# -- links in URLs ----------------------------------------------------------------------------------------------------
+SHARE_PARAMETER = "share"
+"""The query parameter of a share link (``/?share=TOKEN``)."""
+PENDING_SECONDS = 120.0
+"""How long a page's share token waits for that page's websocket [s]."""
+MAX_PENDING = 512
+"""Most share tokens waiting at once (the oldest goes first)."""
+MAX_PENDING_PER_ADDRESS = 8
+"""Most share tokens waiting for one client address (its oldest goes first: one student cannot evict the class's)."""
+_MAX_QUERY_CHARS = MAX_TOKEN_CHARS + 64  # a longer value is kept cut: it then reads as damaged, never as another link
+
+
+def share_url(origin: str, token: str) -> str:
+    """The link of ``token`` on the server whose pages are at ``origin`` (``http://host:port``)."""
+    return f"{origin.rstrip('/')}/?{SHARE_PARAMETER}={token}"
+
+
+def token_of_query(query: str) -> str | None:
+    """The share token a page request's query carries (None: no ``share`` parameter; the value as given, cut to a
+    bounded length, even when damaged: the tab then says the link was refused)."""
+    try:
+        values = parse_qs(str(query)[: 2 * _MAX_QUERY_CHARS], keep_blank_values=True, max_num_fields=32)
+    except ValueError:  # too many fields: not a link this app made
+        return ""
+    found = values.get(SHARE_PARAMETER)
+    return None if not found else found[0][:_MAX_QUERY_CHARS]
+
+
+class PendingLinks:
+    """Share tokens of page requests, each waiting under a random nonce for its tab's websocket (:meth:`put`,
+    :meth:`take`); thread-safe, bounded in number, per client address and in time (``clock``: seconds)."""
+
+    def __init__(
+        self,
+        seconds: float = PENDING_SECONDS,
+        most: int = MAX_PENDING,
+        per_address: int = MAX_PENDING_PER_ADDRESS,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self.seconds, self.most, self.per_address, self.clock = seconds, most, per_address, clock
+        self._lock = threading.Lock()
+        self._items: OrderedDict[str, tuple[float, str, str]] = OrderedDict()  # nonce -> (expiry, address, token)
+
+    def __len__(self) -> int:
+        with self._lock:
+            self._expire(self.clock())
+            return len(self._items)
+
+    def _expire(self, now: float) -> None:
+        while self._items and next(iter(self._items.values()))[0] <= now:
+            self._items.popitem(last=False)
+
+    def put(self, token: str, address: str) -> str:
+        """Keep ``token`` (cut to a bounded length) for a page served to ``address``; its nonce (for the cookie)."""
+        nonce = secrets.token_urlsafe(16)
+        with self._lock:
+            now = self.clock()
+            self._expire(now)
+            mine = [k for k, (_, a, _) in self._items.items() if a == address]
+            for old in mine[: max(0, len(mine) - self.per_address + 1)]:
+                del self._items[old]
+            while len(self._items) >= self.most:
+                self._items.popitem(last=False)
+            self._items[nonce] = (now + self.seconds, str(address), str(token)[:_MAX_QUERY_CHARS])
+        return nonce
+
+    def take(self, nonce: str | None) -> str | None:
+        """The token kept under ``nonce``, once (None: unknown, already taken or expired)."""
+        if not nonce:
+            return None
+        with self._lock:
+            self._expire(self.clock())
+            item = self._items.pop(str(nonce), None)
+        return None if item is None else item[2]

@@ -5,13 +5,16 @@
   loopback address: on a student's phone 127.0.0.1 is the phone itself); :func:`qr_text` / :func:`qr_data_uri`
   draw one of them as a QR code (``segno``) for the terminal and the lecturer's panel.
 - :class:`Handshakes` sees every HTTP request and websocket handshake
-(:func:`~tpm_viz.viserkit.core.hook_handshakes`): a
+(:func:`~tpm_viz.viserkit.adapter.new_server`): a
   websocket whose ``Origin`` is not the host the page was served under is refused with 403 (the same-origin check
   Jupyter's server makes: any page open in the lecturer's browser could otherwise drive the mechanism on
   127.0.0.1); a client without ``Origin`` (not a browser) may connect. The page's response sets a
   ``tpmviz_id`` cookie the server minted and signed (:mod:`tpm_viz.classroom.identity`; one it did not sign is
   replaced), which the browser sends back with every websocket handshake, reconnections included: it is
-  how a tab that comes back after a wifi blip or a restart is recognised (:func:`identity`).
+  how a tab that comes back after a wifi blip or a restart is recognised (:func:`identity`). A page asked with
+  ``?share=TOKEN`` (a share link, :mod:`tpm_viz.app.links`) gets a short-lived ``tpmviz_share`` cookie naming where
+  its token waits (:data:`PENDING`); that page's websocket brings it back and :func:`shared_token` hands the token
+  over once (:mod:`.share` opens it on the tab's own copy).
 """
 
 from __future__ import annotations
@@ -32,11 +35,16 @@ from urllib.parse import urlsplit
 
 import segno
 
+from tpm_viz.app.links import PENDING_SECONDS, PendingLinks, token_of_query
 from tpm_viz.app.network import PROXIED, HostRules, client_address, header_problem, host_name
 from tpm_viz.classroom.identity import Keys, hashed
+from tpm_viz.ui.keyboard import Keyboard
+from tpm_viz.viserkit.page import with_script
 
 __all__ = [
     "COOKIE",
+    "PENDING",
+    "SHARE_COOKIE",
     "Classroom",
     "Handshakes",
     "identity",
@@ -45,6 +53,7 @@ __all__ = [
     "qr_data_uri",
     "qr_text",
     "same_origin",
+    "shared_token",
     "student_urls",
 ]
 
@@ -55,6 +64,10 @@ COOKIE_MAX_AGE = 7 * 24 * 3600
 DEFAULT_KEYS = Keys()
 """The cookie keys of a server built without its own (a secret of this process: in-process servers and tests)."""
 _PAGES = ("/", "/index.html")
+SHARE_COOKIE = "tpmviz_share"
+"""The short-lived cookie that carries a share link's nonce from the page to its websocket (:mod:`.share`)."""
+PENDING = PendingLinks()
+"""The share tokens of pages whose tab has not connected yet (this process's; :class:`Handshakes` fills it)."""
 
 
 def is_loopback_address(host: str) -> bool:
@@ -151,6 +164,25 @@ def _cookie(headers: Any, keys: Keys) -> str | None:
     return None if morsel is None else keys.verify(morsel.value)
 
 
+def _share_nonce(headers: Any) -> str | None:
+    """The value of the share cookie (:data:`SHARE_COOKIE`) a request carries, else None."""
+    raw = None if headers is None else headers.get("Cookie")
+    if not raw or SHARE_COOKIE not in raw:
+        return None
+    try:
+        jar: SimpleCookie = SimpleCookie()
+        jar.load(raw)
+    except Exception:  # a malformed Cookie header: no link
+        return None
+    morsel = jar.get(SHARE_COOKIE)
+    return None if morsel is None else morsel.value
+
+
+def shared_token(headers: Any, links: PendingLinks = PENDING) -> str | None:
+    """The share token of the page a websocket handshake (``headers``) comes from, once (None: none waiting)."""
+    return links.take(_share_nonce(headers))
+
+
 def identity(remote: Any, headers: Any, keys: Keys = DEFAULT_KEYS) -> str | None:
     """Who a tab is across reconnections, hashed (:func:`~tpm_viz.classroom.identity.hashed`): ``c:...`` for a
     browser with a cookie this server signed, else ``a:...`` of its address and user agent for a browser without
@@ -167,17 +199,23 @@ def identity(remote: Any, headers: Any, keys: Keys = DEFAULT_KEYS) -> str | None
 
 
 class Handshakes:
-    """The hook of :func:`~tpm_viz.viserkit.core.hook_handshakes`: refuse cross-origin websockets, give pages an
-    identity."""
+    """The hook of :func:`~tpm_viz.viserkit.adapter.new_server`: refuse cross-origin websockets, give pages an
+    identity, and keep a share link's token for the tab the page opens (:data:`SHARE_COOKIE`)."""
 
-    def __init__(self, hosts: HostRules | None = None, keys: Keys | None = None) -> None:
+    def __init__(
+        self, hosts: HostRules | None = None, keys: Keys | None = None, links: PendingLinks | None = None
+    ) -> None:
         self.refused = 0
+        self.links = links if links is not None else PENDING
+        """Where a page's share token waits for its websocket (:func:`shared_token` reads it)."""
         self.keys = keys if keys is not None else DEFAULT_KEYS
         """Mints the page's identity cookie (:mod:`tpm_viz.classroom.identity`)."""
         self.hosts = hosts if hosts is not None else HostRules()
         """The ``Host`` names served and the trusted proxies (:mod:`tpm_viz.app.network`)."""
         self._warned_proxy = False
         self._logged = 0.0
+        self.keyboard = Keyboard()
+        """The tabs' keys (:mod:`.keyboard`): the page script's requests are answered here."""
 
     def _refusal(self, connection: Any, headers: Any) -> Any:
         """400 for malformed or duplicated headers, 403 for a ``Host`` not of this server (DNS rebinding), else
@@ -217,6 +255,8 @@ class Handshakes:
         refusal = self._refusal(connection, headers)
         if refusal is not None:
             return refusal
+        if (key := self.keyboard.answer(request.path, same_origin(headers))) is not None:
+            return connection.respond(*key)  # a key of the page script (viserkit/page.py)
         if headers.get("Upgrade", "").lower() == "websocket":
             if same_origin(headers):
                 return None
@@ -225,6 +265,8 @@ class Handshakes:
             return connection.respond(http.HTTPStatus.FORBIDDEN, "cross-origin websocket refused\n")
         response = viser_response()
         path = request.path.partition("?")[0]
+        if path in _PAGES:
+            response = with_script(response)  # keys, live region, labels (viserkit/page.py)
         if (
             response is not None
             and response.status_code == 200
@@ -234,4 +276,19 @@ class Handshakes:
             response.headers["Set-Cookie"] = (
                 f"{COOKIE}={self.keys.mint()}; Path=/; Max-Age={COOKIE_MAX_AGE}; HttpOnly; SameSite=Strict"
             )
+        if response is not None and response.status_code == 200 and path in _PAGES:
+            self._share(connection, request.path, headers, response)
         return response
+
+    def _share(self, connection: Any, target: str, headers: Any, response: Any) -> None:
+        """A page asked with ``?share=TOKEN``: keep the token for this page's tab, its nonce in a cookie; a page
+        without one: forget a nonce still in the browser (a plain reload opens no link)."""
+        token = token_of_query(target.partition("?")[2])
+        if token is not None:
+            nonce = self.links.put(token, str(getattr(connection, "tpm_viz_client", "")))
+            response.headers["Set-Cookie"] = (
+                f"{SHARE_COOKIE}={nonce}; Path=/; Max-Age={int(PENDING_SECONDS)}; HttpOnly; SameSite=Strict"
+            )
+        elif _share_nonce(headers) is not None:
+            self.links.take(_share_nonce(headers))
+            response.headers["Set-Cookie"] = f"{SHARE_COOKIE}=; Path=/; Max-Age=0; HttpOnly; SameSite=Strict"
