@@ -15,6 +15,7 @@ from tpm_viz import Params
 from tpm_viz.multibody.control import ControlSetup, simulate
 from tpm_viz.paper.control import ControllerKind, Gains
 from tpm_viz.paper.trajectories import trajectory_from_samples
+from tpm_viz.viserkit.probe import widget_uuid
 
 P = Params.paper()
 
@@ -61,8 +62,8 @@ def test_simulate_shows_the_run_its_charts_and_its_row_equal_to_the_library(conn
         assert chart.handle.visible and all(np.all(np.isfinite(a)) for a in chart.handle.data)
     np.testing.assert_allclose(_state(view).pose.p, expected.p[0], atol=1e-12)  # t = 0: the actual platform
     wait_for(lambda: ("/control/ghost", client_owner(view)) in client.nodes, what="the ghost in the tab's scope")
-    assert cv._ghost.visible
-    np.testing.assert_allclose(cv._ghost.position[:2], expected.p_ref[0], atol=1e-9)
+    assert cv.nodes.ghost.visible
+    np.testing.assert_allclose(cv.nodes.ghost.position[:2], expected.p_ref[0], atol=1e-9)
 
     client.set_value(cv.controller, "PD")  # a second controller on the same setup: a second row
     time.sleep(0.05)
@@ -107,7 +108,7 @@ def test_play_moves_the_actual_platform_and_the_ghost_follows_the_reference(conn
     wait_for(lambda: _state(view).trajectory.t == pytest.approx(0.1), what="t = 0.1 s")
     k = int(np.argmin(np.abs(run.t - 0.1)))
     np.testing.assert_allclose(_state(view).pose.p, run.p[k], atol=1e-9)
-    np.testing.assert_allclose(cv._ghost.position[:2], run.p_ref[k], atol=1e-9)
+    np.testing.assert_allclose(cv.nodes.ghost.position[:2], run.p_ref[k], atol=1e-9)
     client.set_value(cv.magnify, "×10")
     want = run.p_ref[k] + 10 * (run.p[k] - run.p_ref[k])
     wait_for(lambda: np.allclose(_state(view).pose.p, want, atol=1e-9), what="the error magnified ten times")
@@ -119,7 +120,7 @@ def test_play_moves_the_actual_platform_and_the_ghost_follows_the_reference(conn
     client.set_value(cv.controls, "Play")
     wait_for(lambda: _state(view).trajectory.t == pytest.approx(run.t[-1]), timeout=10, what="the end of the run")
     wait_for(lambda: not cv.player.playing, what="stopped at the end")
-    np.testing.assert_allclose(cv._ghost.position[:2], run.p_ref[-1], atol=1e-9)
+    np.testing.assert_allclose(cv.nodes.ghost.position[:2], run.p_ref[-1], atol=1e-9)
 
 
 def test_an_unstable_loop_is_refused_in_one_line_and_the_last_run_stays(connect):
@@ -141,7 +142,7 @@ def test_an_unstable_loop_is_refused_in_one_line_and_the_last_run_stays(connect)
 def _csv_upload(client, view, name: str, content: bytes) -> None:
     """What viser's upload button sends (one part): a transfer start, then the content."""
     transfer = str(uuid.uuid4())
-    uid = view.teaching.player.upload._impl.uuid
+    uid = widget_uuid(view.teaching.player.upload)
     client.send(
         type="FileTransferStartUpload",
         source_component_uuid=uid,

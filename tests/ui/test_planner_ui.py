@@ -16,6 +16,7 @@ from tpm_viz import Params
 from tpm_viz.app.paths import path_for
 from tpm_viz.app.planner import Limits, plan_cycle, plan_path
 from tpm_viz.app.planning import parse_waypoints, solve
+from tpm_viz.viserkit.probe import widget_uuid
 
 P = Params.paper()
 
@@ -82,7 +83,7 @@ def test_the_cycle_time_shown_is_the_library_plan_at_that_limit(connect):
 
 def _measure(client, pv, base: float) -> tuple[list[float], list[float]]:
     """Latencies [s] of single moves of the force slider and of the last value of three drags."""
-    uuid = pv.result_html._impl.uuid
+    uuid = widget_uuid(pv.result_html)
 
     def shown(t0: float, want: str) -> list[tuple[float, str]]:
         return [(t, c) for t, c in client.contents_after(uuid, t0) if _q(c, "plan-force") == want]

@@ -15,6 +15,7 @@ from tpm_viz import Params
 from tpm_viz.app.lessons import DEMOS
 from tpm_viz.paper.trajectories import circle_state, line_state
 from tpm_viz.ui.teaching.charts import CHART_POINTS
+from tpm_viz.viserkit.probe import widget_uuid
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
@@ -49,7 +50,7 @@ def _csv_upload(client, view, name: str, content: bytes) -> None:
     import uuid
 
     transfer = str(uuid.uuid4())
-    uid = view.teaching.player.upload._impl.uuid
+    uid = widget_uuid(view.teaching.player.upload)
     parts = [content[i : i + 65536] for i in range(0, len(content), 65536)] or []
     client.send(
         type="FileTransferStartUpload",

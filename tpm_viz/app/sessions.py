@@ -10,6 +10,7 @@ one :class:`~tpm_viz.InputError`. :func:`write_atomic` replaces a file in one st
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -98,8 +99,23 @@ def _source(source: Source | None) -> dict[str, Any] | None:
     return out
 
 
+def _honest(state: AppState, source: Source | None) -> AppState:
+    """``state`` as saved: never a run's stale dynamic load. The platform is at rest (static load, keeping ``f_ext``);
+    the sample stays only if it is one of the saved trajectory (reopening seeks there again and recomputes ``ṗ, p̈``),
+    a control run's or a plan's sample (a tab's own, not saved) becomes ``"none"``."""
+    if not state.run_load:
+        return state
+    ours = (
+        source is not None
+        and state.trajectory.kind == source.kind
+        and abs(state.trajectory.duration - source.duration) < 1e-12
+    )
+    rest = state.at_rest()
+    return dataclasses.replace(rest, trajectory=state.trajectory) if ours else rest
+
+
 def _saved(saved: Saved) -> dict[str, Any]:
-    s = saved.state
+    s = _honest(saved.state, saved.source)
     return {
         "params": {name: float(getattr(s.params, name)) for name in PARAM_INFO},
         "p": _vec(s.pose.p),
@@ -215,12 +231,13 @@ def _read_saved(raw: Any, where: str) -> Saved:
         _number(sample_raw, "duration", where + "sample."),
         _number(sample_raw, "t", where + "sample."),
     )
-    state = AppState(params=params, pose=pose, load=load, trajectory=sample)
+    source = _read_source(raw.get("trajectory"))
+    state = _honest(AppState(params=params, pose=pose, load=load, trajectory=sample), source)
     show_raw = raw.get("show", {}) if isinstance(raw, dict) else {}
     show = {str(k): v for k, v in show_raw.items() if isinstance(v, bool)} if isinstance(show_raw, dict) else {}
     player_t = _number(raw, "player_t", where) if "player_t" in raw else 0.0
     lang = Lang.parse(raw.get("lang")).value  # absent (older files) or unknown: English
-    return Saved(state, _read_source(raw.get("trajectory")), max(0.0, player_t), show, lang)
+    return Saved(state, source, max(0.0, player_t), show, lang)
 
 
 def encode_saved(saved: Saved) -> dict[str, Any]:

@@ -16,7 +16,15 @@ from tpm_viz.app.readouts import Load
 from tpm_viz.params import Params
 from tpm_viz.words import Phrase
 
-__all__ = ["AppState", "Changes", "TrajectorySample"]
+__all__ = ["AppState", "Changes", "TrajectorySample", "run_note"]
+
+
+def run_note(run: str | Phrase, t: float) -> Phrase:
+    """The one line under the banner while the platform rests on a run's sample (paused, scrubbed, at its end): the
+    forces shown are that run's dynamic load at ``t`` [s], not the static load of the pose."""
+    return Phrase(
+        "Forces: the dynamic load of {run} at t = {t} s (a move or Home shows the static load)", run=run, t=f"{t:.3f}"
+    )
 
 
 @dataclass(frozen=True)
@@ -62,3 +70,17 @@ class AppState:
     def replace(self, **changes: Unpack[Changes]) -> AppState:
         """A copy with some fields changed and the version bumped."""
         return dataclasses.replace(self, version=self.version + 1, **changes)
+
+    @property
+    def run_load(self) -> bool:
+        """Whether the load is a run's sample (``ṗ, p̈`` at the time a trajectory, control run or plan was left at),
+        not one typed by hand."""
+        return self.trajectory.kind != "none" and self.load.mode == "dynamic"
+
+    def at_rest(self, note: str | Phrase | None = None) -> AppState:
+        """The same pose at rest, off any run: a run's dynamic load goes back to the static one (keeping the typed
+        ``f_ext``; eq. 31 with ``ṗ = p̈ = 0``), the sample to ``"none"``. A dynamic load typed by hand stays (it is
+        the question being asked: "what forces at this velocity?"). ``note``: the new note (None: unchanged)."""
+        load = Load("static", f_ext=self.load.f_ext) if self.run_load else self.load
+        sample = TrajectorySample("none", self.trajectory.duration, 0.0)
+        return self.replace(load=load, trajectory=sample, note=self.note if note is None else note)

@@ -20,7 +20,7 @@ from tpm_viz.app.inputs import read_choice, read_number, read_params, read_vec2
 from tpm_viz.app.moves import Move, drag_to, drive_to, switch_mode
 from tpm_viz.app.poses import DEMO_KINDS, go_home, preset_pose, settle
 from tpm_viz.app.readouts import LOAD_MODES, Load
-from tpm_viz.app.state import AppState, TrajectorySample
+from tpm_viz.app.state import AppState
 from tpm_viz.params import Params
 from tpm_viz.words import T
 
@@ -56,11 +56,7 @@ def _moved(state: AppState, move: Move) -> AppState:
     A platform moved by hand is at rest: if its load was a trajectory's sample (``ṗ, p̈`` of the time last played),
     the load goes back to static (keeping the typed ``f_ext``), so that no stale acceleration is shown. A dynamic
     load typed by hand stays: it is the question being asked ("what forces at this velocity?")."""
-    sample = TrajectorySample("none", state.trajectory.duration, 0.0)
-    load = state.load
-    if state.trajectory.kind != "none" and load.mode == "dynamic":
-        load = Load("static", f_ext=load.f_ext)
-    return state.replace(pose=move.pose, note=move.reason, trajectory=sample, load=load)
+    return state.at_rest(move.reason).replace(pose=move.pose)
 
 
 def drag(state: AppState, position: object) -> AppState:
@@ -126,13 +122,17 @@ def set_load(state: AppState, mode: object, f_ext: object, dp: object, ddp: obje
 
 def apply_params(state: AppState, raw: Mapping[str, object]) -> AppState:
     """The parameter inputs (mm, kg): a new mechanism and the nearest valid pose on it."""
-    params = read_params(state.params, raw)
-    move = settle(params, state.pose)
-    return state.replace(params=params, pose=move.pose, note=move.reason)
+    return _new_params(state, read_params(state.params, raw))
 
 
 def paper_params(state: AppState) -> AppState:
     """The paper's Tables 1-2 and the nearest valid pose on them."""
-    params = Params.paper()
+    return _new_params(state, Params.paper())
+
+
+def _new_params(state: AppState, params: Params) -> AppState:
+    """``params`` and the nearest valid pose on them. A run's sample is left (its ``ṗ, p̈`` belong to the old
+    mechanism): the platform is at rest there, with the static load (:meth:`AppState.at_rest`)."""
     move = settle(params, state.pose)
-    return state.replace(params=params, pose=move.pose, note=move.reason)
+    base = state if params == state.params else state.at_rest()
+    return base.replace(params=params, pose=move.pose, note=move.reason)

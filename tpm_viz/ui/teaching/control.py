@@ -19,7 +19,6 @@ import time
 import numpy as np
 import viser
 
-from tpm_viz import meshes
 from tpm_viz.app.palette import hex_colour
 from tpm_viz.app.readouts import reason
 from tpm_viz.classroom.guard import guarded
@@ -51,7 +50,7 @@ from tpm_viz.ui.teaching.motion import MotionPlayer, TimeChart
 from tpm_viz.ui.teaching.player import SPEEDS
 from tpm_viz.ui.teaching.playing import RunHub
 from tpm_viz.ui.teaching.settings import CONTROL_SETTINGS
-from tpm_viz.ui.teaching.trace import TRACE_Z, segments
+from tpm_viz.ui.teaching.stage import CONTROL, ControlNodes, bring, front
 from tpm_viz.ui.typed_sliders import TypedSlider, add_sliders
 from tpm_viz.words import Phrase, T, say
 
@@ -60,8 +59,6 @@ __all__ = ["CONTROLLERS", "MAGNIFY", "ControlView"]
 CONTROLLERS = {label: kind for kind, label in LABELS.items()}
 MAGNIFY = {"×1 (true error)": 1.0, "×10": 10.0, "×100": 100.0, "×1000": 1000.0}
 LESSON_PAYLOAD = 1.0  # kg, set by the lesson when the payload slider is at zero
-GHOST_COLOUR = (34, 197, 94)
-REF_COLOUR, ACTUAL_COLOUR = (34, 197, 94), (220, 38, 38)
 CHART_HZ = 4.0
 
 
@@ -93,8 +90,7 @@ class ControlView:
         self.table: dict[ControllerKind, ControlRun] = {}
         self._table_key: tuple | None = None
         self.charts: tuple[TimeChart, ...] = ()  # built with the tab
-        self._ghost: viser.BoxHandle | None = None
-        self._paths: dict[str, viser.LineSegmentsHandle] = {}
+        self.nodes = ControlNodes(view.client.scene)
         self._last_push = 0.0
         self._request = 0
 
@@ -164,8 +160,9 @@ class ControlView:
 
     def _user(self, event, fn, *args) -> None:
         """Run ``fn`` for a user event (not a server echo); a refusal is told to this tab only."""
-        if getattr(event, "client", None) is None or self.view.closed or getattr(self.view, "session", None) is None:
+        if getattr(event, "client", None) is None or self.view.closed:
             return
+        bring(self.view, CONTROL, redraw=True)
         try:
             fn(*args)
         except TpmVizError as exc:
@@ -284,33 +281,13 @@ class ControlView:
         self.force_chart.show(run.t, (run.tau[:, 0], run.tau[:, 1], run.tau_ff[:, 0], run.tau_ff[:, 1]))
         self.time.max = max(float(run.t[-1]), 1e-3)
         self.time.step = max(float(run.t[-1]) / 400.0, 1e-4)
-        self._draw_paths(params)
+        bring(self.view, CONTROL)
+        self._draw_paths()
 
-    def _draw_paths(self, params: Params) -> None:
+    def _draw_paths(self) -> None:
         motion = self.player.motion
-        if not isinstance(motion, ControlMotion):
-            return
-        scene = self.view.client.scene
-        for name, pts, colour in (
-            ("reference", motion.run.p_ref, REF_COLOUR),
-            ("actual", motion.shown_path(), ACTUAL_COLOUR),
-        ):
-            z = TRACE_Z + (0.001 if name == "actual" else 0.0)
-            self._paths[name] = scene.add_line_segments(
-                f"/control/{name}", segments(pts, z, 400), colour, thickness=2.5, thickness_units="screen"
-            )
-        half = meshes.platform_half_size(params)
-        thick = meshes.PLATFORM_Z[1] - meshes.PLATFORM_Z[0]
-        self._ghost = scene.add_box(
-            "/control/ghost",
-            GHOST_COLOUR,
-            (2 * half, 2 * half, thick),
-            opacity=0.45,
-            cast_shadow=False,
-            receive_shadow=False,
-            position=(0.0, 0.0, float(np.mean(meshes.PLATFORM_Z)) + 0.002),
-            visible=False,
-        )
+        if isinstance(motion, ControlMotion):
+            self.nodes.draw(motion.params, motion.run.p_ref, motion.shown_path())
 
     @guarded(on_error=_internal_error)
     def _on_controls(self, event) -> None:
@@ -347,11 +324,22 @@ class ControlView:
             if not isinstance(motion, ControlMotion):
                 return
             motion.magnify = MAGNIFY.get(self.magnify.value, 1.0)
-            self._draw_paths(motion.params)
+            self._draw_paths()
             t = self.player.at(self.view.session.state)
             if t is not None and not self.player.playing:
                 self.player.seek(t)
             self.view.client.flush()
+
+    def _discard(self) -> None:
+        """The mechanism's parameters changed: the run (computed for the old ones) is dropped, and the summary says
+        so in one line (under the lock)."""
+        self.run, self.seconds, self._lesson = None, None, None
+        self.player.stop()
+        self.status = T("The parameters changed: the control run was discarded; press Simulate again.")
+        for chart in self.charts:
+            chart.hide()
+        self.nodes.hide()
+        self.summary.content = run_html(None, None, self.busy, self.status, self.view.lang)
 
     # -- drawing -------------------------------------------------------------------------------------------
     def _refresh_status(self) -> None:
@@ -367,25 +355,17 @@ class ControlView:
 
     def render(self, frame: Snapshot) -> None:
         """Draw the control tab's part of ``frame`` (under the hub's lock): ghost, chart markers, time slider."""
-        session = getattr(self.view, "session", None)
-        if session is None:
-            return
+        session = self.view.session
         uploaded = self.runs.of(session).uploaded
         options = (*PAPER, upload_label(uploaded)) if uploaded is not None else tuple(PAPER)
         if tuple(self.reference.options) != options:
             self.reference.options = options
+        if self.run is not None and frame.state.params != self.player.motion_params:
+            self._discard()
         t = self.player.at(frame.state)
         motion = self.player.motion
-        ghost = self._ghost
-        if ghost is not None:
-            if t is None or not isinstance(motion, ControlMotion):
-                if ghost.visible:
-                    ghost.visible = False
-            else:
-                x, y = motion.reference_at(t)
-                ghost.position = (float(x), float(y), ghost.position[2])
-                if not ghost.visible:
-                    ghost.visible = True
+        ghost_at = motion.reference_at(t) if t is not None and isinstance(motion, ControlMotion) else None
+        self.nodes.place(self.run is not None and front(self.view) == CONTROL, ghost_at)
         now = time.monotonic()
         if frame.in_drag and now - self._last_push < 1.0 / CHART_HZ:
             return

@@ -120,7 +120,7 @@ def comparison_html(runs: dict[ControllerKind, ControlRun], setup: str | Phrase,
     """The controllers on the same run (same reference, mechanism, mismatch, limits and noise)."""
     if not runs:
         return ""
-    cell = "padding:2px 6px;text-align:right;font-variant-numeric:tabular-nums"
+    cell = "padding:2px 4px;text-align:right;font-variant-numeric:tabular-nums"
     head = "".join(f'<th style="{cell}">{html.escape(say(lang, h))}</th>' for h in _HEADS)
     body = []
     for kind in ControllerKind:
@@ -129,7 +129,7 @@ def comparison_html(runs: dict[ControllerKind, ControlRun], setup: str | Phrase,
             continue
         v = kind.value
         body.append(
-            f'<tr><td style="padding:2px 6px">{html.escape(say(lang, label_of(kind)))}</td>'
+            f'<tr><td style="padding:2px 4px">{html.escape(say(lang, label_of(kind)))}</td>'
             f'<td style="{cell}" data-q="rms-{v}">{num(run.rms_error, ".2f", 1e6)}</td>'
             f'<td style="{cell}" data-q="max-{v}">{num(run.max_error, ".2f", 1e6)}</td>'
             f'<td style="{cell}" data-q="peak-{v}">{num(run.peak_force, ".1f")}</td>'
@@ -139,7 +139,8 @@ def comparison_html(runs: dict[ControllerKind, ControlRun], setup: str | Phrase,
     return (
         f'<div data-q="control-table" style="{_STYLE}"><b>{title}</b> '
         f'<span style="color:#64748b">({html.escape(say(lang, setup))})</span>'
-        f'<table style="border-collapse:collapse;margin-top:4px"><tr>{head}</tr>{"".join(body)}</table></div>'
+        f'<div style="overflow-x:auto"><table style="border-collapse:collapse;margin-top:4px">'
+        f"<tr>{head}</tr>{''.join(body)}</table></div></div>"
     )
 
 

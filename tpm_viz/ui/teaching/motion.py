@@ -22,12 +22,12 @@ import viser
 
 from tpm_viz.app.moves import place
 from tpm_viz.app.readouts import Load
-from tpm_viz.app.state import AppState, TrajectorySample
+from tpm_viz.app.state import AppState, TrajectorySample, run_note
 from tpm_viz.classroom.guard import report
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.params import Params
 from tpm_viz.ui.teaching.charts import LARGE, NORMAL, TICK_PX, AxisLook, marker
-from tpm_viz.words import Phrase
+from tpm_viz.words import Phrase, T
 
 __all__ = ["FPS", "Motion", "MotionPlayer", "TimeChart"]
 
@@ -35,6 +35,8 @@ FPS = 30.0
 CHART_POINTS = 151
 X_LABEL = "time t (s)"
 MARKER = "#f59e0b"
+RUN_NAMES = {"control": T("the control run"), "plan": T("the planned path")}
+"""What the note under the banner calls a player's motion (:func:`~tpm_viz.app.state.run_note`)."""
 
 
 class Motion(Protocol):
@@ -54,10 +56,16 @@ class MotionPlayer:
     def __init__(self, view, kind: str, on_stop: Callable[[], None] | None = None) -> None:
         self.view = view
         self.kind = f"{kind}#{id(self):x}"  # this tab's motion only (another tab's run of the same length is not ours)
+        self.name = RUN_NAMES.get(kind, kind)
         self.motion: Motion | None = None
         self.playing = False
         self._token = -1
         self._on_stop = on_stop
+
+    @property
+    def motion_params(self) -> Params | None:
+        """The mechanism the motion was computed for (None: no motion)."""
+        return None if self.motion is None else self.motion.params
 
     def at(self, state: AppState) -> float | None:
         """The time [s] of this player's motion that ``state`` shows, or None (another motion, moved by hand)."""
@@ -67,8 +75,9 @@ class MotionPlayer:
             return None
         return sample.t if abs(sample.duration - motion.duration) < 1e-12 else None
 
-    def sampled(self, state: AppState, t: float) -> AppState:
-        """``state`` at time ``t`` of the motion (pose and dynamic load; unchanged with the reason if not valid)."""
+    def sampled(self, state: AppState, t: float, settled: bool = False) -> AppState:
+        """``state`` at time ``t`` of the motion (pose and dynamic load; unchanged with the reason if not valid).
+        ``settled``: the platform stays there (paused, scrubbed, at the end): the note says whose load it shows."""
         motion = self.motion
         assert motion is not None
         t = float(np.clip(t, 0.0, motion.duration))
@@ -77,7 +86,8 @@ class MotionPlayer:
         dynamic = Load("dynamic", dp=(float(dp[0]), float(dp[1])), ddp=(float(ddp[0]), float(ddp[1])))
         load = state.load if move.clamped else dynamic
         sample = TrajectorySample(self.kind, motion.duration, t)
-        return state.replace(pose=move.pose, load=load, trajectory=sample, note=move.reason)
+        note = move.reason or (run_note(self.name, t) if settled else "")
+        return state.replace(pose=move.pose, load=load, trajectory=sample, note=note)
 
     def _usable(self) -> Motion:
         motion = self.motion
@@ -95,7 +105,7 @@ class MotionPlayer:
             self._usable()
             session.play_token += 1
             self.playing = False
-            self.view.hub.commit(session, self.sampled(session.state, t), origin=self.view)
+            self.view.hub.commit(session, self.sampled(session.state, t, settled=True), origin=self.view)
 
     def pause(self) -> None:
         """Stop playing (the last frame is committed again in full)."""
@@ -106,7 +116,7 @@ class MotionPlayer:
             session.play_token += 1
             self.playing = False
             if t is not None:
-                self.view.hub.commit(session, self.sampled(session.state, t), origin=self.view)
+                self.view.hub.commit(session, self.sampled(session.state, t, settled=True), origin=self.view)
 
     def stop(self) -> None:
         """Forget the motion (a playing thread ends at its next frame)."""
@@ -147,7 +157,7 @@ class MotionPlayer:
                         t0, wall0, t = 0.0, time.monotonic(), 0.0
                     elif t >= motion.duration:
                         self.playing = False
-                    state = self.sampled(session.state, min(t, motion.duration))
+                    state = self.sampled(session.state, min(t, motion.duration), settled=not self.playing)
                     if state.note:
                         self.playing = False
                     try:

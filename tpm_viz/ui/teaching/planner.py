@@ -29,6 +29,7 @@ from tpm_viz.ui.teaching.motion import MotionPlayer, TimeChart
 from tpm_viz.ui.teaching.planner_text import industry_html, result_html, sizing_html
 from tpm_viz.ui.teaching.player import SPEEDS
 from tpm_viz.ui.teaching.settings import PLANNER_SETTINGS
+from tpm_viz.ui.teaching.stage import PLAN, bring, front, show
 from tpm_viz.ui.teaching.trace import TRACE_Z, segments
 from tpm_viz.ui.typed_sliders import TypedSlider, add_sliders
 from tpm_viz.words import Phrase, T
@@ -158,8 +159,9 @@ class PlannerView:
 
     # -- planning ------------------------------------------------------------------------------------------
     def _user(self, event, fn, *args) -> None:
-        if getattr(event, "client", None) is None or self.view.closed or getattr(self.view, "session", None) is None:
+        if getattr(event, "client", None) is None or self.view.closed:
             return
+        bring(self.view, PLAN, redraw=True)
         try:
             fn(*args)
         except TpmVizError as exc:
@@ -220,6 +222,7 @@ class PlannerView:
         self._path = self.view.client.scene.add_line_segments(
             "/planner/path", segments(s.p, TRACE_Z, 400), PATH_COLOUR, thickness=2.5, thickness_units="screen"
         )
+        show(self._path, front(self.view, PLAN) == PLAN)
         if was_playing:
             try:
                 self.player.play(SPEEDS.get(self.play_speed.value, 0.1), bool(self.loop.value))
@@ -287,6 +290,7 @@ class PlannerView:
             self.request()  # the mechanism changed: plan again for the new one
         motion = self.player.motion
         t = self.player.at(frame.state)
+        show(self._path, front(self.view, PLAN) == PLAN)
         if t is None or not isinstance(motion, PlanMotion):
             for handle in (self._bars, self._ticks):
                 if handle is not None and handle.visible:

@@ -27,9 +27,11 @@ from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.figures import force_plot_png, force_plot_svg
 from tpm_viz.paper.trajectories import DEFAULT_DURATIONS
 from tpm_viz.ui.fields import Note, TypedBox
+from tpm_viz.ui.share import ShareBox
 from tpm_viz.ui.teaching.charts import Charts
 from tpm_viz.ui.teaching.player_text import summary_html
 from tpm_viz.ui.teaching.playing import RunHub, following
+from tpm_viz.ui.teaching.stage import PLAYER, bring, front, show
 from tpm_viz.ui.teaching.trace import PathTrace
 from tpm_viz.ui.typed import QUIET, Quantity, TypedField, TypedGroup, duration_note, force_note
 from tpm_viz.words import Phrase, T
@@ -68,6 +70,7 @@ class PlayerView:
         self._pushes = 0
         self._shown_t = _UNSET
         self.trace = PathTrace(view.client.scene)
+        self._in_front = True  # the path and trace are shown (another run's drawing is in front: hidden)
         self._frame: Snapshot | None = None
 
     def build(self, gui: viser.GuiApi) -> None:
@@ -99,6 +102,7 @@ class PlayerView:
         self.export_csv = gui.add_button("Download the run (CSV)", icon=viser.Icon.DOWNLOAD, color="gray")
         self.export_png = gui.add_button("Download the force plot (PNG)", icon=viser.Icon.PHOTO, color="gray")
         self.export_svg = gui.add_button("Download the force plot (SVG)", icon=viser.Icon.VECTOR, color="gray")
+        self.share = ShareBox(self.view, gui)  # *Copy share link* (ui/share.py)
         self.charts.show_run(None, None)
         self.choice.on_update(self._on_choice)
         self.view.typing.add(self.duration, self._apply_duration)
@@ -112,7 +116,7 @@ class PlayerView:
     # -- helpers -------------------------------------------------------------------------------------------
     @property
     def session(self):
-        return getattr(self.view, "session", None)
+        return self.view.session
 
     def _put(self, handle, value) -> None:
         if handle.value != value:
@@ -127,6 +131,7 @@ class PlayerView:
         button; a success clears an earlier refusal there (a load: once it is computed)."""
         if getattr(event, "client", None) is None or getattr(self.view, "closed", False) or self.session is None:
             return
+        bring(self.view, PLAYER, redraw=True)
         try:
             fn(*args)
         except TpmVizError as exc:
@@ -283,6 +288,13 @@ class PlayerView:
             self._set_run(run)
         state = frame.state
         t = state.trajectory.t if following(state, run) else None
+        if t is not None and ps.playing:
+            bring(self.view, PLAYER)  # played on the shared mechanism (by the lecturer, a lesson): in front
+        in_front = front(self.view, PLAYER) == PLAYER
+        if in_front != self._in_front:
+            self._in_front = in_front
+            show(self.trace.path, in_front and run is not None)
+            force = True
         now = time.monotonic()
         due = not frame.in_drag or now - self._last_push >= 1.0 / CHART_HZ
         if (new_run or force or t != self._shown_t) and (due or new_run or force):
@@ -290,7 +302,7 @@ class PlayerView:
             self._last_push = now
             self._pushes += 1
             self.charts.show_time(t, forces_only=frame.in_drag and self._pushes % 2 == 1)
-            self.trace.show_time(run, t)
+            self.trace.show_time(run, t if in_front else None)
             if t is not None:
                 self._put(self.time, float(np.clip(round(t, 4), 0.0, self.time.max)))
         if due or new_run or force:
@@ -307,6 +319,8 @@ class PlayerView:
         sources = self._sources()
         self.choice.options = tuple(sources)
         self.trace.show_run(run)
+        if not self._in_front:
+            show(self.trace.path, False)
         if run is None:
             if self.runs.of(self.session).loading is None:
                 self._put(self.choice, NONE)

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from tpm_viz.app.moves import place
 from tpm_viz.app.readouts import Load, reason
 from tpm_viz.app.runs import Run, Source, build_run
-from tpm_viz.app.state import AppState, TrajectorySample
+from tpm_viz.app.state import AppState, TrajectorySample, run_note
 from tpm_viz.classroom.session import Hub, Session
 from tpm_viz.classroom.worker import Worker
 from tpm_viz.errors import InputError, TpmVizError
@@ -35,14 +35,16 @@ FPS = 30.0
 """Frames per second of playback (wall clock)."""
 
 
-def sampled(state: AppState, run: Run, t: float) -> AppState:
+def sampled(state: AppState, run: Run, t: float, settled: bool = False) -> AppState:
     """``state`` at time ``t`` [s] of ``run``: the pose at ``p(t)`` (working mode), ``ṗ(t), p̈(t)`` as a dynamic
-    load; the pose and load unchanged, with the reason, if ``p(t)`` is not a valid pose."""
+    load; the pose and load unchanged, with the reason, if ``p(t)`` is not a valid pose. ``settled``: the platform
+    stays there (paused, scrubbed, at the end): the note says whose load the forces are."""
     t, p, dp, ddp = run.state_at(t)
     move = place(state.params, state.pose, p)
     load = state.load if move.clamped else Load("dynamic", dp=tuple(dp), ddp=tuple(ddp))
     sample = TrajectorySample(run.source.kind, run.duration, t)
-    return state.replace(pose=move.pose, load=load, trajectory=sample, note=move.reason)
+    note = move.reason or (run_note(T("the played trajectory"), t) if settled else "")
+    return state.replace(pose=move.pose, load=load, trajectory=sample, note=note)
 
 
 def following(state: AppState, run: Run | None) -> bool:
@@ -127,7 +129,7 @@ class RunHub:
                     ps.uploaded = source
                 session.play_token += 1
                 ps.playing = False
-                self.hub.commit(session, sampled(session.state, run, 0.0))
+                self.hub.commit(session, sampled(session.state, run, 0.0, settled=True))
                 if on_done is not None:
                     on_done(run)
 
@@ -217,7 +219,7 @@ class RunHub:
                         t0, wall0 = 0.0, time.monotonic()
                     elif t >= run.duration:
                         ps.playing = False
-                    state = sampled(session.state, run, min(t, run.duration))
+                    state = sampled(session.state, run, min(t, run.duration), settled=not ps.playing)
                     if state.note:
                         ps.playing = False
                     try:
@@ -245,7 +247,7 @@ class RunHub:
             ps.playing = False
             run = ps.run
             if run is not None and following(session.state, run):
-                self.hub.commit(session, sampled(session.state, run, session.state.trajectory.t))
+                self.hub.commit(session, sampled(session.state, run, session.state.trajectory.t, settled=True))
             else:
                 self._refresh(session)
 
@@ -258,7 +260,7 @@ class RunHub:
             ps = self.of(session)
             session.play_token += 1
             ps.playing = False
-            self.hub.commit(session, sampled(session.state, run, t))
+            self.hub.commit(session, sampled(session.state, run, t, settled=True))
 
     def _refresh(self, session: Session) -> None:
         """Redraw the player panel of every view of ``session`` (status, buttons, charts)."""
