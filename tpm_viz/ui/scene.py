@@ -105,7 +105,7 @@ class MechanismScene:
         self.sliders = [add_frame(f"{r}/slider{i + 1}", show_axes=False) for i in range(2)]
         self.platform = add_frame(f"{r}/platform", show_axes=False)
         self.ghost = add_frame(f"{r}/ghost", show_axes=False)
-        self.labels = [scene.add_label(f"{r}/label_O", "O", position=(0.0, 0.0, 0.002), anchor="top-left")]
+        self.labels = [scene.add_label(f"{r}/label_O", "O", position=(0.02, -0.012, 0.002), anchor="top-left")]
         for i in range(2):
             self.labels.append(scene.add_label(f"{r}/slider{i + 1}/label", f"A{'₁₂'[i]}", anchor="bottom-right"))
             self.labels.append(scene.add_label(f"{r}/platform/label_B{i + 1}", f"B{'₁₂'[i]}", anchor="bottom-right"))

@@ -14,7 +14,8 @@ is removed):
   place (:meth:`~.scene.MechanismScene.set_style`).
 
 The gizmo is always the tab's own (each student drags their own handle); it is written back to the platform's pose
-when this tab is not the one dragging.
+when this tab is not the one dragging. On a phone or a tablet (:meth:`TabScene.set_touch`) it is a handle of constant
+screen size a finger can hold, and a drag moves the platform by a gain (:mod:`.phone`): at most 1 mm per CSS px.
 """
 
 from __future__ import annotations
@@ -26,10 +27,14 @@ import viser
 
 from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.params import Params
+from tpm_viz.ui.phone import TOUCH_CSS, TOUCH_GIZMO_PX, drag_gain
 from tpm_viz.ui.scene import FAMILIES, GIZMO_Z, LABEL_SCALE, LINE_SCALE, MechanismScene, line_width
 from tpm_viz.viserkit.core import drop_gizmo_echo
 
-__all__ = ["PRIVATE_ROOT", "TabScene"]
+__all__ = ["GIZMO_SCALE", "PRIVATE_ROOT", "TabScene"]
+
+GIZMO_SCALE = 0.16
+"""Size of the gizmo [m] with a mouse (its arrows' length in the scene)."""
 
 PRIVATE_ROOT = "/own"
 """Where a tab draws its private copy (its own scope)."""
@@ -54,9 +59,15 @@ class TabScene:
         self._styled: dict[str, Any] = {}  # broadcast node name -> this tab's styled copy (presentation mode)
         self._styled_for: Params | None = None  # the shared parameters those copies were drawn for
         self._gizmo_at: np.ndarray | None = None
+        self.touch = False
+        """A phone or a tablet: the handle of constant screen size and the drag gain (:meth:`set_touch`)."""
+        self._placed = np.zeros(2)  # where the gizmo was last written [m]: where a drag starts from
+        self._anchor: tuple[np.ndarray, np.ndarray, float] | None = (
+            None  # a geared drag: (gizmo, platform) at start, gain
+        )
         self.gizmo = self._api.add_transform_controls(
             "/gizmo",
-            scale=0.16,
+            scale=GIZMO_SCALE,
             active_axes=(True, True, False),
             disable_rotations=True,
             depth_test=False,
@@ -174,12 +185,58 @@ class TabScene:
         if self._gizmo_at is None or not np.array_equal(at, self._gizmo_at):
             self.gizmo.position = at
             self._gizmo_at = at
+            self._placed = at[:2].copy()
 
     def forget(self) -> None:
         """Write the gizmo (and a private copy) again at the next :meth:`update` (a refused drag goes back)."""
         self._gizmo_at = None
+        self._anchor = None
         if self.private is not None:
             self.private.forget()
+
+    # -- touch -----------------------------------------------------------------------------------------------
+    def set_touch(self, on: bool) -> None:
+        """A phone or a tablet (:func:`~.phone.is_touch`): the gizmo becomes a handle of :data:`~.phone.TOUCH_GIZMO_PX`
+        CSS px (viser's ``fixed`` size; the square in the floor's plane only, no arrows), and drags are geared."""
+        if bool(on) == self.touch:
+            return
+        self.touch = bool(on)
+        gizmo = self.gizmo
+        gizmo.fixed = self.touch
+        gizmo.scale = TOUCH_GIZMO_PX if self.touch else GIZMO_SCALE
+        gizmo.disable_axes = self.touch
+        gizmo.line_width = 4.0 if self.touch else 2.5
+        if self.touch:
+            self._client.gui.add_html(TOUCH_CSS)
+
+    def geared(self, phase: str, position: object, platform: object) -> object:
+        """Where a drag event's gizmo ``position`` [m] moves the platform (at ``platform`` [m] now): on a touch tab the
+        platform's start plus the gain times the gizmo's way since the drag started; elsewhere ``position`` itself.
+        The gain is fixed when the drag starts (:func:`~.phone.drag_gain` at the tab's camera)."""
+        if not self.touch:
+            return position
+        try:
+            g = np.asarray(position, dtype=float).reshape(-1)[:2]
+        except (TypeError, ValueError):
+            return position  # refused downstream, in one line
+        if g.shape != (2,) or not np.all(np.isfinite(g)):
+            return position
+        if self._anchor is None:
+            start = np.asarray(platform, dtype=float).reshape(-1)[:2]
+            self._anchor = (self._placed.copy(), start, self._gain(start))
+        g0, p0, gain = self._anchor
+        if phase == "end":
+            self._anchor = None
+        return p0 + gain * (g - g0)
+
+    def _gain(self, at: np.ndarray) -> float:
+        """The drag gain at the platform ``at`` [m] for this tab's camera (1 before the tab reported one)."""
+        try:
+            camera = self._client.camera
+            position, fov, height = np.asarray(camera.position, dtype=float), float(camera.fov), camera.image_height
+        except AssertionError:  # no camera message yet
+            return 1.0
+        return drag_gain(position, (float(at[0]), float(at[1]), GIZMO_Z), fov, float(height))
 
 
 def styled_copy(scene: viser.SceneApi, handle: Any) -> Any:
