@@ -11,13 +11,15 @@ Either way the canvas is the free part of the screen, so the camera frames the m
 The camera is framed again when that ratio changes (a rotated phone, a resized window, a collapsed panel), not
 when the viewer orbits or zooms.
 
-**Presentation mode** (a checkbox of the *Class & view* tab, per tab): large type (the readouts
-:data:`READOUT_PX` CSS pixels, every label darker and larger), a wider panel (:data:`PRESENTATION_WIDTH`), thicker
-lines and larger labels in 3D (:mod:`.tabscene`), the player's charts with 18 px dark axes
-(:data:`~.teaching.charts.LARGE`), and a box of the banner and the two forces that floats over the
-bottom of the canvas whenever the panel is collapsed to its rail (a separate viser panel, shown by the style sheet
-only then; the framing keeps its band free). All of it is this tab's own: the style sheet is an HTML element of
-the tab's GUI, and every tab's GUI is its own.
+**Presentation mode** (a checkbox of the *Class & view* tab, per tab): the stage of a projector. The control panel
+folds to its rail (viser's ``minimize``: the 3D canvas is then the whole screen but the rail) and one click on the rail
+brings it back for the lecturer. A box of live numbers floats over the bottom of the canvas while the panel is folded
+(a separate viser panel, shown by the style sheet only then; the framing keeps its band free): the pose status and
+its warnings at :data:`BANNER_PX`, p, d, τ₁ and τ₂ with their bars at :data:`READOUT_PX` CSS pixels. With the panel
+open, its readout is the same compact one (:data:`~.panels.FOLDED` left out) in large, dark type, the panel wider
+(:data:`PRESENTATION_WIDTH`); thicker lines and larger labels in 3D (:mod:`.tabscene`), the player's charts with 18 px
+dark axes (:data:`~.teaching.charts.LARGE`). All of it is this tab's own: the style sheet is an HTML element of the
+tab's GUI, and every tab's GUI is its own.
 
 Nothing here computes; the style sheets are constants, and the messages are words of :mod:`tpm_viz.words`.
 """
@@ -36,6 +38,7 @@ from tpm_viz.classroom.guard import guarded
 from tpm_viz.params import Params
 from tpm_viz.ui.framing import LIVE_BAND, frame_box
 from tpm_viz.ui.language import KEEP_ALL
+from tpm_viz.ui.panels import FOLDED
 from tpm_viz.ui.scene import camera_pose
 from tpm_viz.words import Lang, T
 
@@ -73,8 +76,8 @@ viser's page reports a resize with the canvas's drawing-buffer size, which its r
 FOV_NUDGE = 2e-5
 """Relative change of the field of view [-] that makes the page send its camera (and canvas size) again: the least
 that viser's camera setter does not drop as unchanged (``np.allclose``), a 0.002 % zoom that nobody sees."""
-LIVE_WIDTH = 560
-"""Width of the box of banner and forces [CSS px] (presentation mode, while the panel is collapsed)."""
+LIVE_WIDTH = 640
+"""Width of the box of live numbers [CSS px] (presentation mode, while the panel is folded to its rail)."""
 LIVE_GAP = 12
 """Gap between that box and the canvas's left and bottom edges [CSS px]."""
 LIVE_CHROME = 64
@@ -112,26 +115,30 @@ PHONE_CSS = f"""<style>
 </style>"""
 """The phone layout and touch targets (by viewport and pointer: no switch), in every tab."""
 
+BANNER_PX = 20
+"""Font size of the pose status and its warnings in the box of live numbers [CSS px]."""
+
 PRESENTATION_CSS = f"""<style>
 div:has(> [data-q="banner"]) {{ color: #0f172a; }}
-[data-q="banner"] {{ font-size: 19px !important; }}
+[data-q="banner"] {{ font-size: {BANNER_PX}px !important; }}
 div:has(> [data-q="banner"]) td {{ font-size: 17px !important; color: #0f172a !important; }}
 div:has(> [data-q="banner"]) > div:last-child, div:has(> [data-q="banner"]) > div:last-child div {{
   font-size: 17px !important; color: #0f172a !important; }}
 div:has(> [data-q="banner"]) td [data-q], [data-q="tau1"], [data-q="tau2"] {{ font-size: {READOUT_PX}px !important; }}
-div:has(> [data-q="banner"]) [style*="grid-template-columns"] {{ grid-template-columns: 1.4em 1fr 6.4em !important; }}
+div:has(> [data-q="banner"]) [style*="grid-template-columns"] {{ grid-template-columns: 1.4em 1fr 7.2em !important; }}
 div:has(> [data-q="banner"]) [style*="grid-template-columns"] > span {{ white-space: nowrap; }}
 .mantine-Paper-root label, .mantine-Button-label, .mantine-Tabs-tab, .mantine-Checkbox-label,
 .mantine-Paper-root .mantine-Text-root {{ font-size: 15px !important; color: #0f172a; letter-spacing: 0 !important; }}
 .uplot .u-title {{ font-size: 17px !important; color: #0f172a; }}
 .uplot .u-legend {{ font-size: 15px !important; }}
 .uplot .u-legend .u-label {{ color: #0f172a; }}
+{", ".join(FOLDED)} {{ display: none; }}
 [data-floating-window]:has([data-live]) {{ visibility: hidden; pointer-events: none; }}
 body:has([data-dock-rail-root]) [data-floating-window]:has([data-live]) {{ visibility: visible; pointer-events: auto; }}
 [data-live] {{ max-height: calc({round(LIVE_BAND * 100)}vh - {LIVE_CHROME}px); overflow-y: auto; }}
-[data-live] [data-q="banner"] {{ font-size: 18px !important; }}
-[data-live] > div > div:last-child > div:not(:first-child) {{ font-size: 15px !important; }}
-[data-live] table, [data-live] > div > div:last-child > div:first-child {{ display: none; }}
+[data-live] [data-q="banner"] {{ font-size: {BANNER_PX}px !important; padding: 3px 8px !important; }}
+[data-live] table {{ margin-top: 2px !important; }}
+[data-live] tbody {{ display: flex; flex-wrap: wrap; column-gap: 1.2em; }}
 @media {_PHONE} {{ div:has(> div > [data-live]) {{ display: none !important; }} }}
 </style>"""
 """Presentation mode: large, dark type (the charts' titles and legends too; their axes are drawn on a canvas, sized by
@@ -211,7 +218,7 @@ class Look:
             return
         view = self.view
         with view.hub.lock:
-            if view.closed or getattr(view, "session", None) is None:
+            if view.closed:
                 return
             view.frame_camera(view.session.state.params)
             view.client.flush()
@@ -268,6 +275,10 @@ class Look:
         client = self.view.client
         self.style.content = PHONE_CSS + (PRESENTATION_CSS if on else "")
         dock_panel(client.gui, PRESENTATION_WIDTH if on else PANEL_WIDTH)
+        if on:  # the controls fold to the rail for the audience; one click on the rail brings them back
+            client.gui.main_panel.minimize()
+        else:
+            client.gui.main_panel.expand()
         if on and self.live is None:
             self.live = client.gui.add_panel()
             with self.live.add_tab(LIVE_LABEL.template):

@@ -34,7 +34,7 @@ from tpm_viz.ui.typed import QUIET, Quantity, TypedField, TypedGroup, force_note
 from tpm_viz.viserkit.core import widget_uuid
 from tpm_viz.words import Lang
 
-__all__ = ["ACTUATOR_HINT", "ACTUATOR_LABELS", "PARAM_LABELS", "Panel", "slider_css"]
+__all__ = ["ACTUATOR_HINT", "ACTUATOR_LABELS", "GROUPS", "GUIDE_HTML", "PARAM_LABELS", "Panel", "slider_css"]
 
 _UNSET = object()
 
@@ -63,6 +63,34 @@ SHOW_LABELS = {
     "forces": "Force arrows",
 }
 
+
+GROUPS = {"explore": "Explore", "teach": "Teach", "lab": "Lab", "setup": "Setup"}
+"""The groups of tabs, by key, with their names: *Explore* (Move, Forces, Explorer), *Teach* (Demos, Player,
+Equations), *Lab* (Control, Planner, Design), *Setup* (Parameters, Class & view). One row of groups and one row of
+the open group's tabs: two rows of tabs at most, at 1024 px and in Korean too."""
+
+GUIDE_LINES = (
+    "Drag the arrows on the grey platform P in 3D (or type p in Move): the legs and the forces follow.",
+    "Near a singularity: the grey buttons at the top of Move. The banner above the tabs turns amber or red.",
+)
+GUIDE_COLOURS = (
+    ("#22c55e", "workspace"),
+    ("#f59e0b", "inverse singularity"),
+    ("#dc2626", "direct singularity"),
+    ("#db2777", "stroke end"),
+    ("#3b82f6", "other assembly mode P′"),
+)
+"""The colours of the 3D view in the guide, by name (the legend of the Move tab says more)."""
+_CHIP = "<span style='display:inline-block;width:10px;height:10px;border-radius:2px;background:{}'></span>"
+GUIDE_HTML = (
+    "<div data-guide='1' style='font-size:0.85em;line-height:1.35'>"
+    + "".join(f"<p style='margin:0 0 3px'>{line}</p>" for line in GUIDE_LINES)
+    + "<div style='display:flex;flex-wrap:wrap;gap:2px 10px'>"
+    + "".join(f"<span>{_CHIP.format(colour)} <span>{name}</span></span>" for colour, name in GUIDE_COLOURS)
+    + "</div></div>"
+)
+"""The first visit's guide: what to drag, where the singularities are, the colours (each text a template of the
+catalogue, shown in the tab's language)."""
 
 PARAM_NAMES = {"pivot_spacing": "pivot spacing", "stroke": "stroke Δd"}
 """Name of a parameter in the notes of its field (the others: their own name)."""
@@ -125,6 +153,38 @@ def slider_css(handles) -> str:
     return f"<style>{rules} {{ display: none !important; }}</style>"
 
 
+FOLDED = (
+    'div:has(> [data-q="banner"]) tr:nth-child(n+3)',  # θ, det J_x, det J_q, cond J, assembly mode
+    'div:has(> [data-q="banner"]) > div:last-child > div:first-child',  # the forces' heading and load line
+    'div:has(> [data-q="tau1_ref"])',  # Pinocchio's cross-check of each force
+    'div:has(> [data-q="tau2_ref"])',
+)
+"""What the compact readout leaves out: it keeps the pose status and its warnings, p, d, τ₁ and τ₂ with their bars."""
+
+
+def _tab_selector(tab) -> str:
+    """A CSS selector of a tab's button, on a wide screen (viser's dock tab) and on a phone (a Mantine tab)."""
+    uuid = getattr(tab, "_id", None)
+    return f':is([data-dock-tab="{uuid}"], [id$="-tab-{uuid}"])' if isinstance(uuid, str) else ""
+
+
+def fold_css(explore, shown) -> str:
+    """A style sheet that folds the readout to :data:`FOLDED`'s compact form while the guide is open or any tab but
+    ``shown`` (Move, Forces) of the ``explore`` group is open: the first control of every tab stays on screen at 768
+    px."""
+    group, tabs = _tab_selector(explore), [_tab_selector(tab) for tab in shown]
+    if not group or not all(tabs):
+        return ""
+    folded = ", ".join(FOLDED)
+    when = (
+        f'body:not(:has({group}[aria-selected="true"]))',
+        f'body:not(:has(:is({", ".join(tabs)})[aria-selected="true"]))',
+        "body:has([data-guide])",
+    )
+    rules = " ".join(f":is({w}) :is({folded}) {{ display: none; }}" for w in when)
+    return f"<style>{rules}</style>"
+
+
 def _params_group(params: Params) -> TypedGroup:
     """The parameter fields (UI units: mm, kg), applied together by Enter or *Apply parameters* only."""
     return TypedGroup(
@@ -145,6 +205,11 @@ class Panel:
         self._written: dict[int, object] = {}
         self._dashboard_at = 0.0
         stroke_mm = state.params.stroke * 1e3
+        self.guide = gui.add_folder("Start here", visible=False)
+        """The first visit's guide (what to drag, the colours, the singularities): shown by :mod:`.guide`."""
+        with self.guide:
+            gui.add_html(GUIDE_HTML)
+            self.guide_done = gui.add_button("Got it", icon=viser.Icon.CHECK, hint="Not shown again in this browser")
         self.dashboard = gui.add_html("")
         self.message = gui.add_markdown("")
         self.restore = gui.add_button(
@@ -153,9 +218,16 @@ class Panel:
             visible=False,
             hint="Your own copy, as it was when the connection dropped (kept 30 minutes)",
         )
-        tabs = gui.add_tab_group()
-        with tabs.add_tab("Move"):
+        self.groups = gui.add_tab_group()
+        """The four groups of tabs (:data:`GROUPS`), each a tab holding a tab group of its own: two rows at most."""
+        self.tabs: dict[str, viser.GuiTabGroupHandle] = {}
+        explore = self.groups.add_tab(GROUPS["explore"], icon=viser.Icon.HAND_FINGER)
+        with explore:
+            tabs = self.tabs["explore"] = gui.add_tab_group()
+        move = tabs.add_tab("Move")
+        with move:
             self.p = _vector_box(gui, "p", hint="Or drag the gizmo in 3D")
+            self.demo = {k: gui.add_button(DEMO_LABELS[k], color="gray") for k in DEMO_KINDS}
             self.d = [
                 gui.add_slider(f"Actuator d{i + 1} (mm)", 0.0, stroke_mm, 0.1, 0.0, hint="Forward kinematics")
                 for i in range(2)
@@ -167,35 +239,44 @@ class Panel:
             )
             self.switch_mode = gui.add_button("Switch assembly mode", icon=viser.Icon.SWITCH_HORIZONTAL)
             self.home = gui.add_button("Home (p = 0)", icon=viser.Icon.HOME)
-            self.demo = {k: gui.add_button(DEMO_LABELS[k], color="gray") for k in DEMO_KINDS}
             self.move_note = Note(gui)
-        with tabs.add_tab("Forces"):
+            gui.add_html(legend_html())
+        forces = tabs.add_tab("Forces")
+        with forces:
             self.load_mode = gui.add_dropdown("Load", LOAD_MODES, initial_value="static")
             self.f_ext = _vector_box(gui, "f_ext")
             self.dp = _vector_box(gui, "dp")
             self.ddp = _vector_box(gui, "ddp")
             self.forces_note = Note(gui)
             gui.add_markdown("Trajectories (the paper's line and circle, your CSV): *Player* tab.")
-        if extra_tabs is not None:  # the teaching layer's tabs (ui/teaching.py)
-            extra_tabs(tabs)
-        with tabs.add_tab("Parameters"):
-            self.params = TypedBox(gui, _params_group(state.params), PARAM_LABELS, note=False)
-            self.apply = gui.add_button("Apply parameters", icon=viser.Icon.CHECK)
-            self.paper = gui.add_button("Paper values (Tables 1-2)", color="gray")
-            self.params.add_note(gui)
+        extra = extra_tabs if extra_tabs is not None else (lambda group, tabs: None)
+        extra("explore", tabs)  # the teaching layer's tabs of each group (ui/teaching/tabs.py)
+        self.fold = gui.add_html(fold_css(explore, (move, forces)))
+        with self.groups.add_tab(GROUPS["teach"], icon=viser.Icon.SCHOOL):
+            tabs = self.tabs["teach"] = gui.add_tab_group()
+        extra("teach", tabs)
         with tabs.add_tab("Equations"):
             gui.add_markdown(
                 "The paper's procedure (a)-(e) with the current numbers (refreshed when you release the platform "
                 "and at every trajectory sample you pause on or scrub to)."
             )
             self.equations = gui.add_html("")
+        with self.groups.add_tab(GROUPS["lab"], icon=viser.Icon.FLASK):
+            tabs = self.tabs["lab"] = gui.add_tab_group()
+        extra("lab", tabs)
+        with self.groups.add_tab(GROUPS["setup"], icon=viser.Icon.SETTINGS):
+            tabs = self.tabs["setup"] = gui.add_tab_group()
+        with tabs.add_tab("Parameters"):
+            self.params = TypedBox(gui, _params_group(state.params), PARAM_LABELS, note=False)
+            self.apply = gui.add_button("Apply parameters", icon=viser.Icon.CHECK)
+            self.paper = gui.add_button("Paper values (Tables 1-2)", color="gray")
+            self.params.add_note(gui)
         with tabs.add_tab("Class & view"):
             self.own_copy = gui.add_checkbox(
                 "Work on my own copy", False, hint="Off: everyone shares the lecturer's mechanism"
             )
             self.class_info = gui.add_markdown("")
             self.show_toggles = {k: gui.add_checkbox(label, True) for k, label in SHOW_LABELS.items()}
-            gui.add_html(legend_html())
             self.frame_camera = gui.add_button("Snapshot the mechanism", icon=viser.Icon.FOCUS_CENTERED)
             self.presentation = gui.add_checkbox(
                 "Presentation mode", False, hint="Large type, thick lines and a wider panel: for a projector"

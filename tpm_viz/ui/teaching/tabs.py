@@ -19,6 +19,7 @@ from tpm_viz.classroom.session import Hub, Session, View
 from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.classroom.worker import Worker
 from tpm_viz.ui.teaching.control import ControlView
+from tpm_viz.ui.teaching.design import DesignView
 from tpm_viz.ui.teaching.explorer import ExplorerView, MapService
 from tpm_viz.ui.teaching.lessons import DemosView
 from tpm_viz.ui.teaching.planner import PlannerView
@@ -65,24 +66,32 @@ class Teaching:
         )
         self.control = ControlView(view, self.services.worker, self.services.runs)
         self.planner = PlannerView(view, self.services.plans)
+        self.design = DesignView(view, self.services.worker)  # the Design studio (ui/teaching/design.py)
         self.takeouts: list[TakeOut] = []  # Record clip and Download report of the player, control and planner
 
-    def build_tabs(self, tabs: viser.GuiTabGroupHandle) -> None:
-        """Add the *Player*, *Explorer*, *Demos*, *Control* and *Planner* tabs to the panel's tab group."""
+    def build_tabs(self, group: str, tabs: viser.GuiTabGroupHandle) -> None:
+        """Add this layer's tabs of ``group`` (a key of :data:`~tpm_viz.ui.panels.GROUPS`) to its tab group:
+        *Explorer* (the maps) in *explore*; *Demos* and *Player* in *teach* (before the panel's *Equations*);
+        *Control* and *Planner* in *lab*."""
         gui = self.view.client.gui
-        with tabs.add_tab("Player", icon=viser.Icon.PLAYER_PLAY):
-            self.player.build(gui)
-            self.takeouts.append(takeout_for(self.view, self.services.worker, self.player, "player", gui))
-        with tabs.add_tab("Explorer", icon=viser.Icon.MAP):
-            self.explorer.build(gui)
-        with tabs.add_tab("Demos", icon=viser.Icon.SCHOOL):
-            self.demos.build(gui)
-        with tabs.add_tab("Control", icon=viser.Icon.ADJUSTMENTS):
-            self.control.build(gui)
-            self.takeouts.append(takeout_for(self.view, self.services.worker, self.control, "control", gui))
-        with tabs.add_tab("Planner", icon=viser.Icon.ROUTE):
-            self.planner.build(gui)
-            self.takeouts.append(takeout_for(self.view, self.services.worker, self.planner, "planner", gui))
+        if group == "explore":
+            with tabs.add_tab("Explorer", icon=viser.Icon.MAP):
+                self.explorer.build(gui)
+        if group == "teach":
+            with tabs.add_tab("Demos", icon=viser.Icon.SCHOOL):
+                self.demos.build(gui)
+            with tabs.add_tab("Player", icon=viser.Icon.PLAYER_PLAY):
+                self.player.build(gui)
+                self.takeouts.append(takeout_for(self.view, self.services.worker, self.player, "player", gui))
+        if group == "lab":
+            with tabs.add_tab("Control", icon=viser.Icon.ADJUSTMENTS):
+                self.control.build(gui)
+                self.takeouts.append(takeout_for(self.view, self.services.worker, self.control, "control", gui))
+            with tabs.add_tab("Planner", icon=viser.Icon.ROUTE):
+                self.planner.build(gui)
+                self.takeouts.append(takeout_for(self.view, self.services.worker, self.planner, "planner", gui))
+            with tabs.add_tab("Design", icon=viser.Icon.RULER_MEASURE):
+                self.design.build(gui)
 
     def attach(self) -> None:
         """The tab has joined its session: draw the session's run (the first render came before that)."""
@@ -104,6 +113,7 @@ class Teaching:
         self.demos.render(frame)
         self.control.render(frame)
         self.planner.render(frame)
+        self.design.render(frame)
 
     def set_presentation(self, on: bool) -> None:
         """Presentation mode on or off for every chart of the tab (player, control, planner)."""
@@ -118,6 +128,7 @@ class Teaching:
         self.control.retell()
         self.planner.retell()
         self.explorer.retell()
+        self.design.retell()
 
     def close(self) -> None:
         """The tab went away."""
