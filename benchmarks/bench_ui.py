@@ -33,6 +33,7 @@ from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz.classroom.dragging import Dragging
 from tpm_viz.classroom.drags import PendingDrag
 from tpm_viz.ui.app import TpmApp, build_server
+from tpm_viz.viserkit.probe import widget_uuid
 
 
 def _stats(name: str, seconds) -> None:
@@ -169,7 +170,7 @@ def bench_browser(samples: int) -> None:
         # (b) Typed actuator position d1 (the number field beside the slider).
         page.evaluate("() => { window.__viserLog.length = 0; }")
         field = (
-            page.locator(f'label[for="{view.panel.d[0]._impl.uuid}"]')
+            page.locator(f'label[for="{widget_uuid(view.panel.d[0])}"]')
             .locator("xpath=ancestor::div[contains(@class,'mantine-Flex-root')][1]")
             .locator("input.mantine-NumberInput-input")
         )

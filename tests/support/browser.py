@@ -1,6 +1,8 @@
 """Headless Chromium for the browser tests and benchmarks: Debian's binary, the flags this machine needs, and
 an init script that logs viser's websocket messages in the page."""
 
+from tpm_viz.viserkit.probe import widget_uuid
+
 CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = [
     "--headless",
@@ -49,4 +51,4 @@ WORKER_LOG_JS = """
 def text_input(page, handle):
     """The ``<input>`` of a viser text field (``add_text``; the ``<textarea>`` of a multi-line one, e.g. a typed number
     of ``tpm_viz.ui.fields``): it has no id of its own, so it is found by its label's ``for`` (the handle's uuid)."""
-    return page.locator(f'div:has(> div > p > label[for="{handle._impl.uuid}"]) :is(input, textarea)')
+    return page.locator(f'div:has(> div > p > label[for="{widget_uuid(handle)}"]) :is(input, textarea)')

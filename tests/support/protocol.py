@@ -32,6 +32,8 @@ import zstandard
 from websockets.asyncio.client import connect
 from websockets.sync.client import connect as connect_sync
 
+from tpm_viz.viserkit.probe import widget_uuid
+
 ROOT = Path(__file__).resolve().parents[2]
 CLK_TCK = os.sysconf("SC_CLK_TCK")
 GIZMO_Z = 0.09
@@ -303,7 +305,7 @@ class ProtocolClient:
 
     def set_value(self, handle, value) -> None:
         """What the browser sends when the user changes a GUI input (or clicks a button: ``value=True``)."""
-        self.send(type="GuiUpdateMessage", uuid=handle._impl.uuid, updates={"value": value})
+        self.send(type="GuiUpdateMessage", uuid=widget_uuid(handle), updates={"value": value})
 
     def click(self, button) -> None:
         self.set_value(button, True)
@@ -313,7 +315,7 @@ class ProtocolClient:
         them (the whole text at each keystroke: here the last one), then press Enter in it (the form's submit)."""
         for key, text in (texts or {}).items():
             self.set_value(box.inputs[key], text)
-        self.send(type="GuiFormSubmitMessage", uuid=box.form._impl.uuid)
+        self.send(type="GuiFormSubmitMessage", uuid=widget_uuid(box.form))
 
     def drag(self, gizmo, owner: str, positions, end: bool = True) -> None:
         """A gizmo drag through ``positions`` (x, y, z) [m], as start, updates and (optionally) end."""

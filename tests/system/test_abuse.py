@@ -33,6 +33,7 @@ from tpm_viz.app.inputs import MAX_TEXT
 from tpm_viz.classroom.guard import ACTIVITY, Faults
 from tpm_viz.ui.app import TpmApp, build_server
 from tpm_viz.viserkit.limits import Gate, guard_of
+from tpm_viz.viserkit.probe import upload_states, widget_uuid
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
@@ -203,9 +204,9 @@ def test_frames_over_1_mib_close_only_that_connection(app, connect):
     button = view.client.gui.add_upload_button("test upload")
     got = []
     button.on_upload(lambda event: got.append(len(event.target.value.content)))
-    transfer = _start_upload(client, button._impl.uuid, 1 << 20, 2)  # what a browser sends: 512 KiB parts
-    _part(client, button._impl.uuid, transfer, 0, b"a" * (512 << 10))
-    _part(client, button._impl.uuid, transfer, 1, b"b" * (512 << 10))
+    transfer = _start_upload(client, widget_uuid(button), 1 << 20, 2)  # what a browser sends: 512 KiB parts
+    _part(client, widget_uuid(button), transfer, 0, b"a" * (512 << 10))
+    _part(client, widget_uuid(button), transfer, 1, b"b" * (512 << 10))
     wait_for(lambda: got == [1 << 20], what="a 1 MiB upload in two 512 KiB parts")
     rogue.close()
 
@@ -213,8 +214,8 @@ def test_frames_over_1_mib_close_only_that_connection(app, connect):
 def test_unfinished_uploads_are_bounded_and_freed(app, connect, monkeypatch):
     monkeypatch.setattr(transport, "UPLOAD_TIMEOUT", 0.5)
     client, view = connect()
-    states = view.client.gui._current_file_upload_states
-    button = view.teaching.player.upload._impl.uuid
+    states = upload_states(view.client)
+    button = widget_uuid(view.teaching.player.upload)
     for _ in range(50):
         transfer = _start_upload(client, button, 1 << 20, 4)
         _part(client, button, transfer, 0, b"x" * 1000)
@@ -268,8 +269,8 @@ def test_updates_must_match_the_widget_kind(app, connect):
     client.set_value(panel.home, "click")  # a button click is True
     client.set_value(text, "x" * (MAX_TEXT + 1))
     client.set_value(player.upload, {"name": "a", "content": b"x"})
-    transfer = _start_upload(client, panel.d[0]._impl.uuid, 10, 1)  # an upload aimed at the d1 slider
-    _part(client, panel.d[0]._impl.uuid, transfer, 0, b"0123456789")
+    transfer = _start_upload(client, widget_uuid(panel.d[0]), 10, 1)  # an upload aimed at the d1 slider
+    _part(client, widget_uuid(panel.d[0]), transfer, 0, b"0123456789")
     client.set_value(text, "ok")
     wait_for(lambda: text.value == "ok", what="a good text after the bad updates")
     assert ACTIVITY.wait_idle()

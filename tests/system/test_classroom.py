@@ -22,6 +22,7 @@ from tpm_viz import InputError
 from tpm_viz.classroom.access import MAX_FAILURES, MAX_FAILURES_SERVER, Access
 from tpm_viz.ui.app import TpmApp, build_server
 from tpm_viz.ui.classroom import same_origin
+from tpm_viz.viserkit.probe import widget_uuid
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
@@ -215,7 +216,7 @@ def test_the_token_field_shows_dots_not_the_token(browser):
         view = wait_for(lambda: next(iter(app.views.values()), None), timeout=30, what="the tab's view")
         wait_for(lambda: view.login is not None, what="the login folder")
         page.get_by_text("Presenter login").click()
-        uuid = view.login.token._impl.uuid
+        uuid = widget_uuid(view.login.token)
         field = page.locator(f'div:has(> div > p > label[for="{uuid}"]) input')
         field.fill("typed-secret")
         security = field.evaluate("e => getComputedStyle(e).webkitTextSecurity")

@@ -6,8 +6,8 @@ Layers, bottom up (a module may import its own layer and the layers its rule lis
 - base (``errors``, ``params``, ``csvio``, ``csvdialect``, ``numbers``, ``words``, ``files``): the standard library and
   numpy;
 - ``paper/``: the paper's maths, numpy only;
-- drawing (``meshes``, ``meshes_parallel``, ``figures``, ``clips``, ``videos``): trimesh / matplotlib / Pillow /
-  PyAV over the paper's maths;
+- drawing (``meshes``, ``meshes_parallel``, ``figures``, ``clips``, ``videos``, ``views3d``): trimesh / matplotlib /
+  Pillow / PyAV over the paper's maths;
 - ``reports/``: documents of a run (the lab report) from the app's runs and the drawing layer;
 - ``exchange/``: model files written from the parameters (no simulator imported);
 - ``multibody/``: the only place that imports pinocchio;
@@ -36,7 +36,7 @@ PACKAGE = pathlib.Path(__file__).resolve().parents[2] / "tpm_viz"
 STDLIB = set(sys.stdlib_module_names) | {"__future__"}
 
 BASE = {"errors", "params", "csvio", "csvdialect", "numbers", "words", "files"}
-DRAWING = {"meshes", "figures", "clips", "videos", "meshes_parallel"}
+DRAWING = {"meshes", "figures", "clips", "videos", "meshes_parallel", "views3d"}
 
 # layer -> (tpm_viz layers it may import, third-party packages it may import)
 RULES: dict[str, tuple[set[str], set[str]]] = {
@@ -192,13 +192,23 @@ def test_no_module_over_400_lines(module):
 
 PRIVATE_VISER = re.compile(
     r"\._(?:thread_executor|websock_connection|websock_server|handle_gui_updates|handle_file_transfer\w*|"
-    r"current_file_upload_states|gui_input_handle_from_uuid|impl_aux|impl)\b|\bviser\._|from viser import _"
+    r"current_file_upload_states|gui_input_handle_from_uuid|impl_aux|impl|share_tunnel|client_state_from_id|"
+    r"live_connections|message_producer|message_consumer|window_loop|broadcast_buffer)\b|"
+    r"\bviser(?:\.infra)?\._(?!_)|from viser(?:\.infra)? import _"
 )
 
 
-def test_private_viser_names_are_used_in_one_module_only():
+def test_private_viser_names_are_used_in_the_adapter_only():
     users = {m for m, p in MODULES.items() if PRIVATE_VISER.search(p.read_text())}
-    assert users == {"tpm_viz.viserkit.core"}, users
+    assert users and all(m.startswith("tpm_viz.viserkit.") for m in users), users
+
+
+def test_tests_and_benchmarks_use_no_private_viser_name():
+    """They reach viser's internals through the adapter's public functions (``tpm_viz.viserkit.probe``)."""
+    root = PACKAGE.parent
+    paths = [p for d in ("tests", "benchmarks") for p in sorted((root / d).rglob("*.py"))]
+    users = [str(p.relative_to(root)) for p in paths if PRIVATE_VISER.search(p.read_text())]
+    assert paths and users == [], users
 
 
 def test_the_door_to_viser_refuses_an_untested_version_loudly():

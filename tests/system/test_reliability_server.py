@@ -32,6 +32,7 @@ from tests.support.hypo import examples
 from tests.support.protocol import ProtocolClient, wait_for
 from tests.ui.test_reliability_app import CSV_TEXT, GOOD_ROWS, NASTY_FLOAT, _timed, assert_valid
 from tpm_viz.classroom.guard import ACTIVITY
+from tpm_viz.viserkit.probe import widget_uuid
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
@@ -209,7 +210,7 @@ def _upload(client: ProtocolClient, button, content: bytes) -> None:
     """What viser's upload button sends: a transfer start, then the parts."""
     transfer = str(uuid.uuid4())
     parts = [content[i : i + 4096] for i in range(0, len(content), 4096)]
-    head = {"source_component_uuid": button._impl.uuid, "transfer_uuid": transfer}
+    head = {"source_component_uuid": widget_uuid(button), "transfer_uuid": transfer}
     client.send(
         type="FileTransferStartUpload",
         **head,

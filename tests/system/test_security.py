@@ -30,6 +30,7 @@ from tpm_viz.app.inputs import MAX_UPLOAD_BYTES
 from tpm_viz.classroom.access import LOCKOUT_SECONDS, MAX_FAILURES, Access, AccessDenied
 from tpm_viz.classroom.guard import ACTIVITY
 from tpm_viz.classroom.session import Session
+from tpm_viz.viserkit.probe import share_tunnel, tunnel_class, upload_states, widget_uuid
 
 TOKEN = "s3cret-Token"
 UI = Path(__file__).resolve().parents[2] / "tpm_viz" / "ui"
@@ -122,10 +123,8 @@ def test_a_blank_token_is_refused_before_serving():
 
 # -- share URL --------------------------------------------------------------------------------------------------------
 def test_share_url_request_from_a_client_opens_no_outside_connection(app, connect, monkeypatch):
-    import viser._tunnel
-
     tunnels, outside = [], []
-    monkeypatch.setattr(viser._tunnel.ViserTunnel, "__init__", lambda self, *a, **k: tunnels.append(a))
+    monkeypatch.setattr(tunnel_class(), "__init__", lambda self, *a, **k: tunnels.append(a))
     real_connect = socket.socket.connect
 
     def spy(sock, address):
@@ -144,7 +143,7 @@ def test_share_url_request_from_a_client_opens_no_outside_connection(app, connec
     wait_for(lambda: abs(_state(view).pose.d[0] - 0.15) < 1e-9, what="d1 after the share requests")
     time.sleep(0.3)  # the share handlers run in viser's thread pool
     assert tunnels == [] and outside == []
-    assert app.server._share_tunnel is None
+    assert share_tunnel(app.server) is None
     assert app.server.request_share_url() is None
 
 
@@ -216,8 +215,8 @@ def test_malformed_gui_updates_are_dropped_with_one_log_line(app, connect, caplo
     label = view.panel.d[0].label
     errors = ACTIVITY.snapshot()[1]
     with caplog.at_level(logging.WARNING, logger="tpm_viz.ui"):
-        client.send(type="GuiUpdateMessage", uuid=view.panel.d[0]._impl.uuid, updates={"label": "hacked"})
-        client.send(type="GuiUpdateMessage", uuid=view.panel.d[0]._impl.uuid, updates={"max": 1e9, "value": 5.0})
+        client.send(type="GuiUpdateMessage", uuid=widget_uuid(view.panel.d[0]), updates={"label": "hacked"})
+        client.send(type="GuiUpdateMessage", uuid=widget_uuid(view.panel.d[0]), updates={"max": 1e9, "value": 5.0})
         client.set_value(view.panel.d[1], "abc")
         client.set_value(view.panel.f_ext.inputs["f_x"], 3.0)  # a typed field takes text
         client.set_value(view.panel.p.inputs["p1"], None)
@@ -250,7 +249,7 @@ def _start_upload(client: ProtocolClient, button, size: int, parts: int) -> str:
     transfer = str(uuid.uuid4())
     client.send(
         type="FileTransferStartUpload",
-        source_component_uuid=button._impl.uuid,
+        source_component_uuid=widget_uuid(button),
         transfer_uuid=transfer,
         filename="big.csv",
         mime_type="text/csv",
@@ -263,7 +262,7 @@ def _start_upload(client: ProtocolClient, button, size: int, parts: int) -> str:
 def _part(client: ProtocolClient, button, transfer: str, index: int, content: bytes) -> None:
     client.send(
         type="FileTransferPart",
-        source_component_uuid=button._impl.uuid,
+        source_component_uuid=widget_uuid(button),
         transfer_uuid=transfer,
         part_index=index,
         content=content,
@@ -275,7 +274,7 @@ def test_uploads_are_limited_in_size(app, connect):
     got = []
     button = view.client.gui.add_upload_button("test upload")
     button.on_upload(lambda event: got.append(event.target.value.content))
-    states = view.client.gui._current_file_upload_states
+    states = upload_states(view.client)
 
     too_big = _start_upload(client, button, MAX_UPLOAD_BYTES + 1, 2)
     _part(client, button, too_big, 0, b"x" * 1000)

@@ -23,6 +23,7 @@ import pytest
 from tests.support.protocol import ProtocolClient, wait_for
 from tests.ui.test_reliability_app import assert_valid
 from tpm_viz.classroom.guard import ACTIVITY
+from tpm_viz.viserkit.probe import connection_states
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
@@ -82,7 +83,7 @@ def test_connect_drag_disconnect_cycles_leave_nothing_behind(app, caplog):
     errors = [r for r in caplog.records if r.levelno >= logging.ERROR and r.name.startswith(server_side)]
     assert not errors, [r.getMessage() for r in errors]
     assert not app.views and not app.hub.shared.views
-    assert not app.server._websock_server._client_state_from_id  # viser dropped every connection
+    assert not connection_states(app.server)  # viser dropped every connection
     pools = ("ThreadPoolExecutor", "tpm-viz-drag")  # viser's callback pool (<= 32 threads) and the drag pool (2)
     wait_for(
         lambda: len([t for t in threading.enumerate() if not t.name.startswith(pools)]) <= threads_before,

@@ -22,6 +22,7 @@ from tpm_viz.app.runs import Source, build_run
 from tpm_viz.params import Params
 from tpm_viz.reports.report import report_html
 from tpm_viz.ui.language import show_text
+from tpm_viz.viserkit.probe import widget_uuid
 from tpm_viz.words import Lang, T, say
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
@@ -66,7 +67,7 @@ class TextClient(ProtocolClient):
     def holds(self, handle) -> bool:
         """The tab shows the content the server last wrote to ``handle`` (an HTML or markdown element)."""
         shown = show_text(Lang.KO, "content", handle.content)  # as a Korean tab is sent it
-        return self.gui.get(handle._impl.uuid, {}).get("content") == shown
+        return self.gui.get(widget_uuid(handle), {}).get("content") == shown
 
     def texts(self) -> list[str]:
         """Every text of every element the tab holds now."""
@@ -136,7 +137,7 @@ def test_a_korean_tab_has_no_english_sentence_on_any_tab(app):
         shown = (pl.summary, cv.summary, cv.table_html, cv.lesson_text, pv.result_html, pv.sizing)
         wait_for(lambda: all(client.holds(handle) for handle in (*shown, view.panel.equations)), what="the texts")
         texts = client.texts()
-        equations = client.gui[view.panel.equations._impl.uuid]["content"]
+        equations = client.gui[widget_uuid(view.panel.equations)]["content"]
         assert "<math" in equations and HANGUL.search(plain(equations))  # the procedure, in Korean
         for kind in MAP_KINDS:  # every floor map's legend (the Maps tab)
             with view.hub.lock:

@@ -9,8 +9,8 @@ from dataclasses import dataclass
 from typing import Any, Literal, Optional
 
 import pytest
-from viser import _messages
 
+from tpm_viz.viserkit.probe import messages as _messages
 from tpm_viz.viserkit.transport import message_problem
 
 

@@ -1,6 +1,6 @@
 """viser wakes its senders with ``asyncio.Event.set()`` from whatever thread pushes a message. From a callback thread
 that races the event loop adding a waiter ("deque mutated during iteration", seen in the server log under
-``bench_load.py --mode hall``) and can leave a sender asleep for good. ``safe_wakeups`` (viserkit/core.py) hands the
+``bench_load.py --mode hall``) and can leave a sender asleep for good. The safe wake-ups (viserkit/patches.py) hand the
 wake-up to the loop instead; here four threads push while thirty senders wait and clear, as viser's do for a
 broadcast: no push raises, and no sender misses a wake-up (a lost one times out)."""
 
@@ -10,17 +10,16 @@ import asyncio
 import sys
 import threading
 
-from viser.infra._async_message_buffer import AsyncMessageBuffer
-
-from tpm_viz.viserkit.core import safe_wakeups
+from tpm_viz.viserkit.probe import message_buffer, wake_safely
 
 PUSHES = 4 * 2000
 
 
 def test_pushes_from_threads_wake_every_sender_and_never_raise():
-    safe_wakeups()
     loop = asyncio.new_event_loop()
-    event = AsyncMessageBuffer(loop, persistent_messages=False).message_event
+    buffer = message_buffer(loop, False)
+    wake_safely(buffer)
+    event = buffer.message_event
     errors: list[BaseException] = []
     count, lock, stuck = [0], threading.Lock(), [0]
 

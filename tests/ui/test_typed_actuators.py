@@ -17,6 +17,7 @@ from tests.support.protocol import wait_for
 from tpm_viz import Params
 from tpm_viz.app import transitions
 from tpm_viz.ui.typed import QUIET
+from tpm_viz.viserkit.probe import widget_uuid
 from tpm_viz.words import Lang, catalogue
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
@@ -92,7 +93,7 @@ def test_the_slider_still_drives_and_the_typed_field_shows_its_value(connect):
     client.set_value(view.panel.d[0], 250.0)
     wait_for(lambda: abs(_state(view).pose.d[0] - 0.25) < 1e-12, what="d1 = 250 mm by the slider")
     wait_for(lambda: view.panel.d_typed.inputs["d1"].value == "250", what="the typed field shows it")
-    uuids = [handle._impl.uuid for handle in view.panel.d]
+    uuids = [widget_uuid(handle) for handle in view.panel.d]
     css = view.panel.d_css.content
     assert all(f'[id="{u}"] ~ *' in css for u in uuids) and "display: none" in css  # no number box beside them
 

@@ -23,6 +23,7 @@ from tpm_viz import Params
 from tpm_viz.app.paths import path_for
 from tpm_viz.app.planner import Limits, plan_cycle
 from tpm_viz.ui.typed import QUIET
+from tpm_viz.viserkit.probe import widget_uuid
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
@@ -154,7 +155,7 @@ def test_keys_lost_in_the_throttle_leave_the_box_showing_what_is_applied(app):
         client.set_value(d1, "1")  # what arrived of d1
         client.set_value(d2, "130\n")  # the latest message: d2's text and Enter
         wait_for(lambda: view.session.state.pose.d[0] == pytest.approx(0.001, abs=1e-12), what="d1 = 1 mm")
-        wait_for(lambda: client.written.get(d1._impl.uuid, [])[-1:] == ["1"], what="d1's text written back")
+        wait_for(lambda: client.written.get(widget_uuid(d1), [])[-1:] == ["1"], what="d1's text written back")
         assert d1.value == "1" and d2.value == "130"
     finally:
         client.close()

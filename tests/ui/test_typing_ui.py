@@ -17,6 +17,7 @@ import pytest
 from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz import Params
 from tpm_viz.ui.typed import QUIET
+from tpm_viz.viserkit.probe import arrive, widget_uuid
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
@@ -185,7 +186,7 @@ class Recorder(ProtocolClient):
 def _upload(client, button, name: str, content: bytes, declared: int | None = None) -> str:
     transfer = str(uuid.uuid4())
     parts = [content[i : i + 65536] for i in range(0, len(content), 65536)]
-    head = {"source_component_uuid": button._impl.uuid, "transfer_uuid": transfer}
+    head = {"source_component_uuid": widget_uuid(button), "transfer_uuid": transfer}
     size = len(content) if declared is None else declared
     client.send(type="FileTransferStartUpload", **head, filename=name, mime_type="text/csv", part_count=len(parts),
                 size_bytes=size)  # fmt: skip
@@ -268,7 +269,7 @@ def test_a_keystroke_not_yet_seen_by_the_tab_is_never_written_over(connect):
     with view.hub.lock:
         box.show({"p1": 30.0, "p2": 20.0})
         assert (handle.value, box.inputs["p2"].value) == ("30", "20")
-        handle._impl.value = "4"  # arrived, callback not run yet
+        arrive(handle, "4")  # arrived, callback not run yet
         box.show({"p1": 10.0, "p2": 20.0})  # another tab's move
         assert handle.value == "4"
         box.group.typed("p1", "4", 0.0)  # the callback: the field is being typed in, and stays so

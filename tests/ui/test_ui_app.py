@@ -19,6 +19,7 @@ from tests.support.protocol import wait_for
 from tpm_viz import Params, forward_kinematics_both, inverse_kinematics
 from tpm_viz.ui.app import is_loopback, main
 from tpm_viz.ui.scene import COLORS
+from tpm_viz.viserkit.probe import share_tunnel
 
 P = Params.paper()
 
@@ -100,7 +101,7 @@ def test_share_url_tunnel_is_disabled(app, connect):
     client.send(type="ShareUrlRequest")
     client.set_value(view.panel.d[0], 150.0)  # a later message: the request above was handled by then
     wait_for(lambda: abs(_state(view).pose.d[0] - 0.15) < 1e-9, what="d1 after the share request")
-    assert app.server._share_tunnel is None
+    assert share_tunnel(app.server) is None
 
 
 def test_first_render_shows_the_home_pose(connect):

@@ -21,6 +21,7 @@ import pytest
 from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES
 from tpm_viz.ui.app import build_server
+from tpm_viz.viserkit.probe import widget_uuid
 from tpm_viz.viserkit.transport import harden
 from tpm_viz.words import Lang
 
@@ -82,7 +83,7 @@ def bare():
     def connected(client) -> None:
         lang = next(langs)
         harden(client, lang=lambda: lang)
-        buttons[client.client_id] = client.gui.add_upload_button("Upload CSV")._impl.uuid
+        buttons[client.client_id] = widget_uuid(client.gui.add_upload_button("Upload CSV"))
 
     server.on_client_connect(connected)
     yield server, buttons
@@ -117,12 +118,12 @@ def test_the_player_refuses_a_file_in_the_tabs_language(connect):
     client, view = connect()
     player = view.teaching.player
     view.words.set(Lang.KO)
-    _send_file(client, player.upload._impl.uuid, b"t,p1,p2\n0,0,0\n1,50,0\n2,100,0\n3,150,0\n")  # mm, not m
+    _send_file(client, widget_uuid(player.upload), b"t,p1,p2\n0,0,0\n1,50,0\n2,100,0\n3,150,0\n")  # mm, not m
     wait_for(lambda: HANGUL.search(re.sub("<[^>]+>", " ", player.note.handle.content)), what="the refusal")
     text = re.sub("<[^>]+>", " ", player.note.handle.content)
     assert "10 m" in text and not re.search(r"[A-Za-z]{3,}", text), text
     view.words.set(Lang.EN)
-    _send_file(client, player.upload._impl.uuid, b"t,p1,p2\n0,0,0\n2400,0,0\n4800,0,0\n7200,0,0\n")  # 2 h
+    _send_file(client, widget_uuid(player.upload), b"t,p1,p2\n0,0,0\n2400,0,0\n4800,0,0\n7200,0,0\n")  # 2 h
     wait_for(
         lambda: "the trajectory lasts 7200 s (at most 3600 s)" in player.note.handle.content,
         what="the English refusal",

@@ -2,7 +2,8 @@
 while the
 loop is busy costs one self-pipe write, every callback still runs (once, in the order first asked), a call on the
 loop thread writes nothing, a closed loop refuses like asyncio's, and one failing callback does not stop the others.
-Also: viser's buffers see their loop through one shared :class:`Wakeups` once :func:`safe_wakeups` is installed."""
+Also: viser's buffers see their loop through one shared :class:`Wakeups` once the safe wake-ups are on them
+(``viserkit.install``)."""
 
 from __future__ import annotations
 
@@ -10,9 +11,8 @@ import asyncio
 import threading
 
 import pytest
-from viser.infra._async_message_buffer import AsyncMessageBuffer
 
-from tpm_viz.viserkit.core import safe_wakeups
+from tpm_viz.viserkit.probe import message_buffer, wake_safely
 from tpm_viz.viserkit.wakeups import Wakeups
 
 
@@ -110,9 +110,10 @@ def test_a_failing_wakeup_is_logged_and_the_others_run(caplog):
 
 @pytest.mark.parametrize("buffers", [2, 5])
 def test_viser_buffers_share_one_wakeups_per_loop(buffers):
-    safe_wakeups()
     loop = CountingLoop()
-    made = [AsyncMessageBuffer(loop, persistent_messages=False) for _ in range(buffers)]
+    made = [message_buffer(loop, False) for _ in range(buffers)]
+    for b in made:
+        wake_safely(b)
     assert all(isinstance(b.event_loop, Wakeups) for b in made)
     assert len({id(b.event_loop) for b in made}) == 1 and made[0].event_loop.loop is loop
 

@@ -1,7 +1,6 @@
-"""The leaner senders (viserkit/windows.py, installed by ``_viser.lean_senders``) send exactly the windows viser's
-own window
-loop sends; a window of the shared buffer is encoded once for every tab, in viser's wire format; one pause timer
-serves every tab of a buffer, and a flush ends the pause."""
+"""The leaner senders (viserkit/windows.py, put on a server's buffers by ``viserkit.install``) send exactly the windows
+viser's own window loop sends; a window of the shared buffer is encoded once for every tab, in viser's wire format;
+one pause timer serves every tab of a buffer, and a flush ends the pause."""
 
 from __future__ import annotations
 
@@ -12,19 +11,12 @@ import msgspec
 import numpy as np
 import pytest
 import zstandard
-from viser import _messages
-from viser.infra._async_message_buffer import AsyncMessageBuffer
 
-from tpm_viz.viserkit.core import _WINDOW_LOOP, lean_senders, safe_wakeups
+from tpm_viz.viserkit.probe import VISER_WINDOW_LOOP, align, lean_buffer, message_buffer
+from tpm_viz.viserkit.probe import messages as _messages
 from tpm_viz.viserkit.windows import Frames, Tick, encoder, window_loop
 
 MARKER = _messages.ReplayDoneMessage()
-
-
-@pytest.fixture(autouse=True)
-def _lean():
-    safe_wakeups()
-    lean_senders()
 
 
 def _message(k: int, excluded: int | None = None):
@@ -37,7 +29,8 @@ async def _run(loop_impl, persistent: bool, seed: int, client: int = 7):
     """Push a seeded mix of messages (a backlog, atomic blocks, this tab's own echoes, flushes) while ``loop_impl``
     reads the windows; returns the windows as lists of labels (``M`` for the end-of-replay marker)."""
     rng = random.Random(seed)
-    buffer = AsyncMessageBuffer(asyncio.get_running_loop(), persistent_messages=persistent)
+    lean = loop_impl is window_loop
+    buffer = (lean_buffer if lean else message_buffer)(asyncio.get_running_loop(), persistent)
     buffer.max_window_size = 5
     count = 0
 
@@ -81,7 +74,7 @@ async def _run(loop_impl, persistent: bool, seed: int, client: int = 7):
 @pytest.mark.parametrize("seed", range(4))
 def test_the_same_messages_in_the_same_order_as_viser_sends_them(persistent, seed):
     ours, count = asyncio.run(_run(window_loop, persistent, seed))
-    viser, count_v = asyncio.run(_run(_WINDOW_LOOP, persistent, seed))
+    viser, count_v = asyncio.run(_run(VISER_WINDOW_LOOP, persistent, seed))
     assert count == count_v
     flat = [label for window in ours for label in window]
     assert flat == [label for window in viser for label in window]
@@ -96,7 +89,7 @@ def test_the_same_messages_in_the_same_order_as_viser_sends_them(persistent, see
 
 def test_an_atomic_block_is_never_split_across_windows():
     async def scenario():
-        buffer = AsyncMessageBuffer(asyncio.get_running_loop(), persistent_messages=True)
+        buffer = lean_buffer(asyncio.get_running_loop(), True)
         windows: list[list[str]] = []
 
         async def read():
@@ -175,15 +168,13 @@ def _decode(frame: bytes) -> tuple[dict, list[np.ndarray]]:
 
 def test_a_frame_is_viser_s_wire_format_and_encoded_once_for_every_tab():
     zstd = zstandard.ZstdCompressor(level=1)
-    from viser.infra import _infra
-
     calls = []
 
     def counted(window):
         calls.append(len(window))
         return encode(window)
 
-    encode = encoder(msgspec.msgpack.encode, zstd.compress, _infra._append_aligned_buffers)
+    encode = encoder(msgspec.msgpack.encode, zstd.compress, align)
     points = np.random.default_rng(3).normal(size=(4, 3)).astype(np.float32)
     window = [_message(1), _messages.SceneNodeUpdateMessage("/links", {"batched_positions": points}), _message(2)]
     frames = Frames(counted, keep=2)

@@ -1,4 +1,4 @@
-"""Each outgoing message is serialised once for every tab it goes to (viserkit/core.py ``share_serialization``), and
+"""Each outgoing message is serialised once for every tab it goes to (``shared_serializer`` in viserkit/wire.py), and
 what a tab receives is exactly what viser's own serialisation gives, wherever the message falls in a window."""
 
 from __future__ import annotations
@@ -8,14 +8,10 @@ import dataclasses
 
 import numpy as np
 import pytest
-from viser import _messages
 
-from tpm_viz.viserkit.core import _SERIALIZE, share_serialization
-
-
-@pytest.fixture(autouse=True)
-def _shared():
-    share_serialization()
+from tpm_viz.viserkit.probe import VISER_SERIALIZE as _SERIALIZE
+from tpm_viz.viserkit.probe import messages as _messages
+from tpm_viz.viserkit.probe import shared_serialize
 
 
 def _node_update(seed: int):
@@ -40,11 +36,11 @@ def _decoded(out, buffers):
 def test_a_message_in_any_window_position_decodes_as_viser_serialises_it(offset):
     message, others = _node_update(0), [_node_update(k) for k in range(1, 4)]
     first: list = []
-    out_first = message.as_serializable_dict(first)  # the first tab: viser's own path, cached
+    out_first = shared_serialize(message, first)  # the first tab: viser's own path, cached
     window: list = []
     for other in others[:offset]:
-        other.as_serializable_dict(window)
-    out = message.as_serializable_dict(window)  # another tab, the message later in its window
+        shared_serialize(other, window)
+    out = shared_serialize(message, window)  # another tab, the message later in its window
     fresh: list = []
     expected = _decoded(_SERIALIZE(message, fresh), fresh)
     assert _decoded(out, window) == expected == _decoded(out_first, first)
@@ -53,16 +49,16 @@ def test_a_message_in_any_window_position_decodes_as_viser_serialises_it(offset)
 
 def test_the_second_tab_reuses_the_first_serialisation():
     message = _messages.SetPositionMessage("/tpm/platform", (0.1, 0.2, 0.0))
-    one, two = message.as_serializable_dict([]), message.as_serializable_dict([])
+    one, two = shared_serialize(message, []), shared_serialize(message, [])
     assert one is two  # made once
 
 
 def test_a_changed_copy_is_serialised_again():
     """ui/language.py rewrites copies of GUI messages per tab: a copy never reuses its original's wire dict."""
     original = _messages.GuiUpdateMessage("uuid-1", {"label": "Move"})
-    assert original.as_serializable_dict([])["updates"] == {"label": "Move"}
+    assert shared_serialize(original, [])["updates"] == {"label": "Move"}
     replaced = dataclasses.replace(original, updates={"label": "이동"})
-    assert replaced.as_serializable_dict([])["updates"] == {"label": "이동"}
+    assert shared_serialize(replaced, [])["updates"] == {"label": "이동"}
     shallow = copy.copy(original)
     shallow.updates = {"label": "힘"}
-    assert shallow.as_serializable_dict([])["updates"] == {"label": "힘"}
+    assert shared_serialize(shallow, [])["updates"] == {"label": "힘"}

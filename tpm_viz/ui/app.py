@@ -14,9 +14,7 @@ guarded (:mod:`.guard`): one bad tab never stops the server.
 
 from __future__ import annotations
 
-import contextlib
 import gc
-import io
 import ipaddress
 import logging
 import signal
@@ -35,7 +33,7 @@ from tpm_viz.app.network import HostRules, Network
 from tpm_viz.app.readouts import Reference
 from tpm_viz.app.state import AppState
 from tpm_viz.classroom.access import Access
-from tpm_viz.classroom.guard import guard_executor, guarded, log, log_fault, report
+from tpm_viz.classroom.guard import guarded, log, log_fault, report
 from tpm_viz.classroom.identity import Keys
 from tpm_viz.classroom.session import Hub
 from tpm_viz.errors import InputError, TpmVizError
@@ -43,21 +41,18 @@ from tpm_viz.params import Params
 from tpm_viz.ui.classroom import Classroom, Handshakes, local_addresses, qr_text, student_urls
 from tpm_viz.ui.client import ClientView
 from tpm_viz.ui.continuity import LectureStore, lecture_store
+from tpm_viz.ui.guide import Guides
+from tpm_viz.ui.keyboard import keyboard_of
 from tpm_viz.ui.login import LoginPanel
 from tpm_viz.ui.look import dock_panel
+from tpm_viz.ui.phone import is_touch
 from tpm_viz.ui.room import Room
 from tpm_viz.ui.scene import MechanismScene, camera_pose
+from tpm_viz.ui.share import ShareDesk
 from tpm_viz.ui.teaching.tabs import Services
-from tpm_viz.viserkit.core import (
-    check_viser,
-    disable_share_url,
-    hook_handshakes,
-    lean_senders,
-    safe_wakeups,
-    share_serialization,
-    thread_pool,
-)
-from tpm_viz.viserkit.limits import DEFAULT_MAX_CONNECTIONS, harden_server, set_max_connections
+from tpm_viz.viserkit.adapter import install, new_server
+from tpm_viz.viserkit.core import connection_request
+from tpm_viz.viserkit.limits import DEFAULT_MAX_CONNECTIONS, set_max_connections
 from tpm_viz.viserkit.transport import harden
 from tpm_viz.words import Lang, Phrase, say
 
@@ -66,7 +61,7 @@ __all__ = ["TpmApp", "build_server", "main"]
 BRAND = (13, 148, 136)
 CLASS_INFO_DELAY = 0.3
 """A change of the class (tabs joining, leaving, switching) is shown in every tab's classroom line after this many
-seconds, once for all the changes meanwhile [s]."""
+seconds per 30 tabs (at least this), once for all the changes meanwhile [s]."""
 
 
 def is_loopback(host: str) -> bool:
@@ -96,19 +91,11 @@ def build_server(
     Raises :class:`~tpm_viz.viserkit.core.IncompatibleViserError` (one line) if the installed viser is not the tested
     one.
     """
-    check_viser()
-    safe_wakeups()  # viser's senders woken safely from the callback threads (before its buffers exist)
-    lean_senders()  # a shared window encoded once for every tab, one pause timer per buffer
     sys.setswitchinterval(GIL_SWITCH_INTERVAL)
-    with (
-        contextlib.redirect_stdout(io.StringIO()),
-        hook_handshakes(Handshakes(hosts or HostRules(addresses=local_addresses, bound=host), keys)),
-    ):  # same-origin check; viser prints its own banner even with verbose=False
-        server = viser.ViserServer(host=host, port=port, label="tpm-viz", verbose=False)
-    disable_share_url(server)
-    share_serialization()  # a broadcast message is serialised once, not once per tab (viserkit/core.py)
-    guard_executor(thread_pool(server))  # every callback's exception is logged
-    harden_server(server)  # one tab cannot freeze or fill the server (viserkit/limits.py)
+    handshakes = Handshakes(hosts or HostRules(addresses=local_addresses, bound=host), keys)
+    server = new_server(handshake=handshakes, host=host, port=port, label="tpm-viz", verbose=False)  # same-origin
+    keyboard_of(server, handshakes.keyboard)  # the page script's keys reach this server's tabs (ui/keyboard.py)
+    install(server)  # viser's patches on this server, in viserkit/PATCHES.md's order (viserkit/adapter.py)
     server.gui.configure_theme(
         control_width="large", show_share_button=False, show_logo=False, brand_color=BRAND, dark_mode=False
     )
@@ -156,6 +143,12 @@ class TpmApp:
         self.room = Room(self, classroom, store)
         """Classroom mode, tabs that come back, the session file (:mod:`.room`)."""
         self.room.start()
+        self.guides = Guides(self.room.store)
+        """Which browsers dismissed the first visit's guide (:mod:`.guide`)."""
+        self.shares = ShareDesk(self.hub, lambda: self.room.store.store, lambda: self.room.urls)
+        """Share links: *Copy share link* and the link a tab's page was opened with (:mod:`.share`)."""
+        self.keyboard = keyboard_of(server)
+        """The tabs' keys: arrows move the platform, Q/A and W/S the sliders (:mod:`.keyboard`)."""
         server.on_client_connect(self._connect)
         server.on_client_disconnect(self._disconnect)
 
@@ -168,12 +161,16 @@ class TpmApp:
     def _connect(self, client: viser.ClientHandle) -> None:
         harden(client, lang=lambda: self._lang_of(client.client_id))  # malformed updates and big uploads dropped
         who = self.room.identify(client)  # before the view moves the camera
-        view = ClientView(client, self.hub, self.services)
+        view = self.room.build(who, lambda saved: ClientView(client, self.hub, self.services, saved=saved))
         if self.access.enabled:
             view.login = LoginPanel(client.gui, lambda event, view=view: self._login(event, view))
         with self._views_lock:
             self.views[client.client_id] = view
+        self.keyboard.join(view)
         self.room.connected(view, who)  # presenter or not; what it had before a drop
+        self.guides.greet(view, who[0])  # the first visit's guide, unless this browser dismissed it (ui/guide.py)
+        self.shares.connected(view, connection_request(self.server, client.client_id))  # a link: its own copy
+        view.scene.set_touch(is_touch(connection_request(self.server, client.client_id)))  # a phone (ui/phone.py)
         self._class_info()
 
     def _lang_of(self, client_id: int) -> Lang:
@@ -187,6 +184,7 @@ class TpmApp:
         with self._views_lock:
             view = self.views.pop(client.client_id, None)
         if view is not None:
+            self.keyboard.leave(view)
             self.room.leaving(view)  # kept 30 minutes for a tab that comes back
             self.access.logout(view)
             view.close()
@@ -216,11 +214,13 @@ class TpmApp:
 
     def _class_info(self) -> None:
         """Tabs joined, left, switched or logged in: redraw every tab's classroom line, at most once per
-        :data:`CLASS_INFO_DELAY` (150 tabs arriving or leaving at once redraw 150 lines once, not 150 x 150 times)."""
+        :data:`CLASS_INFO_DELAY` per 30 tabs (150 tabs arriving or leaving at once redraw 150 lines a few times, not
+        150 x 150 times)."""
         with self._views_lock:
             if self._class_info_timer is not None:
                 return
-            self._class_info_timer = timer = threading.Timer(CLASS_INFO_DELAY, self._write_class_info)
+            delay = CLASS_INFO_DELAY * max(1.0, len(self.views) / 30)
+            self._class_info_timer = timer = threading.Timer(delay, self._write_class_info)
         timer.daemon = True
         timer.start()
 

@@ -21,6 +21,7 @@ import viser
 from tpm_viz import meshes
 from tpm_viz.app import transitions
 from tpm_viz.app.poses import DEMO_KINDS
+from tpm_viz.app.sessions import Saved
 from tpm_viz.app.state import AppState
 from tpm_viz.classroom.dragging import Dragging
 from tpm_viz.classroom.guard import guarded
@@ -34,6 +35,7 @@ from tpm_viz.ui.login import LoginPanel
 from tpm_viz.ui.look import Look
 from tpm_viz.ui.panels import Panel
 from tpm_viz.ui.scene import MechanismScene
+from tpm_viz.ui.share import ShareBox
 from tpm_viz.ui.tabscene import TabScene
 from tpm_viz.ui.teaching.tabs import Services, Teaching
 from tpm_viz.viserkit.core import widget_value
@@ -62,9 +64,14 @@ _callback = control
 class ClientView:
     """The scene, panel and callbacks of one connected browser tab."""
 
-    def __init__(self, client: viser.ClientHandle, hub: Hub, services: Services) -> None:
+    def __init__(self, client: viser.ClientHandle, hub: Hub, services: Services, saved: Saved | None = None) -> None:
+        """Build the tab, then join the shared mechanism, or with ``saved`` (a returning tab's own copy) a private
+        copy of it from the first draw."""
         self.client = client
         self.hub = hub
+        self.session: Session = hub.shared
+        """The session this tab shows, set when it joins (:meth:`Hub.join`); until then (the tab being built under
+        the hub's lock) the shared one, so a callback that arrives meanwhile finds it, then waits for the lock."""
         self.closed = False
         self.lang = Lang.EN
         """The language of this tab's words (:mod:`tpm_viz.words`): render a phrase with ``say(view.lang, ...)``."""
@@ -77,16 +84,22 @@ class ClientView:
         """The typed number fields of this tab (Enter, Apply, the quiet time: :mod:`.fields`)."""
         self.drags = Dragging(self)
         """The gizmo drags of this tab (:mod:`.dragging`)."""
-        with hub.lock:
-            state = hub.shared.state
+        with hub.lock, client.atomic():  # built and drawn, then sent as one: no wake-up of the loop per widget
+            state = hub.shared.state if saved is None else saved.state
             self.words = TabWords(self)  # the Language selector, first in the panel; sets self.lang (ui/language.py)
             self.scene = TabScene(client, cast(MechanismScene, hub.shared.scene))
             self.teaching = Teaching(self, services)  # player, explorer, lessons (ui/teaching/)
             self.panel = Panel(client.gui, state, extra_tabs=self.teaching.build_tabs)
+            with self.panel.tabs["setup"].add_tab("Share", icon=viser.Icon.SHARE):
+                self.share = ShareBox(self, client.gui)  # *Copy share link* beside Class & view (ui/share.py)
             self.look = Look(self)  # phone layout, presentation mode, camera framed for the canvas (ui/look.py)
             self._wire()
             self.frame_camera(state.params)
-            self.session: Session = hub.join(self, private=False)
+            if saved is None:
+                hub.join(self, private=False)
+            else:
+                self._join_own_copy(saved)
+            self.scene.gizmo.on_update(self.drags.on_drag)  # once joined: a drag always finds its session
             self.teaching.attach()
             self._catch_up()
 
@@ -103,6 +116,16 @@ class ClientView:
                 self.scene.set_visible(what, visible)
         self.client.flush()
 
+    def _join_own_copy(self, saved: Saved) -> None:
+        """Join a new own copy of ``saved`` (with an empty player: it does not inherit the shared run; the saved
+        trajectory is loaded again by :func:`.continuity.restore`), the box ticked."""
+        source = Session(saved.state, shared=False)
+        runs = self.teaching.services.runs
+        runs.of(source)
+        self.hub.join(self, private=True, session=source, scene=self.scene.open_private(saved.state.params))
+        runs.adopt(self.session, source)
+        self.panel.own_copy.value = True  # echoed with client=None: ignored
+
     def switch(self, private: bool, source: Session | None = None) -> None:
         """Move this tab to a new own copy of ``source`` (default: its session; a copy of ``source`` starts with its
         player, not the shared one's), or back to the shared mechanism (under the lock)."""
@@ -111,12 +134,12 @@ class ClientView:
         if private:
             origin = old if source is None else source
             scene = self.scene.open_private(origin.state.params)
-            self.session = self.hub.join(self, private=True, session=origin, scene=scene)
+            self.hub.join(self, private=True, session=origin, scene=scene)
             if source is not None:
                 self.teaching.services.runs.adopt(self.session, source)
         else:
             self.scene.close_private()
-            self.session = self.hub.join(self, private=False)
+            self.hub.join(self, private=False)
         self._slot = None
         self.teaching.switched(old)
         self.hub.membership_changed()
@@ -129,8 +152,7 @@ class ClientView:
         20 Hz, less in a lecture hall, the tabs in turn)."""
         if self.closed:
             return
-        session = getattr(self, "session", None)  # None during the first render (inside Hub.join)
-        slot = watch_slot(time.monotonic(), 1 if session is None else len(session.views), self._phase)
+        slot = watch_slot(time.monotonic(), len(self.session.views), self._phase)
         if frame.in_drag and not dragging and slot == self._slot:
             return
         self._slot = slot
@@ -182,19 +204,19 @@ class ClientView:
 
     def set_class_info(self, text: str | Phrase) -> None:
         """The classroom line of the *Class & view* tab."""
-        self.panel.class_info.content = say(self.lang, text)
+        content = say(self.lang, text)
+        if self.panel.class_info.content != content:  # a line for every tab at every join: only what changed
+            self.panel.class_info.content = content
 
     # -- commits -------------------------------------------------------------------------------------------
     def _commit(self, state: AppState, dragging: bool = False) -> None:
-        self.hub.authorize(self, self.session)  # before anything changes (presenter mode)
         self.panel.tell("")
-        self.session.play_token += 1  # any input stops a playing trajectory
-        self.hub.commit(self.session, state, origin=self, dragging=dragging)
+        self.hub.commit(self.session, state, origin=self, dragging=dragging)  # checks that this tab may
+        self.session.play_token += 1  # an input that changed the mechanism stops a playing trajectory
 
     # -- wiring --------------------------------------------------------------------------------------------
     def _wire(self) -> None:
-        panel, scene = self.panel, self.scene
-        scene.gizmo.on_update(self.drags.on_drag)
+        panel = self.panel
         self.typing.add(panel.p, self._apply_p)
         self.typing.add(panel.d_typed, self._apply_d)
         for name in ("f_ext", "dp", "ddp"):
@@ -214,13 +236,15 @@ class ClientView:
             handle.on_update(lambda event, what=what: self._on_show(event, what))
         panel.frame_camera.on_click(self._on_frame)
 
-    def drain_drags(self) -> None:
-        """Commit the session's pending drags (called by a tab that leaves with the session's drain)."""
-        self.drags.drain()
-
     def commit_drag(self, phase: str, position: np.ndarray) -> None:
-        """Commit this tab's drag to ``position`` [m] (under the hub's lock)."""
-        self._commit(transitions.drag(self.session.state, position), dragging=phase != "end")
+        """Commit this tab's drag to ``position`` [m] (under the hub's lock; geared on a touch tab: ui/phone.py)."""
+        state = self.session.state
+        target = self.scene.geared(phase, position, state.pose.p)
+        self._commit(transitions.drag(state, target), dragging=phase != "end")
+
+    def commit_key(self, state: AppState) -> None:
+        """Commit a key's move (:mod:`.keyboard`; under the hub's lock), with the permission of any input."""
+        self._commit(state)
 
     def drag_ended(self) -> None:
         """This tab's drag ended inside another tab's commit: its gizmo is written back by that commit."""
