@@ -6,10 +6,11 @@ On each screen, measured in the page: the panel and everything in it stays insid
 the panel scrolls in its own box); the mechanism is in view: the 8 corners of the box around the base plate and the
 pins, projected through the tab's camera as the server knows it (position, orientation, field of view and canvas
 size reported by the browser; a pinhole written here), land inside the 3D canvas and outside the panel. On the
-phone the panel's sheet is at most 45 % of the height, every control is at least 24 px across, and with the
-sheet collapsed to its handle the mechanism is framed again in the taller canvas. In presentation
-mode every readout cell is at least 20 px, and on the projector with the panel collapsed to its rail the box of
-banner and forces shows, with the mechanism clear of it. One app and one browser for the module; the screenshots
+phone the panel's sheet is at most 45 % of the height, every control is at least 24 px across (a button or tab
+44 px), and with the sheet collapsed to its handle the mechanism is framed again in the taller canvas. In presentation
+mode (which folds the panel to its rail; one click brings it back) every cell of the compact readout (p, d, τ₁, τ₂) is
+at least 20 px, and on the projector with the panel folded the box of live numbers shows, with the mechanism clear of
+it. One app and one browser for the module; the screenshots
 are kept in a temporary folder named in the output.
 """
 
@@ -21,14 +22,18 @@ import tempfile
 import numpy as np
 import pytest
 
-from tests.support.browser import CHROMIUM, CHROMIUM_ARGS
+from tests.support.browser import launched_chromium
 from tests.support.protocol import wait_for
+from tests.support.stage import open_tab
 from tpm_viz import meshes
 from tpm_viz.ui.app import TpmApp, build_server
+from tpm_viz.viserkit.probe import widget_uuid
 
 pytestmark = pytest.mark.browser
 
 SCREENS = [(1024, 768), (1366, 768), (1920, 1080), (390, 844)]
+LIVE_QS = ["p1", "p2", "d1", "d2", "tau1", "tau2"]
+"""The numbers of the compact readout (presentation mode; with the pose status): p, d and the two forces."""
 PHONE = (390, 844)
 PANEL = '[data-testid="floating-panel"], .mantine-Paper-root[style*="position: fixed"]'
 """The control panel: docked beside the canvas on a wide screen, a sheet along the bottom on a phone."""
@@ -69,13 +74,15 @@ TARGETS = """
   for (const e of panel.querySelectorAll(sel)) {
     const r = e.getBoundingClientRect();
     if (r.width === 0 || r.height === 0 || getComputedStyle(e).visibility === 'hidden') continue;
-    if (r.width < 24 - 0.01 || r.height < 24 - 0.01)
+    const least = (e.tagName === 'BUTTON' || e.getAttribute('role') === 'tab') ? 44 : 24;
+    if (r.width < least - 0.01 || r.height < least - 0.01)
       out.push(`${e.tagName} "${e.textContent.trim().slice(0, 30)}" ${r.width.toFixed(1)}x${r.height.toFixed(1)}`);
   }
   return out;
 }
 """
-"""Every visible control of the panel smaller than 24 × 24 CSS px (empty: none)."""
+"""Every visible control of the panel smaller than 24 × 24 CSS px, or a button or tab smaller than 44 × 44 (empty:
+none)."""
 
 RECTS = """
 (selector) => {
@@ -109,15 +116,8 @@ def served():
 
 @pytest.fixture(scope="module")
 def chromium():
-    if not os.path.exists(CHROMIUM):
-        pytest.skip(f"{CHROMIUM} is not installed")
-    sync_api = pytest.importorskip("playwright.sync_api")
-    with sync_api.sync_playwright() as pw:
-        browser = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS, headless=True)
-        try:
-            yield browser
-        finally:
-            browser.close()
+    with launched_chromium() as browser:
+        yield browser
 
 
 @pytest.fixture(scope="module")
@@ -196,8 +196,7 @@ def _in_view(page, view, what: str) -> None:
 
 
 def _tab(page, name: str) -> None:
-    page.get_by_role("tab", name=name, exact=True).click()
-    page.wait_for_timeout(250)
+    open_tab(page, name)  # its group first (tests/support/stage.py)
 
 
 def _fits(page, where: str) -> None:
@@ -209,9 +208,21 @@ def _fits(page, where: str) -> None:
 
 def _presentation(page, view) -> None:
     _tab(page, "Class & view")
-    page.locator(f'[id="{view.panel.presentation._impl.uuid}"]').click()
+    page.locator(f'[id="{widget_uuid(view.panel.presentation)}"]').click()
     wait_for(lambda: view.look.presentation, what="presentation mode on the server")
+    _unfold(page)
     _tab(page, "Move")
+
+
+def _unfold(page) -> None:
+    """Presentation mode folds the panel to its rail (on a wide screen; the phone's sheet stays): one click on the
+    rail brings it back."""
+    if page.viewport_size == {"width": PHONE[0], "height": PHONE[1]}:
+        return
+    rail = page.locator('[aria-label^="Expand"]')
+    wait_for(lambda: rail.count() > 0, what="the panel folded to its rail")
+    rail.first.click()
+    wait_for(lambda: page.evaluate(RECTS, PANEL)["canvas"][2] < page.viewport_size["width"] - 300, what="the panel")
 
 
 @pytest.mark.parametrize("size", SCREENS, ids=[f"{w}x{h}" for w, h in SCREENS])
@@ -241,8 +252,8 @@ def test_each_screen_in_normal_and_presentation_mode(served, chromium, shots, si
 
         _presentation(page, view)
         _in_view(page, view, f"the mechanism in view at {name} in presentation mode")
-        sizes = page.evaluate(FONT_SIZES, PANEL.split(", ")[size == PHONE])
-        assert len(sizes) == 12 and min(px for _, px in sizes) >= 20.0, sizes
+        sizes = page.evaluate(FONT_SIZES, PANEL.split(", ")[size == PHONE])  # the compact readout of the stage
+        assert [q for q, _ in sizes] == LIVE_QS and min(px for _, px in sizes) >= 20.0, sizes
         page.screenshot(path=os.path.join(shots, f"{name}-presentation.png"))
         _fits(page, f"{name} in presentation mode")
         if size == PHONE:
@@ -252,7 +263,7 @@ def test_each_screen_in_normal_and_presentation_mode(served, chromium, shots, si
             wait_for(lambda: page.evaluate(RECTS, PANEL)["live"] is not None, what="the box of banner and forces")
             _in_view(page, view, "the mechanism in view, clear of the box of banner and forces")
             sizes = page.evaluate(FONT_SIZES, "[data-live]")
-            assert [q for q, _ in sizes] == ["tau1", "tau2"] and min(px for _, px in sizes) >= 20.0, sizes
+            assert [q for q, _ in sizes] == LIVE_QS and min(px for _, px in sizes) >= 20.0, sizes
             assert page.locator("[data-live] [data-q=banner]").is_visible()
             page.screenshot(path=os.path.join(shots, f"{name}-presentation-collapsed.png"))
     finally:
@@ -265,16 +276,19 @@ def test_a_korean_projector_in_presentation_mode(served, chromium, shots):
     try:
         wait_for(lambda: view.lang.value == "ko", what="a Korean tab")
         _in_view(page, view, "the mechanism in view")
-        tabs = page.locator(PANEL).get_by_role("tab")
-        names = [tabs.nth(i).inner_text().strip() for i in range(tabs.count())]
-        tabs.nth(len(names) - 1).click()  # the last tab: Class & view
-        page.locator(f'[id="{view.panel.presentation._impl.uuid}"]').click()
+        groups = ["살펴보기", "가르치기", "실험", "설정"]  # Explore, Teach, Lab, Setup
+        open_tab(page, "수업·보기", group=groups[3])  # Class & view
+        page.locator(f'[id="{widget_uuid(view.panel.presentation)}"]').click()
         wait_for(lambda: view.look.presentation, what="presentation mode on the server")
-        for i in range(len(names)):
-            tabs.nth(i).click()
-            page.wait_for_timeout(250)
-            assert page.evaluate(OVERFLOW, PANEL) == [], f"Korean, presentation mode, the {names[i]} tab"
-        tabs.nth(0).click()
+        _unfold(page)
+        for group in groups:
+            page.get_by_role("tab", name=group, exact=True).click()
+            inner = page.locator(PANEL).get_by_role("tab")
+            names = [inner.nth(i).inner_text().strip() for i in range(inner.count())]
+            for name in names[len(groups) :]:  # the open group's tabs, after the row of groups
+                open_tab(page, name, group=group)
+                assert page.evaluate(OVERFLOW, PANEL) == [], f"Korean, presentation mode, the {name} tab"
+        open_tab(page, "이동", group=groups[0])  # Move
         _in_view(page, view, "the mechanism in view in presentation mode")
         page.screenshot(path=os.path.join(shots, "1024x768-korean-presentation.png"))
     finally:

@@ -43,6 +43,7 @@ from tpm_viz.ui.scene import camera_pose
 from tpm_viz.words import Lang, T
 
 __all__ = [
+    "BUTTON_TOUCH",
     "HANDLE",
     "LIVE_LABEL",
     "PANEL_WIDTH",
@@ -68,6 +69,8 @@ SHEET = 0.45
 """Height of the panel's sheet on a phone [fraction of the window height]; the canvas is the rest above it."""
 TOUCH = 24
 """Least width and height of a control on a phone [CSS px] (WCAG 2.2 target size, level AA)."""
+BUTTON_TOUCH = 44
+"""Least width and height of a button, tab or icon button on a phone [CSS px] (WCAG 2.2 target size, level AAA)."""
 ASPECT_CHANGE = 0.01
 """Relative change of a canvas's aspect ratio that frames the camera again (a pixel of rounding does not)."""
 RESIZE_ASKS = (0.3, 1.0, 3.0)
@@ -109,8 +112,9 @@ PHONE_CSS = f"""<style>
   .mantine-Slider-thumb {{ width: {TOUCH}px !important; height: {TOUCH}px !important; border-radius: 50% !important;
     background: #fff !important; }}
   .mantine-Checkbox-input, .mantine-Checkbox-inner {{ width: {TOUCH}px !important; height: {TOUCH}px !important; }}
-  .mantine-Button-root, .mantine-Input-input, .mantine-Tabs-tab {{ min-height: {TOUCH}px !important; }}
-  .mantine-ActionIcon-root {{ min-width: {TOUCH}px !important; min-height: {TOUCH}px !important; }}
+  .mantine-Input-input {{ min-height: {TOUCH}px !important; }}
+  .mantine-Button-root, .mantine-Tabs-tab {{ min-height: {BUTTON_TOUCH}px !important; }}
+  .mantine-ActionIcon-root {{ min-width: {BUTTON_TOUCH}px !important; min-height: {BUTTON_TOUCH}px !important; }}
 }}
 </style>"""
 """The phone layout and touch targets (by viewport and pointer: no switch), in every tab."""
