@@ -1,6 +1,13 @@
 """Headless Chromium for the browser tests and benchmarks: Debian's binary, the flags this machine needs, and
 an init script that logs viser's websocket messages in the page."""
 
+import contextlib
+import os
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+
 from tpm_viz.viserkit.probe import widget_uuid
 
 CHROMIUM = "/usr/bin/chromium"
@@ -14,6 +21,21 @@ CHROMIUM_ARGS = [
     "--disable-component-update",
     "--disable-sync",
 ]
+
+
+@contextlib.contextmanager
+def launched_chromium() -> Iterator[Any]:
+    """A headless Chromium (each ``new_context()`` a fresh browser with no cookies); the test is skipped when Chromium
+    or playwright is not installed."""
+    if not os.path.exists(CHROMIUM):
+        pytest.skip(f"{CHROMIUM} is not installed")
+    sync_api = pytest.importorskip("playwright.sync_api")
+    with sync_api.sync_playwright() as pw:
+        browser = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS, headless=True)
+        try:
+            yield browser
+        finally:
+            browser.close()
 
 
 WORKER_LOG_JS = """

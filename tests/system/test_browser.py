@@ -17,6 +17,8 @@ import pytest
 
 from tests.support.browser import WORKER_LOG_JS, text_input
 from tests.support.protocol import wait_for
+from tests.support.stage import open_tab
+from tpm_viz.viserkit.probe import widget_uuid
 
 pytestmark = pytest.mark.browser
 
@@ -100,14 +102,14 @@ def test_app_end_to_end(app, browser):
     tau_before = _text(page, "theta1")
 
     # Click the d1 slider track near its right end: forward kinematics moves the platform.
-    track = page.locator(f'[id="{view.panel.d[0]._impl.uuid}"]')
+    track = page.locator(f'[id="{widget_uuid(view.panel.d[0])}"]')
     box = track.bounding_box()
     track.click(position={"x": 0.9 * box["width"], "y": box["height"] / 2})
     wait_for(lambda: float(_text(page, "d1")) > 250.0, what="d1 near 270 mm")
     assert _text(page, "theta1") != tau_before
 
     # A parameter change (Parameters tab): l_a = 280 mm, then Apply. Numbers change everywhere.
-    page.get_by_role("tab", name="Parameters").click()
+    open_tab(page, "Parameters")
     _fill(page, view.panel.params.inputs["l_a"], "280", enter=False)
     page.get_by_role("button", name="Apply parameters").click()
     wait_for(lambda: view.session.state.params.l_a == pytest.approx(0.28), what="l_a applied")
@@ -123,7 +125,7 @@ def test_app_end_to_end(app, browser):
     page.get_by_text("b: in use 92 mm").first.wait_for(timeout=10_000)
     assert view.session.state.params.b == pytest.approx(0.092)
     assert text_input(page, view.panel.params.inputs["b"]).input_value() == "-5"
-    page.get_by_role("tab", name="Move").click()
+    open_tab(page, "Move")
     time.sleep(PAUSE)
     page.get_by_role("button", name="Home (p = 0)").click()
     _wait_text(page, "p1", "0.0")

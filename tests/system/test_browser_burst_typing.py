@@ -16,6 +16,8 @@ import pytest
 
 from tests.support.browser import text_input
 from tests.support.protocol import decode_batch, wait_for
+from tests.support.stage import open_tab
+from tpm_viz.viserkit.probe import widget_uuid
 
 pytestmark = pytest.mark.browser
 
@@ -63,16 +65,16 @@ def test_a_number_and_enter_in_one_burst_apply_the_whole_number(app, browser):
 
     # The Control tab: ω_n's field beside its slider, next in the Tab order; 1e9 refused under the row.
     cv = view.teaching.control
-    page.get_by_role("tab", name="Control").click()
+    open_tab(page, "Control")
     wn = cv.typed["wn"]
-    slider = page.locator(f'[id="{wn.slider._impl.uuid}"]')
+    slider = page.locator(f'[id="{widget_uuid(wn.slider)}"]')
     typed = text_input(page, wn.field)
     typed.wait_for(timeout=10_000)
     s, t = slider.bounding_box(), typed.bounding_box()
     assert t["x"] >= s["x"] + s["width"] - 1  # to the right of the slider
     assert abs((t["y"] + t["height"] / 2) - (s["y"] + s["height"] / 2)) < 12  # in its row
     assert slider.evaluate("e => getComputedStyle(e.nextElementSibling).display") == "none"  # viser's box hidden
-    page.locator(f'[id="{wn.slider._impl.uuid}"] [role=slider]').focus()
+    page.locator(f'[id="{widget_uuid(wn.slider)}"] [role=slider]').focus()
     page.keyboard.press("Tab")
     assert typed.evaluate("e => e === document.activeElement")
     page.keyboard.press("Control+a")

@@ -18,9 +18,11 @@ import tempfile
 import pytest
 
 from tests.support.protocol import wait_for
+from tests.support.stage import GROUP_OF, open_tab
 from tests.system.test_browser_charts import _check_chart, open_with_a_run
 from tpm_viz.ui.teaching.charts import FORCES, KINEMATICS
-from tpm_viz.words import Lang
+from tpm_viz.viserkit.probe import widget_uuid
+from tpm_viz.words import Lang, catalogue
 
 pytestmark = pytest.mark.browser
 
@@ -63,7 +65,7 @@ def _fonts(page, charts, least: float | None, most: float | None) -> list[dict]:
     def drawn():
         out = []
         for handle in charts.handles:
-            axes = page.evaluate(FONTS_JS, handle._impl.uuid)
+            axes = page.evaluate(FONTS_JS, widget_uuid(handle))
             if not axes or any(least is not None and a["tick"] < least for a in axes):
                 return None
             if any(most is not None and a["tick"] > most for a in axes):
@@ -81,6 +83,14 @@ def _check_all(page, charts, where: str) -> None:
         _check_chart(handle, page, y_label, f"{where}, chart {k}")
 
 
+def _unfold(page) -> None:
+    """Presentation mode folds the panel to its rail: one click on the rail brings it back."""
+    rail = page.locator('[aria-label^="Expand"]')
+    wait_for(lambda: rail.count() > 0, what="the panel folded to its rail")
+    rail.first.click()
+    wait_for(lambda: rail.count() == 0, what="the panel back")
+
+
 def test_presentation_mode_draws_the_chart_axes_large_and_dark_and_whole(app, browser):
     shots = tempfile.mkdtemp(prefix="tpm-viz-chart-presentation-")
     print(f"screenshots in {shots}")
@@ -91,13 +101,14 @@ def test_presentation_mode_draws_the_chart_axes_large_and_dark_and_whole(app, br
     assert {a["tick"] for a in normal} == {12.0} and {a["title"] for a in normal} == {12.0}
     assert max(_contrast(a["stroke"]) for a in normal) < LEAST_CONTRAST  # grey
 
-    page.get_by_role("tab", name="Class & view").click()
-    page.locator(f'[id="{view.panel.presentation._impl.uuid}"]').click()
+    open_tab(page, "Class & view")
+    page.locator(f'[id="{widget_uuid(view.panel.presentation)}"]').click()
     wait_for(lambda: view.look.presentation, what="presentation mode on the server")
-    page.get_by_role("tab", name="Player").click()
+    _unfold(page)
+    open_tab(page, "Player")
     for lang in (Lang.EN, Lang.KO):
         if lang is Lang.KO:
-            page.locator(f'[id="{view.words.selector._impl.uuid}"]').click()
+            page.locator(f'[id="{widget_uuid(view.words.selector)}"]').click()
             page.get_by_role("option", name=Lang.KO.label, exact=True).click()
             wait_for(lambda: view.lang is Lang.KO, what="the tab in Korean")
         large = _fonts(page, charts, LEAST_PX, None)
@@ -105,12 +116,12 @@ def test_presentation_mode_draws_the_chart_axes_large_and_dark_and_whole(app, br
         assert min(_contrast(a["stroke"]) for a in large) >= LEAST_CONTRAST  # near-black
         _check_all(page, charts, f"presentation mode, {lang.value}")
         for name, handle in (("forces", charts.forces), ("accelerations", charts.kinematics[-1])):
-            page.evaluate(SCROLL_JS, handle._impl.uuid)
+            page.evaluate(SCROLL_JS, widget_uuid(handle))
             page.screenshot(path=os.path.join(shots, f"1024x768-{lang.value}-presentation-{name}.png"))
 
-    tabs = page.get_by_role("tab")  # Korean names now: the Class & view tab is the last one
-    tabs.nth(tabs.count() - 1).click()
-    page.locator(f'[id="{view.panel.presentation._impl.uuid}"]').click()
+    ko = catalogue(Lang.KO)  # Korean names now
+    open_tab(page, ko["Class & view"], group=ko[GROUP_OF["Class & view"]])
+    page.locator(f'[id="{widget_uuid(view.panel.presentation)}"]').click()
     wait_for(lambda: not view.look.presentation, what="presentation mode off on the server")
     back = _fonts(page, charts, None, 13.0)
     assert {a["tick"] for a in back} == {12.0} and [a["stroke"] for a in back] == [a["stroke"] for a in normal]

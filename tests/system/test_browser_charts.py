@@ -23,8 +23,10 @@ import time
 import pytest
 
 from tests.support.protocol import wait_for
+from tests.support.stage import open_tab
 from tpm_viz.app.runs import Source
 from tpm_viz.ui.teaching.charts import FORCES, KINEMATICS
+from tpm_viz.viserkit.probe import widget_uuid
 from tpm_viz.words import Lang, say
 
 pytestmark = pytest.mark.browser
@@ -72,7 +74,7 @@ def _check_chart(handle, page, y_label, where: str) -> None:
     server_x = handle.axes[0]
     m = wait_for(
         lambda: (
-            (r := page.evaluate(MEASURE_JS, [handle._impl.uuid, _labels_everywhere(y_label)]))
+            (r := page.evaluate(MEASURE_JS, [widget_uuid(handle), _labels_everywhere(y_label)]))
             and r["axes"][0]["values"] == list(server_x["values"])
             and r["x"] == list(handle.scales["x"]["range"])
             and r["plot"]["width"] > 0
@@ -113,8 +115,8 @@ def open_with_a_run(app, browser):
     page.wait_for_selector("[data-q=p1]", timeout=30_000)
     view = wait_for(lambda: next(iter(app.views.values()), None), what="the tab's view")
     charts = view.teaching.player.charts
-    page.get_by_role("tab", name="Player").click()
-    page.locator(f'[id="{view.teaching.player.choice._impl.uuid}"]').click()
+    open_tab(page, "Player")
+    page.locator(f'[id="{widget_uuid(view.teaching.player.choice)}"]').click()
     page.get_by_role("option", name="circle (Fig. 5)", exact=True).click()
     time.sleep(PAUSE)
     wait_for(lambda: charts.forces.visible and charts.forces.data[0][-1] == 0.5, what="the run")
@@ -128,7 +130,7 @@ def test_chart_axes_are_whole_on_a_laptop_and_on_a_phone(app, browser):
     runs = app.services.runs
     for size in ({"width": 1024, "height": 768}, {"width": 390, "height": 844}, {"width": 320, "height": 568}):
         page.set_viewport_size(size)
-        page.get_by_role("tab", name="Player").click()
+        open_tab(page, "Player")
         for duration in (0.5, 0.01, 0.0137, 100.0):
             runs.load(view.session, Source.paper("circle", duration), origin=view)
             wait_for(lambda d=duration: player.charts.forces.data[0][-1] == d, what=f"the run of {duration} s")

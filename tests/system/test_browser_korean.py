@@ -19,6 +19,8 @@ import pytest
 
 from tests.support.browser import CHROMIUM, CHROMIUM_ARGS
 from tests.support.protocol import wait_for
+from tests.support.stage import GROUP_OF, open_tab
+from tpm_viz.ui.panels import GROUPS
 from tpm_viz.words import Lang, catalogue
 
 HANGUL = re.compile("[\uac00-\ud7a3]")
@@ -70,16 +72,24 @@ def test_a_korean_tab_fits_its_panel(app, width, height):
             page.get_by_text("언어", exact=True).wait_for(timeout=30_000)
             (view,) = wait_for(lambda: list(app.views.values()), what="the tab's view")
             assert view.lang is Lang.KO
+            ko = catalogue(Lang.KO)
+            groups = [ko[group] for group in GROUPS.values()]  # the row of groups, then the open group's tabs
             tabs = page.get_by_role("tab")
-            names = [tabs.nth(i).inner_text().strip() for i in range(tabs.count())]
-            assert len(names) == 10 and set(names) <= korean, names
-            for i, name in enumerate(names):
-                tabs.nth(i).click()
-                page.wait_for_timeout(300)
-                assert page.evaluate(CUT) == [], f"cut in the {name} tab at {width}×{height}"
-                texts = page.locator(".mantine-Paper-root label").all_inner_texts()
-                assert any(HANGUL.search(t) for t in texts), f"no Korean label in the {name} tab"
-                page.screenshot(path=os.path.join(shots, f"{i:02d}.png"))
+            names: list[str] = []
+            for group in groups:
+                handle = page.get_by_role("tab", name=group, exact=True)
+                handle.click()
+                wait_for(lambda h=handle: h.get_attribute("aria-selected") == "true", what=f"the {group} group open")
+                shown = [tabs.nth(i).inner_text().strip() for i in range(tabs.count())]
+                assert shown[: len(groups)] == groups, shown
+                for name in shown[len(groups) :]:
+                    open_tab(page, name, group=group)
+                    assert page.evaluate(CUT) == [], f"cut in the {name} tab at {width}×{height}"
+                    texts = page.locator(".mantine-Paper-root label").all_inner_texts()
+                    assert any(HANGUL.search(t) for t in texts), f"no Korean label in the {name} tab"
+                    page.screenshot(path=os.path.join(shots, f"{len(names):02d}.png"))
+                    names.append(name)
+            assert {ko[name] for name in GROUP_OF} <= set(names) <= korean, names
             print(f"screenshots: {shots}")
             with app.hub.lock:  # the check sees a cut text when there is one
                 view.client.gui.add_button("가나다라마바사아자차카타파하" * 12)

@@ -11,6 +11,7 @@ import pytest
 
 from tests.support.browser import WORKER_LOG_JS
 from tests.support.protocol import wait_for
+from tests.support.stage import open_tab
 
 pytestmark = pytest.mark.browser
 
@@ -34,7 +35,7 @@ def test_planner_and_control_tabs_show_their_numbers(app, browser, tmp_path):
     page.wait_for_selector("[data-q=p1]", timeout=20_000)
     view = wait_for(lambda: next(iter(app.views.values()), None), what="the tab's view")
 
-    page.get_by_role("tab", name="Planner").click()
+    open_tab(page, "Planner")
     pv = view.teaching.planner
     wait_for(lambda: pv.result is not None, timeout=20, what="the first plan")
     page.locator("[data-q=cycle-time]").first.wait_for(timeout=10_000)
@@ -45,7 +46,7 @@ def test_planner_and_control_tabs_show_their_numbers(app, browser, tmp_path):
     page.screenshot(path=str(shot))
     _keep(shot)
 
-    page.get_by_role("tab", name="Control").click()
+    open_tab(page, "Control")
     page.get_by_role("button", name="Simulate").click()
     cv = view.teaching.control
     wait_for(lambda: cv.run is not None, timeout=20, what="the simulation")

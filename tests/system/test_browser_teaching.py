@@ -11,6 +11,8 @@ import pytest
 
 from tests.support.browser import WORKER_LOG_JS
 from tests.support.protocol import wait_for
+from tests.support.stage import open_tab
+from tpm_viz.viserkit.probe import widget_uuid
 
 pytestmark = pytest.mark.browser
 
@@ -38,7 +40,7 @@ def _text(page, name: str) -> str:
 
 
 def _pick(page, handle, option: str) -> None:
-    page.locator(f'[id="{handle._impl.uuid}"]').click()
+    page.locator(f'[id="{widget_uuid(handle)}"]').click()
     page.get_by_role("option", name=option, exact=True).click()
     time.sleep(PAUSE)
 
@@ -54,11 +56,11 @@ def test_play_a_trajectory_and_watch_the_platform_and_the_charts(app, browser, t
     view = wait_for(lambda: next(iter(app.views.values()), None), what="the tab's view")
     player = view.teaching.player
 
-    page.get_by_role("tab", name="Player").click()
+    open_tab(page, "Player")
     _pick(page, player.choice, "circle (Fig. 5)")
     page.get_by_text("circle (Fig. 5), T = 0.5 s").first.wait_for(timeout=10_000)
     wait_for(lambda: _text(page, "p1") == "100.0", what="the platform at the circle's start")
-    forces = player.charts.forces._impl.uuid
+    forces = widget_uuid(player.charts.forces)
     wait_for(lambda: (page.evaluate(MARKER_JS, forces) or {}).get("k") == 0, what="the chart in the page")
     chart = page.evaluate(MARKER_JS, forces)
     n, last = chart["n"], chart["n"] - 1
@@ -77,14 +79,14 @@ def test_play_a_trajectory_and_watch_the_platform_and_the_charts(app, browser, t
     assert _text(page, "p1") == "100.0" and _text(page, "p2") in ("0.0", "-0.0")
     assert page.evaluate("() => (window.__viserLog||[]).some(m => m.name === '/player/trace')")
     for chart in player.charts.kinematics:
-        assert page.evaluate(MARKER_JS, chart._impl.uuid)["k"] == last
+        assert page.evaluate(MARKER_JS, widget_uuid(chart))["k"] == last
 
     # A user's CSV, through the real file input of the upload button.
     t = np.linspace(0.0, 1.0, 21)
     rows = "".join(f"{a:.3f},{0.05 * np.sin(np.pi * a):.6f},{0.03 * np.sin(2 * np.pi * a):.6f}\n" for a in t)
     path = tmp_path / "wave.csv"
     path.write_text("t,p1,p2\n" + rows)
-    page.set_input_files(f'[id="file_upload_{player.upload._impl.uuid}"]', str(path))
+    page.set_input_files(f'[id="file_upload_{widget_uuid(player.upload)}"]', str(path))
     page.get_by_text("wave.csv, T = 1 s").first.wait_for(timeout=10_000)
     wait_for(lambda: _text(page, "p1") == "0.0", what="the platform at the CSV's start")
 

@@ -18,6 +18,7 @@ import pytest
 from tests.support.browser import text_input
 from tests.support.protocol import decode_batch, wait_for
 from tpm_viz.ui.typed import QUIET
+from tpm_viz.viserkit.probe import widget_uuid
 
 pytestmark = pytest.mark.browser
 
@@ -52,7 +53,7 @@ def test_typing_1_5e2_into_d1_puts_the_actuator_at_150_mm(app, browser):
     assert _slider1_positions(page, frames)[-1][0] == pytest.approx(0.130 - A, abs=1e-12)  # home: d1 = a - b - l_a
 
     # The slider is there to drag, without viser's number box beside it.
-    slider = page.locator(f'[id="{view.panel.d[0]._impl.uuid}"]')
+    slider = page.locator(f'[id="{widget_uuid(view.panel.d[0])}"]')
     assert slider.bounding_box()["width"] > 150
     assert slider.evaluate("e => getComputedStyle(e.nextElementSibling).display") == "none"
 

@@ -16,6 +16,8 @@ import pytest
 
 from tests.support.browser import text_input
 from tests.support.protocol import wait_for
+from tests.support.stage import open_tab
+from tpm_viz.viserkit.probe import widget_uuid
 
 pytestmark = pytest.mark.browser
 
@@ -52,8 +54,8 @@ def test_typing_5e_minus_1_into_duration_and_a_refused_upload(app, browser, tmp_
     view = wait_for(lambda: next(iter(app.views.values()), None), what="the tab's view")
     player = view.teaching.player
 
-    page.get_by_role("tab", name="Player").click()
-    page.locator(f'[id="{player.choice._impl.uuid}"]').click()
+    open_tab(page, "Player")
+    page.locator(f'[id="{widget_uuid(player.choice)}"]').click()
     page.get_by_role("option", name="line (Fig. 4)", exact=True).click()
     page.get_by_text("line (Fig. 4), T = 0.2 s").first.wait_for(timeout=10_000)
     time.sleep(PAUSE)
@@ -73,7 +75,7 @@ def test_typing_5e_minus_1_into_duration_and_a_refused_upload(app, browser, tmp_
 
     far = tmp_path / "far.csv"
     far.write_text("t,p1,p2\n0,0,0\n0.1,0.1,0\n0.2,0.4,0\n0.3,0.1,0\n")  # 400 mm: out of reach
-    page.set_input_files(f'[id="file_upload_{player.upload._impl.uuid}"]', str(far))
+    page.set_input_files(f'[id="file_upload_{widget_uuid(player.upload)}"]', str(far))
     assert not _toast_seen(page, 2.0)
     page.get_by_text("Refused: the trajectory far.csv").first.wait_for(timeout=10_000)
     refusal = page.get_by_text("Refused: the trajectory far.csv").first.bounding_box()
@@ -84,7 +86,7 @@ def test_typing_5e_minus_1_into_duration_and_a_refused_upload(app, browser, tmp_
     wave = tmp_path / "wave.csv"
     wave.write_text("t,p1,p2\n" + "".join(f"{a:.3f},{0.05 * np.sin(np.pi * a):.6f},0\n" for a in t))
     time.sleep(PAUSE)
-    page.set_input_files(f'[id="file_upload_{player.upload._impl.uuid}"]', str(wave))
+    page.set_input_files(f'[id="file_upload_{widget_uuid(player.upload)}"]', str(wave))
     page.get_by_text("wave.csv, T = 1 s").first.wait_for(timeout=10_000)
     wait_for(lambda: page.get_by_text("Refused: the trajectory far.csv").count() == 0, what="the refusal cleared")
     assert errors == []

@@ -19,6 +19,7 @@ from tests.support.browser import text_input
 from tests.support.pages import TOKEN, Page, classroom_app, views_of
 from tests.support.protocol import ServerProcess, wait_for
 from tests.support.proxy import TcpProxy
+from tests.support.stage import open_tab
 from tests.support.stores import page_cookie, stored_lecture
 from tpm_viz.app import sessions
 from tpm_viz.app.runs import Source, build_run
@@ -270,10 +271,10 @@ def test_browser_tab_comes_back_on_its_own_copy_after_a_network_drop(app, browse
         page.goto(f"http://127.0.0.1:{proxy.port}/")
         view = wait_for(lambda: next(iter(app.views.values()), None), timeout=30, what="the tab's view")
         wait_for(lambda: view.session.readout is not None, what="the first render")
-        page.get_by_role("tab", name="Class & view").click()
+        open_tab(page, "Class & view")
         page.get_by_label("Work on my own copy").check()
         wait_for(lambda: not view.session.shared, what="the own copy")
-        page.get_by_role("tab", name="Parameters").click()
+        open_tab(page, "Parameters")
         field = text_input(page, view.panel.params.inputs["l_a"])
         field.fill("280")
         field.press("Tab")
@@ -294,7 +295,7 @@ def test_browser_tab_comes_back_on_its_own_copy_after_a_network_drop(app, browse
         assert back.session.state.params.l_a == pytest.approx(0.28)
         assert app.hub.shared.state.params.l_a == pytest.approx(0.26) and app.hub.shared_viewers() == 0
         page.get_by_text("Welcome back").first.wait_for(timeout=10_000)
-        page.get_by_role("tab", name="Class & view").click()
+        open_tab(page, "Class & view")
         wait_for(lambda: page.get_by_label("Work on my own copy").is_checked(), what="the box ticked")
         assert errors == []
         page.close()

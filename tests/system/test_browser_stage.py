@@ -1,0 +1,170 @@
+"""A stage for the room (issue 25), measured in headless Chromium: a 1024×768 projector in presentation mode, a
+1366×768 and a 1024×768 laptop in normal mode, a 390×844 touch phone.
+
+Measured in the page (:data:`tests.support.stage.STAGE`): the 3D canvas's share of the window (its bounding box), the
+rows of tabs (distinct tops of the panel's tab elements), the first control of every tab (its bottom inside the
+window, before any scrolling), the font size of the live numbers in presentation mode, and the mechanism framed in
+the canvas, clear of the panel and of the box of live numbers (the pinhole check of ``test_browser_layout``).
+The first visit's guide: shown to a new browser, gone after *Got it*, not shown again to the same browser after a
+reload, shown again to another browser.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+
+import pytest
+
+from tests.support.protocol import wait_for
+from tests.support.stage import GROUP_OF, STAGE, open_tab
+from tests.system.test_browser_layout import _in_view, chromium, served  # noqa: F401  (fixtures)
+from tpm_viz.viserkit.probe import widget_uuid
+
+pytestmark = pytest.mark.browser
+
+LIVE_NUMBERS = """
+() => [...document.querySelectorAll('[data-live] [data-q]')].filter(e => e.getClientRects().length > 0)
+  .map(e => [e.dataset.q, parseFloat(getComputedStyle(e).fontSize)])
+"""
+"""Font size [CSS px] of each number (and the pose status) shown in the box of live numbers."""
+LIVE_SHOWN = """
+() => { const w = document.querySelector('[data-floating-window]:has([data-live])');
+        return !!w && getComputedStyle(w).visibility === 'visible' && w.getBoundingClientRect().height > 0; }
+"""
+SINGULARITY_BUTTONS = ("Near an inverse singularity", "Near the direct singularity", "At a stroke end")
+
+
+@pytest.fixture(scope="module")
+def shots():
+    folder = tempfile.mkdtemp(prefix="tpm-viz-stage-")
+    yield folder
+    print(f"screenshots: {folder}")
+
+
+def _open(served, chromium, size, context=None, locale="en-US"):  # noqa: F811
+    touch = size == (390, 844)
+    if context is None:
+        context = chromium.new_context(
+            viewport={"width": size[0], "height": size[1]}, has_touch=touch, is_mobile=touch, locale=locale
+        )
+    before = set(served.views)
+    page = context.new_page()
+    page.goto(f"http://127.0.0.1:{served.port}/")
+    page.wait_for_selector("[data-q=p1]", timeout=120_000)
+    new = wait_for(lambda: set(served.views) - before, what="the tab's view")
+    view = served.views[next(iter(new))]
+    wait_for(lambda: view in served.guides.greeted, what="the tab's view connected and greeted")
+    return context, page, view
+
+
+def _every_tab(page, where: str) -> dict[str, float]:
+    """Open every tab; check at most two rows of tabs and the tab's first control on screen; its bottom [px]."""
+    bottoms = {}
+    for name in GROUP_OF:
+        if name == "Design":
+            page.get_by_role("tab", name=GROUP_OF[name], exact=True).click()
+            if page.get_by_role("tab", name="Design", exact=True).count() == 0:
+                continue  # the Design view is not in this build
+        open_tab(page, name)
+        stage = page.evaluate(STAGE)
+        assert len(stage["rows"]) <= 2, f"{where}, {name}: tabs on {len(stage['rows'])} rows {stage['names']}"
+        first = stage["first"]
+        assert first is not None, f"{where}, {name}: nothing under the tabs"
+        assert first["bottom"] <= stage["height"], f"{where}, {name}: first control {first} below the window"
+        bottoms[name] = first["bottom"]
+    open_tab(page, "Move")
+    return bottoms
+
+
+def _buttons_in_view(page, where: str) -> None:
+    for label in SINGULARITY_BUTTONS:
+        box = page.get_by_role("button", name=label, exact=True).bounding_box()
+        assert box is not None and box["y"] + box["height"] <= page.viewport_size["height"], f"{where}: {label} {box}"
+
+
+def _presentation_on(page, view) -> None:
+    open_tab(page, "Class & view")
+    page.locator(f'[id="{widget_uuid(view.panel.presentation)}"]').click()
+    wait_for(lambda: view.look.presentation, what="presentation mode on the server")
+
+
+def test_the_projector_in_presentation_mode(served, chromium, shots):  # noqa: F811
+    context, page, view = _open(served, chromium, (1024, 768))
+    try:
+        _presentation_on(page, view)
+        # the controls fold to the rail: the canvas is the screen, the live numbers float over its bottom
+        wait_for(lambda: page.evaluate(STAGE)["share"] >= 0.6, what="the 3D view on 60 % of the projector")
+        wait_for(lambda: page.evaluate(LIVE_SHOWN), what="the box of live numbers")
+        _in_view(page, view, "the mechanism framed on the projector, clear of the live numbers")
+        share = page.evaluate(STAGE)["share"]
+        sizes = dict(page.evaluate(LIVE_NUMBERS))
+        assert {"banner", "p1", "p2", "d1", "d2", "tau1", "tau2"} <= set(sizes), sizes
+        assert min(sizes.values()) >= 20.0, sizes
+        bars = page.locator("[data-live] [style*='grid-template-columns']")
+        assert bars.count() == 2 and all(bars.nth(i).is_visible() for i in range(2))  # τ₁ and τ₂ with their bars
+        page.screenshot(path=os.path.join(shots, "projector-1024x768-presentation.png"))
+        print(f"projector 1024x768, presentation mode, panel folded: canvas share {share:.3f}")
+
+        page.locator('[aria-label^="Expand"]').first.click()  # the lecturer: one click on the rail
+        wait_for(lambda: page.evaluate(STAGE)["rows"], what="the panel back")
+        stage = page.evaluate(STAGE)
+        assert stage["canvas"][2] <= 1024 - 400, stage  # the panel is docked beside the canvas again
+        bottoms = _every_tab(page, "projector, presentation mode, panel open")
+        _buttons_in_view(page, "projector, presentation mode, panel open")
+        print(f"projector, presentation mode, panel open: first control bottoms {bottoms}")
+    finally:
+        context.close()
+
+
+@pytest.mark.parametrize("size", [(1366, 768), (1024, 768)], ids=["1366x768", "1024x768"])
+def test_a_laptop_in_normal_mode_and_the_first_visit(served, chromium, shots, size):  # noqa: F811
+    context, page, view = _open(served, chromium, size)
+    name = f"{size[0]}x{size[1]}"
+    try:
+        stage = page.evaluate(STAGE)
+        width = stage["canvas"][2] - stage["canvas"][0]
+        assert width >= 0.5 * size[0], stage
+        guide = page.locator("[data-guide]")
+        assert guide.is_visible()  # a new browser: the guide, with the singularity buttons in view beside it
+        _buttons_in_view(page, f"{name} with the guide")
+        with_guide = _every_tab(page, f"{name} with the guide")
+        page.screenshot(path=os.path.join(shots, f"laptop-{name}-guide.png"))
+        page.get_by_role("button", name="Got it").click()
+        wait_for(lambda: not view.panel.guide.visible, what="the guide dismissed")
+        page.wait_for_selector("[data-guide]", state="detached")
+        _buttons_in_view(page, f"{name} after the guide")
+        after = _every_tab(page, f"{name} after the guide")
+        legend = page.get_by_text("workspace: poses inside the stroke", exact=False)
+        legend.scroll_into_view_if_needed()
+        assert legend.is_visible()  # the colour legend is on the Move tab
+        print(f"{name}: canvas width {width:.0f} px ({width / size[0]:.2f}); first control bottoms {after}")
+        print(f"{name} with the guide open: {with_guide}")
+        page.screenshot(path=os.path.join(shots, f"laptop-{name}.png"))
+
+        _, page2, view2 = _open(served, chromium, size, context=context)  # the same browser, a new page
+        page.close()
+        assert not view2.panel.guide.visible and page2.locator("[data-guide]").count() == 0
+        other, page3, view3 = _open(served, chromium, size)  # another browser: its own first visit
+        try:
+            wait_for(lambda: view3.panel.guide.visible, what="the guide for a new browser")
+            page3.wait_for_selector("[data-guide]")
+        finally:
+            other.close()
+    finally:
+        context.close()
+
+
+def test_a_phone(served, chromium, shots):  # noqa: F811
+    context, page, view = _open(served, chromium, (390, 844))
+    try:
+        _in_view(page, view, "the mechanism framed above the sheet")
+        stage = page.evaluate(STAGE)
+        assert stage["share"] >= 0.5 and len(stage["rows"]) <= 2, stage
+        page.get_by_role("button", name="Got it").click()
+        wait_for(lambda: not view.panel.guide.visible, what="the guide dismissed")
+        bottoms = _every_tab(page, "phone")
+        print(f"phone 390x844: canvas share {stage['share']:.3f}; first control bottoms {bottoms}")
+        page.screenshot(path=os.path.join(shots, "phone-390x844.png"))
+    finally:
+        context.close()
