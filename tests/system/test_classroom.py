@@ -217,7 +217,7 @@ def test_the_token_field_shows_dots_not_the_token(browser):
         wait_for(lambda: view.login is not None, what="the login folder")
         page.get_by_text("Presenter login").click()
         uuid = widget_uuid(view.login.token)
-        field = page.locator(f'div:has(> div > p > label[for="{uuid}"]) input')
+        field = page.locator(f'div:has(> div > p > label[for="{uuid}"]) textarea')  # one-line-drawn: Enter logs in
         field.fill("typed-secret")
         security = field.evaluate("e => getComputedStyle(e).webkitTextSecurity")
         assert security == "disc"
