@@ -243,7 +243,10 @@ def skipped(owner: Any, name: str) -> bool:
     """Whether the patch ``name`` is switched off on the registered server of ``owner`` (a server or a client
     handle; False for a server that is not registered: the patch acts, as on a bare server in a test)."""
     server = getattr(owner, "_viser_server", owner)
-    return name in _SKIPS.get(server, frozenset())
+    try:
+        return name in _SKIPS.get(server, frozenset())
+    except TypeError:  # None or another object that cannot be weakly referenced: not a registered server
+        return False
 
 
 def lean_encoder(shared: bool) -> Encode:

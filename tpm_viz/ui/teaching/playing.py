@@ -87,8 +87,12 @@ class RunHub:
         return ps
 
     def adopt(self, session: Session, source: Session) -> None:
-        """A private copy starts with the run of the session it was copied from."""
-        if session not in self._sessions and source in self._sessions:
+        """A private copy starts with the run of the session it was copied from (its player may already have been
+        drawn once, empty, when the tab joined the copy: that empty player is replaced); the shared session never
+        takes a copy's run."""
+        mine = self._sessions.get(session)
+        fresh = mine is None or (mine.run is None and mine.loading is None and mine.uploaded is None)
+        if fresh and not session.shared and source in self._sessions and source is not session:
             old = self._sessions[source]
             self._sessions[session] = PlayerSession(run=old.run, uploaded=old.uploaded, extra=old.extra)
 
