@@ -31,6 +31,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from importlib import resources
 from types import MappingProxyType
+from typing import Any
 
 __all__ = ["Lang", "Phrase", "T", "catalogue", "fields_of", "preferred", "say", "shown", "shown_html"]
 
@@ -84,11 +85,19 @@ class Phrase:
     def __str__(self) -> str:
         return self.render(Lang.EN)
 
+    def __reduce__(self) -> tuple[Any, tuple[str, dict[str, object]]]:
+        """Pickled as its template and values (a design row crosses to a worker process with its reason)."""
+        return _phrase, (self.template, dict(self.values))
+
     def __hash__(self) -> int:
         return hash((self.template, tuple(sorted((k, repr(v)) for k, v in self.values.items()))))
 
     def __eq__(self, other: object) -> bool:
         return isinstance(other, Phrase) and (self.template, dict(self.values)) == (other.template, dict(other.values))
+
+
+def _phrase(template: str, values: dict[str, object]) -> Phrase:
+    return Phrase(template, **values)
 
 
 def T(template: str) -> Phrase:

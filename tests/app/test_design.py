@@ -5,6 +5,9 @@ mechanism's own joint positions, the cubic law's own sizing and the scaling law 
 from __future__ import annotations
 
 import math
+import pickle
+import tomllib
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,6 +20,7 @@ from tpm_viz.paper import arrangement as arr
 from tpm_viz.paper.arrangement import Arrangement
 from tpm_viz.paper.dynamics import inverse_dynamics
 from tpm_viz.params import Params
+from tpm_viz.words import Lang, say
 
 PERP, PAR = Arrangement.PERPENDICULAR, Arrangement.PARALLEL
 PAPER = Params.paper()
@@ -104,12 +108,28 @@ def test_area_means_reach_the_stated_tolerance_on_a_known_integral():
 
 def test_an_infeasible_task_has_no_numbers():
     got = evaluate(PAR, PAPER, TASK)  # crosses p2 = 0, the parallel arrangement's direct singularity
-    assert not got.feasible and "direct singularity" in got.why
+    assert not got.feasible and "direct singularity" in str(got.why)
     assert all(math.isnan(v) for k, v in got.row().items() if k != "feasible")
     too_big = evaluate(PERP, PAPER, Task(-0.3, 0.3, -0.1, 0.1))
     assert not too_big.feasible and all(math.isnan(v) for k, v in too_big.row().items() if k != "feasible")
     invalid = evaluate(PAR, Params.paper(a=0.05, b=0.092, l_a=0.1), PAR_TASK)  # a < b: no pose in the stroke
-    assert not invalid.feasible and "a − b > 0" in invalid.why
+    assert not invalid.feasible and "a − b > 0" in str(invalid.why)
+
+
+def test_an_infeasible_design_says_why_in_each_language_and_keeps_it_across_processes():
+    """The reason is a phrase: English in the CSV (``str``), the tab's language on screen, intact after pickling (a
+    design row crosses to a worker process). Korean checked against the catalogue file read here, not the code."""
+    ko = tomllib.loads((Path(__file__).parents[2] / "assets" / "words" / "ko.toml").read_text("utf-8"))
+    got = evaluate(PERP, PAPER, Task(-0.2, 0.2, -0.2, 0.2))  # its corner is out of stroke
+    english = str(got.why)
+    assert english.startswith("the task is not covered: (") and english.endswith(") mm is out of stroke")
+    korean = say(Lang.KO, got.why)
+    assert ko["out of stroke"] in korean and korean.startswith(
+        ko["the task is not covered: ({x:.1f}, {y:.1f}) mm is {status}"][:8]
+    )
+    assert not any(word in korean for word in ("task", "covered", "stroke"))
+    back = pickle.loads(pickle.dumps(got))
+    assert say(Lang.KO, back.why) == korean and str(back.why) == english
 
 
 def test_feasibility_agrees_with_a_dense_check_of_the_task():

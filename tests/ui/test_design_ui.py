@@ -206,3 +206,19 @@ def test_the_texts_of_the_tab_in_korean_hold_the_numbers_and_no_nan():
     assert f"{want.gci:.3f}" in texts[2] and "Δd = 200.0 mm" in texts[2]
     assert f"data-q='compare-0-cycle_time'>{want.cycle_time:.3f}<" in texts[3]
     assert "compare-1-gci" not in texts[3]  # an infeasible column: a dash and why, never a number
+
+
+def test_an_infeasible_cell_says_why_in_the_tabs_language():
+    """A design whose task leaves the stroke: its cell and its comparison column give the reason in Korean, with the
+    corner's coordinates (the library's grid corner, in mm) and no English words."""
+    task = Task(-0.2, 0.2, -0.2, 0.2)
+    spec = MapSpec(Arrangement.PERPENDICULAR, P, task, Axis("a", 0.42, 0.54, 2), Axis("stroke", 0.2, 0.3, 2))
+    rows = spec.rows(0, spec.size)
+    bad = next(k for k, r in enumerate(rows) if not r["feasible"])
+    cell = text.cell_html(spec, bad, rows[bad], Lang.KO)
+    table = text.table_html([{**rows[bad], "case": "given"}], T("footprint"), Lang.KO)
+    for shown in (cell, table):
+        reason = re.sub(r"<[^>]+>", " ", shown)
+        assert "작업 영역을 덮지 못합니다" in reason and "-200.0" in reason
+        assert not re.search(r"\b(task|covered|stroke|unreachable|mm is)\b", reason)
+    assert "the task is not covered" in str(rows[bad]["why"])  # the CSV keeps English

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize
 
-from tpm_viz.app.design import INDEX_COLUMNS, Indices, Settings, Task, evaluate
+from tpm_viz.app.design import INDEX_COLUMNS, Indices, Settings, Task, evaluate, reason
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.paper.arrangement import Arrangement
 from tpm_viz.params import Params
@@ -128,7 +128,7 @@ def design_row(
     try:
         indices = evaluate(Arrangement.parse(arrangement), Params(**values), Task(*task), settings)
     except TpmVizError as exc:  # a parameter set that is not valid, an area mean that does not converge
-        indices = Indices(False, why=str(exc))
+        indices = Indices(False, why=reason(exc))
     row.update(indices.row())
     row["why"] = indices.why
     return row

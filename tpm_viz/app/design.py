@@ -36,8 +36,9 @@ from tpm_viz.app.planner import DEFAULT_GRID, Limits, plan_path
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.paper import arrangement as arr
 from tpm_viz.paper.arrangement import Arrangement
-from tpm_viz.paper.status import WARN, PoseStatus, SingularityThresholds
+from tpm_viz.paper.status import STATUS_WORDS, WARN, PoseStatus, SingularityThresholds
 from tpm_viz.params import Params
+from tpm_viz.words import Phrase
 
 __all__ = [
     "CHECK_STEP",
@@ -55,6 +56,7 @@ __all__ = [
     "footprint",
     "pick_path",
     "pointwise",
+    "reason",
     "task_grid",
 ]
 
@@ -166,7 +168,8 @@ class Indices:
     moving_mass: float = math.nan
     footprint_x: float = math.nan
     footprint_y: float = math.nan
-    why: str = field(default="", compare=False)
+    why: str | Phrase = field(default="", compare=False)
+    """Why it is infeasible: a phrase shown in each tab's language (``str()``: English, as the CSV writes it)."""
 
     def row(self) -> dict[str, float]:
         """``{column: value}`` in :data:`INDEX_COLUMNS` order (``feasible`` as 1.0 or 0.0)."""
@@ -324,8 +327,19 @@ def _peak_cubic(arrangement: Arrangement, params: Params, path: GeometricPath, d
     return peak
 
 
+_NOT_COVERED = "the task is not covered: ({x:.1f}, {y:.1f}) mm is {status}"
+_NO_CYCLE = "no pick cycle within the force limit: {why}"
+
+
+def reason(why: object) -> str | Phrase:
+    """``why`` as an infeasible design's reason: a phrase as it is, an error by its phrase (or its text)."""
+    if isinstance(why, BaseException):
+        why = why.args[0] if why.args and isinstance(why.args[0], Phrase) else str(why)
+    return why if isinstance(why, Phrase) else str(why)
+
+
 def _infeasible(why: object) -> Indices:
-    return Indices(False, why=str(why))
+    return Indices(False, why=reason(why))
 
 
 def evaluate(arrangement: Arrangement, params: Params, task: Task, settings: Settings = Settings()) -> Indices:
@@ -340,10 +354,8 @@ def evaluate(arrangement: Arrangement, params: Params, task: Task, settings: Set
     bad = np.flatnonzero(status != PoseStatus.REGULAR)
     if bad.size:
         k = int(bad[np.argmax(status[bad])])
-        return _infeasible(
-            f"the task is not covered: ({grid[k, 0] * 1e3:.1f}, {grid[k, 1] * 1e3:.1f}) mm is "
-            f"{PoseStatus(int(status[k])).label}"
-        )
+        status_k = STATUS_WORDS[PoseStatus(int(status[k]))]
+        return _infeasible(Phrase(_NOT_COVERED, x=grid[k, 0] * 1e3, y=grid[k, 1] * 1e3, status=status_k))
     (gci, dyn_mean), _ = area_means(lambda p: pointwise(arrangement, params, p), task, settings.rtol)
     values = pointwise(arrangement, params, grid)
     cond_max = -1.0 / _refined_max(lambda p: -_inverse_condition(arrangement, params, p), task, grid, -values[:, 0])
@@ -353,7 +365,7 @@ def evaluate(arrangement: Arrangement, params: Params, task: Task, settings: Set
     try:
         plan = plan_path(params, path, Limits(settings.force_limit), settings.planner_grid, arrangement)
     except TpmVizError as exc:
-        return _infeasible(f"no pick cycle within the force limit: {exc}")
+        return _infeasible(Phrase(_NO_CYCLE, why=reason(exc)))
     width, depth = footprint(arrangement, params, grid)
     return Indices(
         True,

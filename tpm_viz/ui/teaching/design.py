@@ -306,7 +306,7 @@ class DesignView:
         if found is None:
             raise InputError(T("that design is not computed yet"))
         if not found.get("feasible"):
-            why = str(found.get("why", ""))
+            why = found.get("why") or ""
             raise InputError(Phrase("that design is infeasible ({why}): not loaded", why=why))
         lengths = {name: float(found[name]) for name in SWEPT}
         view = self.view

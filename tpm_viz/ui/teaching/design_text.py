@@ -118,9 +118,7 @@ def cell_html(spec: MapSpec, k: int, row: Row | None, lang: Lang = Lang.EN) -> s
     if row is None:
         body = _esc(lang, T("not computed yet"))
     elif not row.get("feasible"):
-        body = (
-            f'<span style="color:#991b1b">{_esc(lang, Phrase("infeasible: {why}", why=str(row.get("why", ""))))}</span>'
-        )
+        body = f'<span style="color:#991b1b">{_esc(lang, Phrase("infeasible: {why}", why=row.get("why") or ""))}</span>'
     else:
         parts = [
             f"{_esc(lang, T(INDICES[key].label))} <span data-q='cell-{key}'>"
@@ -150,9 +148,7 @@ def table_html(rows: Sequence[Row], hold: Phrase, lang: Lang = Lang.EN) -> str:
             if r.get("feasible")
             else _esc(
                 lang,
-                Phrase(
-                    "infeasible: {why}", why=str(r.get("why", "")) or say(lang, T("no design found within the limits"))
-                ),
+                Phrase("infeasible: {why}", why=r.get("why") or T("no design found within the limits")),
             )
             for r in rows
         ]
