@@ -11,9 +11,9 @@ prints what they compute, operation by operation:
   ``h = τ(p, ṗ, 0)`` and the columns of ``M = τ(p, 0, e_j)`` are ``_procedure`` again; a 2x2 solve gives ``p̈``;
 - computed torque: :func:`tpm_viz.paper.control.task_space_command` then ``_procedure`` at the measurement.
 
-The checks are a short C skeleton per function with the Python's own thresholds
-(:data:`tpm_viz.paper.dynamics.SINGULAR_TOL`, :data:`tpm_viz.paper.control.CTC_DIRECT_TOL`, the default
-tolerance of :func:`tpm_viz.paper.kinematics.in_stroke`). C99, ``libm`` only, no allocation, no global
+The checks are a short C skeleton per function (:mod:`.c_text`, the shape they share in :mod:`.c_blocks`) with
+the Python's own thresholds (:data:`tpm_viz.paper.dynamics.SINGULAR_TOL`, :data:`tpm_viz.paper.control.CTC_DIRECT_TOL`,
+the default tolerance of :func:`tpm_viz.paper.kinematics.in_stroke`). C99, ``libm`` only, no allocation, no global
 state; a function that refuses returns a non-zero code and leaves its outputs untouched. The parallel
 arrangement's functions (``tpm_par_*``) come from :mod:`.c_parallel` the same way.
 """
@@ -26,7 +26,8 @@ from typing import Any
 
 import numpy as np
 
-from tpm_viz.exchange.c_expr import Emitter, Graph, Sym
+from tpm_viz.exchange.c_blocks import Stages, traced_block
+from tpm_viz.exchange.c_expr import Graph
 from tpm_viz.exchange.c_parallel import parallel_fields
 from tpm_viz.exchange.c_text import HEADER, SOURCE
 from tpm_viz.paper.control import CTC_DIRECT_TOL, task_space_command
@@ -60,40 +61,11 @@ def _params(s: SimpleNamespace) -> Any:
     return SimpleNamespace(l_a=s.l_a, offset=s.offset, m_a=s.m_a, m_b=s.m_b, m_p=s.m_p)
 
 
-def _used(body: str, candidates: dict[str, str]) -> str:
-    """Declarations of the locals that ``body`` refers to (an unused one is a warning, and -Werror)."""
-    words = set(body.replace("(", " ").replace(")", " ").replace(";", " ").replace(",", " ").split())
-    return "\n".join(f"        const double {name} = {value};" for name, value in candidates.items() if name in words)
-
-
-_PARAM_LOCALS = {
-    "l_a": "prm->l_a",
-    "offset": "prm->a - prm->b",
-    "m_a": "prm->m_a",
-    "m_b": "prm->m_b",
-    "m_p": "prm->m_p",
-}
-_STATE_LOCALS = {
-    "p1": "p[0]",
-    "p2": "p[1]",
-    "dp1": "dp[0]",
-    "dp2": "dp[1]",
-    "ddp1": "ddp[0]",
-    "ddp2": "ddp[1]",
-}
-
-
-def _block(stages: list[tuple[str, list[tuple[str, Sym]]]], extra: dict[str, str] | None = None) -> str:
-    body = Emitter(indent=" " * 8).emit(stages)
-    decl = _used(body, {**_PARAM_LOCALS, **_STATE_LOCALS, **(extra or {})})
-    return f"{decl}\n{body}" if decl else body
-
-
 def _ik_body() -> str:
     g = Graph()
     s = _symbols(g)
     d = _ik_unchecked(_params(s), np.array([s.p1, s.p2], dtype=object))
-    return _block(
+    return traced_block(
         [
             (
                 "working-mode inverse kinematics, eq. (4): d_i = p_i + a - b - sqrt(l_a^2 - p_j^2) [m]",
@@ -109,12 +81,12 @@ def _jacobian_body() -> str:
     prm = _params(s)
     cols = [_procedure(prm, s.p1, s.p2, e1, e2, 0.0, 0.0, s.c1, s.c2, 0.0, 0.0) for e1, e2 in ((1.0, 0.0), (0.0, 1.0))]
     entries = [("J11", cols[0][0]), ("J12", cols[1][0]), ("J21", cols[0][1]), ("J22", cols[1][1])]
-    return _block(
+    return traced_block(
         [("J = dd/dp, eqs. (9)-(10): [[1, tan theta_1], [tan theta_2, 1]], tan theta_i = p_j / c_i", entries)]
     )
 
 
-def _procedure_stages(out: tuple, suffix: str = "") -> list[tuple[str, list[tuple[str, Sym]]]]:
+def _procedure_stages(out: tuple, suffix: str = "") -> Stages:
     return [
         (comment, [(n + suffix, out[k]) for n, k in zip(names, range(*sl), strict=True)])
         for sl, names, comment in _STAGES
@@ -125,7 +97,7 @@ def _id_body() -> str:
     g = Graph()
     s = _symbols(g)
     out = _procedure(_params(s), s.p1, s.p2, s.dp1, s.dp2, s.ddp1, s.ddp2, s.c1, s.c2, s.f1, s.f2)
-    return _block(_procedure_stages(out))
+    return traced_block(_procedure_stages(out))
 
 
 def _fd_body() -> str:
@@ -135,7 +107,7 @@ def _fd_body() -> str:
     h = _procedure(prm, s.p1, s.p2, s.dp1, s.dp2, 0.0, 0.0, s.c1, s.c2, s.f1, s.f2)
     m1 = _procedure(prm, s.p1, s.p2, 0.0, 0.0, 1.0, 0.0, s.c1, s.c2, 0.0, 0.0)
     m2 = _procedure(prm, s.p1, s.p2, 0.0, 0.0, 0.0, 1.0, s.c1, s.c2, 0.0, 0.0)
-    return _block(
+    return traced_block(
         [
             (
                 "velocity and external-force terms h = tau(p, dp, ddp = 0), eqs. (9)-(31) [N]",
@@ -172,7 +144,7 @@ def _ctc_body() -> str:
         "kd1": "kd[0]",
         "kd2": "kd[1]",
     }
-    return _block(stages, extra)
+    return traced_block(stages, extra)
 
 
 def _params_initializer(params: Params) -> str:
