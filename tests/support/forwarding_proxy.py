@@ -9,38 +9,22 @@ daemon thread; :meth:`ForwardingProxy.close` stops it. Bounded: at most 200 conn
 from __future__ import annotations
 
 import asyncio
-import contextlib
-import threading
+
+from tests.support.proxy import MAX_CONNECTIONS, LoopbackProxy, splice
 
 __all__ = ["ForwardingProxy"]
 
-MAX_CONNECTIONS = 200
 MAX_HEAD = 65_536
 
 
-class ForwardingProxy:
+class ForwardingProxy(LoopbackProxy):
     """``127.0.0.1:<port>`` -> ``127.0.0.1:<target>``, adding ``header: <client address>`` to each request head
     (``style``: ``"xff"`` for X-Forwarded-For, ``"forwarded"`` for RFC 7239 Forwarded)."""
 
     def __init__(self, target: int, style: str = "xff") -> None:
-        self.target = target
         self.style = style
-        self.port = 0
         self._count = 0
-        self._loop = asyncio.new_event_loop()
-        self._ready = threading.Event()
-        self._server: asyncio.base_events.Server | None = None
-        self._thread = threading.Thread(target=self._run, name="forwarding-proxy", daemon=True)
-        self._thread.start()
-        if not self._ready.wait(10.0):
-            raise RuntimeError("the proxy did not start")
-
-    def _run(self) -> None:
-        asyncio.set_event_loop(self._loop)
-        self._server = self._loop.run_until_complete(asyncio.start_server(self._handle, "127.0.0.1", 0))
-        self.port = self._server.sockets[0].getsockname()[1]
-        self._ready.set()
-        self._loop.run_forever()
+        super().__init__(target, "forwarding-proxy")
 
     def _header(self, client: str) -> bytes:
         if self.style == "forwarded":
@@ -61,18 +45,7 @@ class ForwardingProxy:
                 return
             up_reader, up_writer = await asyncio.open_connection("127.0.0.1", self.target, local_addr=("127.0.0.1", 0))
             up_writer.write(head[:-2] + self._header(client) + b"\r\n")
-
-            async def pipe(src: asyncio.StreamReader, dst: asyncio.StreamWriter) -> None:
-                try:
-                    while data := await src.read(65536):
-                        dst.write(data)
-                        await dst.drain()
-                except (ConnectionError, OSError):
-                    pass
-                finally:
-                    dst.close()
-
-            await asyncio.gather(pipe(reader, up_writer), pipe(up_reader, writer), return_exceptions=True)
+            await splice(reader, writer, up_reader, up_writer)
         except (asyncio.IncompleteReadError, asyncio.LimitOverrunError, ConnectionError, OSError):
             pass
         finally:
@@ -80,19 +53,3 @@ class ForwardingProxy:
             writer.close()
             if up_writer is not None:
                 up_writer.close()
-
-    def close(self) -> None:
-        """Stop the proxy and its thread."""
-
-        async def stop() -> None:
-            if self._server is not None:
-                self._server.close()
-            tasks = [t for t in asyncio.all_tasks() if t is not asyncio.current_task()]
-            for task in tasks:
-                task.cancel()
-            await asyncio.gather(*tasks, return_exceptions=True)
-            self._loop.stop()
-
-        with contextlib.suppress(RuntimeError):
-            asyncio.run_coroutine_threadsafe(stop(), self._loop)
-        self._thread.join(timeout=5.0)

@@ -2,7 +2,8 @@
 :meth:`TcpProxy.drop` cuts every connection and refuses new ones for a while (a wifi blip, a closed laptop lid).
 
 The proxy runs its own asyncio loop in a daemon thread; :meth:`TcpProxy.close` stops it. Bounded: at most
-:data:`MAX_CONNECTIONS` at once.
+:data:`MAX_CONNECTIONS` at once. :class:`LoopbackProxy` and :func:`splice` are that skeleton, shared with
+:mod:`tests.support.forwarding_proxy`.
 """
 
 from __future__ import annotations
@@ -12,24 +13,46 @@ import contextlib
 import threading
 import time
 
-__all__ = ["TcpProxy"]
+__all__ = ["LoopbackProxy", "TcpProxy", "splice"]
 
 MAX_CONNECTIONS = 200
 
 
-class TcpProxy:
-    """``127.0.0.1:<port>`` -> ``127.0.0.1:<target>``."""
+async def _pipe(src: asyncio.StreamReader, dst: asyncio.StreamWriter) -> None:
+    try:
+        while data := await src.read(65536):
+            dst.write(data)
+            await dst.drain()
+    except (ConnectionError, OSError):
+        pass
+    finally:
+        dst.close()
 
-    def __init__(self, target: int) -> None:
+
+async def splice(
+    reader: asyncio.StreamReader,
+    writer: asyncio.StreamWriter,
+    up_reader: asyncio.StreamReader,
+    up_writer: asyncio.StreamWriter,
+) -> None:
+    """Pipe bytes both ways until either side ends; each direction closes its destination when it stops."""
+    await asyncio.gather(_pipe(reader, up_writer), _pipe(up_reader, writer), return_exceptions=True)
+
+
+class LoopbackProxy:
+    """A server on ``127.0.0.1:<port>`` (for ``127.0.0.1:<target>``) in its own asyncio loop and daemon thread.
+
+    Subclasses implement :meth:`_handle` (one client connection) and set their own state before calling this
+    ``__init__`` (it starts serving). :meth:`close` cuts the connections in ``_writers`` and stops the thread."""
+
+    def __init__(self, target: int, name: str) -> None:
         self.target = target
         self.port = 0
-        self.accepted = 0
-        self._down_until = 0.0
         self._writers: set[asyncio.StreamWriter] = set()
         self._loop = asyncio.new_event_loop()
         self._ready = threading.Event()
         self._server: asyncio.base_events.Server | None = None
-        self._thread = threading.Thread(target=self._run, name="tcp-proxy", daemon=True)
+        self._thread = threading.Thread(target=self._run, name=name, daemon=True)
         self._thread.start()
         if not self._ready.wait(10.0):
             raise RuntimeError("the proxy did not start")
@@ -42,42 +65,7 @@ class TcpProxy:
         self._loop.run_forever()
 
     async def _handle(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
-        if time.monotonic() < self._down_until or len(self._writers) >= MAX_CONNECTIONS:
-            writer.close()  # the network is down
-            return
-        self.accepted += 1
-        try:
-            up_reader, up_writer = await asyncio.open_connection("127.0.0.1", self.target)
-        except OSError:
-            writer.close()
-            return
-        self._writers |= {writer, up_writer}
-
-        async def pipe(src: asyncio.StreamReader, dst: asyncio.StreamWriter) -> None:
-            try:
-                while data := await src.read(65536):
-                    dst.write(data)
-                    await dst.drain()
-            except (ConnectionError, OSError):
-                pass
-            finally:
-                dst.close()
-
-        await asyncio.gather(pipe(reader, up_writer), pipe(up_reader, writer), return_exceptions=True)
-        self._writers -= {writer, up_writer}
-
-    def drop(self, seconds: float) -> None:
-        """Cut every connection now (reset, no closing handshake) and refuse new ones for ``seconds``."""
-
-        def cut() -> None:
-            self._down_until = time.monotonic() + seconds
-            for w in list(self._writers):
-                transport = w.transport
-                with contextlib.suppress(Exception):
-                    transport.abort()
-            self._writers.clear()
-
-        self._loop.call_soon_threadsafe(cut)
+        raise NotImplementedError
 
     def close(self) -> None:
         """Stop the proxy and its thread."""
@@ -94,5 +82,42 @@ class TcpProxy:
             await asyncio.gather(*tasks, return_exceptions=True)
             self._loop.stop()
 
-        asyncio.run_coroutine_threadsafe(stop(), self._loop)
+        with contextlib.suppress(RuntimeError):  # the loop has already stopped
+            asyncio.run_coroutine_threadsafe(stop(), self._loop)
         self._thread.join(timeout=5.0)
+
+
+class TcpProxy(LoopbackProxy):
+    """``127.0.0.1:<port>`` -> ``127.0.0.1:<target>``; :meth:`drop` is the network going down."""
+
+    def __init__(self, target: int) -> None:
+        self.accepted = 0
+        self._down_until = 0.0
+        super().__init__(target, "tcp-proxy")
+
+    async def _handle(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        if time.monotonic() < self._down_until or len(self._writers) >= MAX_CONNECTIONS:
+            writer.close()  # the network is down
+            return
+        self.accepted += 1
+        try:
+            up_reader, up_writer = await asyncio.open_connection("127.0.0.1", self.target)
+        except OSError:
+            writer.close()
+            return
+        self._writers |= {writer, up_writer}
+        await splice(reader, writer, up_reader, up_writer)
+        self._writers -= {writer, up_writer}
+
+    def drop(self, seconds: float) -> None:
+        """Cut every connection now (reset, no closing handshake) and refuse new ones for ``seconds``."""
+
+        def cut() -> None:
+            self._down_until = time.monotonic() + seconds
+            for w in list(self._writers):
+                transport = w.transport
+                with contextlib.suppress(Exception):
+                    transport.abort()
+            self._writers.clear()
+
+        self._loop.call_soon_threadsafe(cut)

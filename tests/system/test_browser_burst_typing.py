@@ -15,7 +15,8 @@ import math
 import pytest
 
 from tests.support.browser import text_input
-from tests.support.protocol import decode_batch, wait_for
+from tests.support.protocol import wait_for
+from tests.support.scene_frames import node_positions, open_recorded
 from tests.support.stage import open_tab
 from tpm_viz.viserkit.probe import widget_uuid
 
@@ -26,26 +27,12 @@ A = 0.482  # m, the paper's a (Table 1): rail i starts at -a e_i
 
 def _slider1_x(page, frames: list[bytes]) -> float | None:
     """The last x [m] of the broadcast node ``/tpm/slider1`` in the frames the page received."""
-    page.wait_for_timeout(20)  # Playwright delivers the page's events while one of its calls runs
-    x = None
-    for raw in list(frames):
-        for m in decode_batch(raw):
-            if m.get("name") == "/tpm/slider1" and m.get("owner") == "":
-                position = m.get("position") or (m.get("props") or {}).get("position")
-                if position is not None:
-                    x = float(position[0])
-    return x
+    positions = node_positions(page, frames)
+    return positions[-1][0] if positions else None
 
 
 def test_a_number_and_enter_in_one_burst_apply_the_whole_number(app, browser):
-    page = browser.new_page()
-    frames: list[bytes] = []
-    errors: list[str] = []
-    page.on("pageerror", lambda exc: errors.append(str(exc)))
-    page.on("websocket", lambda ws: ws.on("framereceived", lambda p: frames.append(p) if isinstance(p, bytes) else 0))
-    page.goto(f"http://127.0.0.1:{app.port}/")
-    page.wait_for_selector("[data-q=p1]", timeout=20_000)
-    view = wait_for(lambda: next(iter(app.views.values()), None), what="the tab's view")
+    page, frames, errors, view = open_recorded(app, browser)
 
     field = text_input(page, view.panel.d_typed.inputs["d1"])
     for text, mm in (("60", 60.0), ("130", 130.0), ("2.5e2", 250.0)):

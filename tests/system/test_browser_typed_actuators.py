@@ -2,10 +2,10 @@
 
 ``1.5e2`` typed key by key into *d1 (mm)* and Enter: the actuator is at 150 mm, in the server's state and in the 3D
 scene the page was sent. The scene is checked from an independent route: the websocket frames the page received
-(decoded here), where the frame ``/tpm/slider1`` sits at ``A_1 = (d1 - a) e1`` (eq. 1 of the paper: d1 is the
-slider's distance along rail 1 from its base end at ``-a e1``). The slider beside it has no number box of viser's,
-and a value beyond the stroke is refused right under the fields, in mm. All GUI inputs share a 50 ms throttle in
-viser's client: we pause.
+(decoded by tests/support/scene_frames.py), where the frame ``/tpm/slider1`` sits at ``A_1 = (d1 - a) e1`` (eq. 1
+of the paper: d1 is the slider's distance along rail 1 from its base end at ``-a e1``). The slider beside it has no
+number box of viser's, and a value beyond the stroke is refused right under the fields, in mm. All GUI inputs share
+a 50 ms throttle in viser's client: we pause.
 """
 
 from __future__ import annotations
@@ -16,7 +16,8 @@ import time
 import pytest
 
 from tests.support.browser import text_input
-from tests.support.protocol import decode_batch, wait_for
+from tests.support.protocol import wait_for
+from tests.support.scene_frames import node_positions, open_recorded
 from tpm_viz.ui.typed import QUIET
 from tpm_viz.viserkit.probe import widget_uuid
 
@@ -26,31 +27,10 @@ A = 0.482  # m, the paper's a (Table 1): rail i starts at -a e_i
 PAUSE = 0.08  # s, longer than the client's 50 ms input throttle
 
 
-def _slider1_positions(page, frames: list[bytes]) -> list[tuple[float, ...]]:
-    """Every position of the broadcast node ``/tpm/slider1`` in the frames the page received, in order. Playwright's
-    sync API delivers the page's events only while one of its calls runs: a short wait lets the frames in first."""
-    page.wait_for_timeout(20)
-    out = []
-    for raw in list(frames):
-        for m in decode_batch(raw):
-            if m.get("name") == "/tpm/slider1" and m.get("owner") == "":
-                position = m.get("position") or (m.get("props") or {}).get("position")
-                if position is not None:
-                    out.append(tuple(float(x) for x in position))
-    return out
-
-
 def test_typing_1_5e2_into_d1_puts_the_actuator_at_150_mm(app, browser):
-    page = browser.new_page()
-    frames: list[bytes] = []
-    errors: list[str] = []
-    page.on("pageerror", lambda exc: errors.append(str(exc)))
-    page.on("websocket", lambda ws: ws.on("framereceived", lambda p: frames.append(p) if isinstance(p, bytes) else 0))
-    page.goto(f"http://127.0.0.1:{app.port}/")
-    page.wait_for_selector("[data-q=p1]", timeout=20_000)
-    view = wait_for(lambda: next(iter(app.views.values()), None), what="the tab's view")
-    wait_for(lambda: _slider1_positions(page, frames), what="the slider's first position")
-    assert _slider1_positions(page, frames)[-1][0] == pytest.approx(0.130 - A, abs=1e-12)  # home: d1 = a - b - l_a
+    page, frames, errors, view = open_recorded(app, browser)
+    wait_for(lambda: node_positions(page, frames), what="the slider's first position")
+    assert node_positions(page, frames)[-1][0] == pytest.approx(0.130 - A, abs=1e-12)  # home: d1 = a - b - l_a
 
     # The slider is there to drag, without viser's number box beside it.
     slider = page.locator(f'[id="{widget_uuid(view.panel.d[0])}"]')
@@ -68,8 +48,8 @@ def test_typing_1_5e2_into_d1_puts_the_actuator_at_150_mm(app, browser):
         assert view.session.state.pose.d[0] == pytest.approx(0.13)  # time: then "1" was a pause (tests/ui checks it)
     field.press("Enter")
     wait_for(lambda: view.session.state.pose.d[0] == 0.15, what="d1 = 150 mm in the server's state")
-    wait_for(lambda: _slider1_positions(page, frames)[-1][0] == pytest.approx(0.150 - A, abs=1e-12), what="A_1 in 3D")
-    x, y = _slider1_positions(page, frames)[-1][:2]
+    wait_for(lambda: node_positions(page, frames)[-1][0] == pytest.approx(0.150 - A, abs=1e-12), what="A_1 in 3D")
+    x, y = node_positions(page, frames)[-1][:2]
     assert (x, y) == (pytest.approx(0.15 - A, abs=1e-12), pytest.approx(0.0, abs=1e-12))  # on rail 1, eq. (1)
     wait_for(lambda: page.locator("[data-q=d1]").first.inner_text().startswith("150.0"), what="the readout")
     assert field.input_value() == "1.5e2"  # the text typed stays: it means the value in use
