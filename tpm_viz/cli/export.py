@@ -36,19 +36,21 @@ def _file_mode(path: str) -> int:
         return 0o666 & ~umask
 
 
-def write_atomically(path: str, text: str) -> None:
-    """Write ``text`` (UTF-8) to ``path`` through a temporary file in the same directory and ``os.replace``."""
+def write_atomically(path: str, data: str | bytes) -> None:
+    """Write ``data`` (text as UTF-8) to ``path`` through a temporary file in the same directory, ``fsync`` and
+    ``os.replace``, with the permissions a plain ``open()`` would give it (a replaced file keeps its own). Every
+    file the CLI writes whole goes through here (models, C, clips, reports: :mod:`tpm_viz.cli.outputs`)."""
     directory = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(directory):
         raise InputError(f"cannot write --output {path!r}: directory {directory!r} does not exist")
     try:  # a failure names the user's path, never the temporary file
-        fd, tmp = tempfile.mkstemp(prefix=".tpm-viz-export-", suffix=".tmp", dir=directory)
+        fd, tmp = tempfile.mkstemp(prefix=".tpm-viz-", suffix=".tmp", dir=directory)
     except OSError as exc:
         raise OSError(exc.errno, exc.strerror, path) from None
     try:
         os.fchmod(fd, _file_mode(path))  # mkstemp makes 0600; give the file the mode a plain open() would
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data.encode("utf-8") if isinstance(data, str) else data)
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, path)

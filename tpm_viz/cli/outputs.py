@@ -9,15 +9,14 @@ atomically; bad input raises :class:`~tpm_viz.errors.TpmVizError` (``cli.main`` 
 from __future__ import annotations
 
 import argparse
-import contextlib
 import datetime
 import json
 import os
 import sys
-import tempfile
 
 from tpm_viz.app.runs import MAX_DURATION, RUN_SAMPLES, Run, Source, build_run
 from tpm_viz.cli.common import check_output, params_from_args
+from tpm_viz.cli.export import write_atomically
 from tpm_viz.csvio import read_text
 from tpm_viz.errors import InputError
 from tpm_viz.paper.trajectories import parse_trajectory_csv
@@ -48,26 +47,8 @@ def run_from_args(args: argparse.Namespace, reference=None) -> Run:
     return build_run(params, source, reference, samples=args.samples)
 
 
-def write_bytes(path: str, data: bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file in the same directory and ``os.replace``."""
-    directory = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(directory):
-        raise InputError(f"cannot write --output {path!r}: directory {directory!r} does not exist")
-    try:  # a failure names the user's path, never the temporary file
-        fd, tmp = tempfile.mkstemp(prefix=".tpm-viz-", suffix=".tmp", dir=directory)
-    except OSError as exc:
-        raise OSError(exc.errno, exc.strerror, path) from None
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException as exc:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        if isinstance(exc, OSError):
-            raise OSError(exc.errno, exc.strerror, path) from None
-        raise
+write_bytes = write_atomically
+"""Write a clip, sidecar or report atomically: :func:`tpm_viz.cli.export.write_atomically`, the CLI's one writer."""
 
 
 def _suffix(path: str, allowed: tuple[str, ...]) -> str:
