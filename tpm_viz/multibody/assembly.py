@@ -143,13 +143,20 @@ class ClosedLoopAssembly:
                     l_a=la * 1e3,
                 )
             )
+        return self._assembled(p, d)
+
+    def _assembled(self, p: np.ndarray, d: np.ndarray | None) -> ThreeArrays:
+        """``(q, J_c, J_P)`` by Newton from the arrangement's guess (``_guess_from_platform``: the working mode, or
+        ``d``'s branch), then from the last pose (continuation with its tangent predictor); the first closed
+        parallelogram on the working mode (``c_i = l_a cos θ_i > 0``, eq. 4 / eq. P3) unless ``d`` picks the branch.
+        ``p`` [m] is reachable (the caller checked)."""
         starts = [lambda: self._guess_from_platform(p, d)]
         if d is None and self._last is not None:  # fallback: continuation from the last pose, tangent predictor
             p_last, q_last, dq_dp = self._last
             starts.append(lambda: q_last if dq_dp is None else q_last + dq_dp @ (p - p_last))
         for start in starts:
             q, ok, jc, jp = self._newton(start(), p, "platform")
-            working = min(math.cos(x) for x in self._link_angles(q)) > 0  # c_i = l_a cos θ_i > 0 (eq. 4)
+            working = min(math.cos(x) for x in self._link_angles(q)) > 0  # c_i = l_a cos θ_i > 0
             if ok and self._is_parallelogram(q) and (d is not None or working):
                 q = self._wrap(q)
                 if d is None:
@@ -158,8 +165,8 @@ class ClosedLoopAssembly:
         raise SingularConfigurationError(
             Phrase(
                 "no closed-loop configuration found at ({x}, {y}) mm (too close to cos θ_i = 0, eq. 11)",
-                x=fixed(p1, ".1f", 1e3),
-                y=fixed(p2, ".1f", 1e3),
+                x=fixed(float(p[0]), ".1f", 1e3),
+                y=fixed(float(p[1]), ".1f", 1e3),
             )
         )
 

@@ -1,7 +1,7 @@
 """An independent closed-loop multibody model of the 2-PPa TPM in Pinocchio (the role ADAMS played).
 
-This is the only module of tpm-viz that imports :mod:`pinocchio`. The model is built from a
-:class:`~tpm_viz.Params` (no model file), zero gravity (the paper's ``U = 0``), SI units.
+Only :mod:`tpm_viz.multibody` imports :mod:`pinocchio`. The model is built from a :class:`~tpm_viz.Params` (no
+model file) with the pieces of :mod:`tpm_viz.multibody.tree`, zero gravity (the paper's ``U = 0``), SI units.
 
 Tree, in the depth-first order Pinocchio needs (``crba`` silently assumes every subtree is
 contiguous in ``v``), so ``q = (d_1, φ_10, φ_p, φ_11, d_2, φ_20, φ_21)`` (see
@@ -57,6 +57,7 @@ from tpm_viz.multibody import forward
 from tpm_viz.multibody.assembly import DOF, ClosedLoopAssembly, ThreeArrays
 from tpm_viz.multibody.locking import locked
 from tpm_viz.multibody.rank import RankedSvd, ranked_svd
+from tpm_viz.multibody.tree import Built, closed_tree, point_mass, rod, se3
 from tpm_viz.paper.kinematics import as_xy
 from tpm_viz.params import Params
 from tpm_viz.words import Phrase
@@ -69,63 +70,24 @@ PART_NAMES = ("slider1", "slider2", "link1_0", "link1_1", "link2_0", "link2_1", 
 _SINGULAR_RTOL = 1e-9
 
 
-def _se3(xyz: ArrayLike, angle: float = 0.0) -> pin.SE3:
-    c, s = np.cos(angle), np.sin(angle)
-    return pin.SE3(np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]), np.asarray(xyz, dtype=float))
-
-
-def _rod(mass: float, length: float) -> pin.Inertia:
-    """Uniform slender rod along local x from the origin: COM at ``l/2``, ``I = m l²/12`` (y, z)."""
-    i_t = mass * length**2 / 12.0
-    return pin.Inertia(mass, np.array([length / 2.0, 0.0, 0.0]), np.diag([0.0, i_t, i_t]))
-
-
-def _point_mass(mass: float, xyz: ArrayLike = (0.0, 0.0, 0.0)) -> pin.Inertia:
-    return pin.Inertia(mass, np.asarray(xyz, dtype=float), np.zeros((3, 3)))
-
-
-def _build(params: Params) -> tuple[pin.Model, list[pin.RigidConstraintModel], dict[str, int]]:
+def _build(params: Params) -> Built:
     """The Pinocchio model, its constraint models (LOCAL_WORLD_ALIGNED) and the part frame ids."""
     a, b, la, sp = params.a, params.b, params.l_a, params.pivot_spacing
-    model = pin.Model()
-    model.gravity = pin.Motion.Zero()  # horizontal mechanism, U = 0
     e = np.eye(3)
-    rod, leg2 = _rod(params.m_b / 2.0, la), np.pi / 2  # leg 2's link frames: x along e_2 at φ = 0
+    link, leg2 = rod(params.m_b / 2.0, la), np.pi / 2  # leg 2's link frames: x along e_2 at φ = 0
     # Depth-first order (Pinocchio's crba needs every subtree contiguous in v):
     # (name, parent, joint, placement in parent, body inertia).
     tree = [
-        ("slider1", "universe", pin.JointModelPX(), _se3(-a * e[0]), _point_mass(params.m_a)),
-        ("link1_0", "slider1", pin.JointModelRZ(), _se3([0, 0, 0]), rod),
-        ("platform", "link1_0", pin.JointModelRZ(), _se3([la, 0, 0]), _point_mass(params.m_p, [b, 0, 0])),
-        ("link1_1", "slider1", pin.JointModelRZ(), _se3(sp * e[1]), rod),
-        ("slider2", "universe", pin.JointModelPY(), _se3(-a * e[1]), _point_mass(params.m_a)),
-        ("link2_0", "slider2", pin.JointModelRZ(), _se3([0, 0, 0], leg2), rod),
-        ("link2_1", "slider2", pin.JointModelRZ(), _se3(sp * e[0], leg2), rod),
+        ("slider1", "universe", pin.JointModelPX(), se3(-a * e[0]), point_mass(params.m_a)),
+        ("link1_0", "slider1", pin.JointModelRZ(), se3([0, 0, 0]), link),
+        ("platform", "link1_0", pin.JointModelRZ(), se3([la, 0, 0]), point_mass(params.m_p, [b, 0, 0])),
+        ("link1_1", "slider1", pin.JointModelRZ(), se3(sp * e[1]), link),
+        ("slider2", "universe", pin.JointModelPY(), se3(-a * e[1]), point_mass(params.m_a)),
+        ("link2_0", "slider2", pin.JointModelRZ(), se3([0, 0, 0], leg2), link),
+        ("link2_1", "slider2", pin.JointModelRZ(), se3(sp * e[0], leg2), link),
     ]
-    joints = {"universe": 0}
-    for name, parent, joint, placement, inertia in tree:
-        joints[name] = model.addJoint(joints[parent], joint, placement, name)
-        model.appendBodyToJoint(joints[name], inertia, pin.SE3.Identity())
-    del joints["universe"]
-    frames = {}
-    for name, jid in joints.items():
-        origin = [b, 0, 0] if name == "platform" else [0, 0, 0]  # platform frame at P = B_1 + b e_1
-        frames[name] = model.addFrame(pin.Frame(name, jid, _se3(origin), pin.FrameType.OP_FRAME), False)
-    tip = _se3([la, 0, 0])
     on_platform = {"link1_1": [0, sp, 0], "link2_0": [b, -b, 0], "link2_1": [b + sp, -b, 0]}  # from B_1
-    closures = [
-        pin.RigidConstraintModel(
-            pin.ContactType.CONTACT_3D,
-            model,
-            joints[link],
-            tip,
-            joints["platform"],
-            _se3(xyz),
-            pin.ReferenceFrame.LOCAL_WORLD_ALIGNED,
-        )
-        for link, xyz in on_platform.items()
-    ]
-    return model, closures, frames
+    return closed_tree(params, tree, on_platform)
 
 
 class MultibodyModel(ClosedLoopAssembly):

@@ -28,7 +28,8 @@ from numpy.typing import ArrayLike
 
 from tpm_viz.errors import InputError, SingularConfigurationError, UnreachablePoseError
 from tpm_viz.multibody.locking import locked
-from tpm_viz.multibody.model import MultibodyModel, _point_mass, _rod, _se3
+from tpm_viz.multibody.model import MultibodyModel
+from tpm_viz.multibody.tree import Built, closed_tree, point_mass, rod, se3
 from tpm_viz.numbers import fixed
 from tpm_viz.paper import parallel as par
 from tpm_viz.params import Params
@@ -39,45 +40,21 @@ __all__ = ["ParallelMultibodyModel", "inverse_dynamics", "parallel_model_for"]
 _SINGULAR_RTOL = 1e-9
 
 
-def _build_parallel(params: Params) -> tuple[pin.Model, list[pin.RigidConstraintModel], dict[str, int]]:
+def _build_parallel(params: Params) -> Built:
     """The Pinocchio model of the parallel arrangement, its closures and the part frame ids."""
     a, b, la, sp = params.a, params.b, params.l_a, params.pivot_spacing
-    model = pin.Model()
-    model.gravity = pin.Motion.Zero()  # horizontal mechanism, U = 0
-    rod = _rod(params.m_b / 2.0, la)
+    link = rod(params.m_b / 2.0, la)
     tree = [
-        ("slider1", "universe", pin.JointModelPX(), _se3([-a, 0, 0]), _point_mass(params.m_a)),
-        ("link1_0", "slider1", pin.JointModelRZ(), _se3([0, 0, 0]), rod),
-        ("platform", "link1_0", pin.JointModelRZ(), _se3([la, 0, 0]), _point_mass(params.m_p, [b, 0, 0])),
-        ("link1_1", "slider1", pin.JointModelRZ(), _se3([0, sp, 0]), rod),
-        ("slider2", "universe", pin.JointModelPX(), _se3([a, 0, 0], math.pi), _point_mass(params.m_a)),
-        ("link2_0", "slider2", pin.JointModelRZ(), _se3([0, 0, 0]), rod),
-        ("link2_1", "slider2", pin.JointModelRZ(), _se3([0, -sp, 0]), rod),  # +s e_2 in the world
+        ("slider1", "universe", pin.JointModelPX(), se3([-a, 0, 0]), point_mass(params.m_a)),
+        ("link1_0", "slider1", pin.JointModelRZ(), se3([0, 0, 0]), link),
+        ("platform", "link1_0", pin.JointModelRZ(), se3([la, 0, 0]), point_mass(params.m_p, [b, 0, 0])),
+        ("link1_1", "slider1", pin.JointModelRZ(), se3([0, sp, 0]), link),
+        ("slider2", "universe", pin.JointModelPX(), se3([a, 0, 0], math.pi), point_mass(params.m_a)),
+        ("link2_0", "slider2", pin.JointModelRZ(), se3([0, 0, 0]), link),
+        ("link2_1", "slider2", pin.JointModelRZ(), se3([0, -sp, 0]), link),  # +s e_2 in the world
     ]
-    joints = {"universe": 0}
-    for name, parent, joint, placement, inertia in tree:
-        joints[name] = model.addJoint(joints[parent], joint, placement, name)
-        model.appendBodyToJoint(joints[name], inertia, pin.SE3.Identity())
-    del joints["universe"]
-    frames = {}
-    for name, jid in joints.items():
-        origin = [b, 0, 0] if name == "platform" else [0, 0, 0]  # platform frame at P = B_1 + b e_1
-        frames[name] = model.addFrame(pin.Frame(name, jid, _se3(origin), pin.FrameType.OP_FRAME), False)
-    tip = _se3([la, 0, 0])
     on_platform = {"link1_1": [0, sp, 0], "link2_0": [2 * b, 0, 0], "link2_1": [2 * b, sp, 0]}  # from B_1
-    closures = [
-        pin.RigidConstraintModel(
-            pin.ContactType.CONTACT_3D,
-            model,
-            joints[link],
-            tip,
-            joints["platform"],
-            _se3(xyz),
-            pin.ReferenceFrame.LOCAL_WORLD_ALIGNED,
-        )
-        for link, xyz in on_platform.items()
-    ]
-    return model, closures, frames
+    return closed_tree(params, tree, on_platform)
 
 
 class ParallelMultibodyModel(MultibodyModel):
@@ -113,25 +90,7 @@ class ParallelMultibodyModel(MultibodyModel):
                     l_a=la * 1e3,
                 )
             )
-        starts = [self._guess_from_platform(p, d)]
-        if d is None and self._last is not None:
-            p_last, q_last, dq_dp = self._last
-            starts.append(q_last if dq_dp is None else q_last + dq_dp @ (p - p_last))
-        for start in starts:
-            q, ok, jc, jp = self._newton(start, p, "platform")
-            working = min(math.cos(x) for x in self._link_angles(q)) > 0  # c_i = l_a cos θ_i > 0 (eq. P3)
-            if ok and self._is_parallelogram(q) and (d is not None or working):
-                q = self._wrap(q)
-                if d is None:
-                    self._last = (p.copy(), q, None)
-                return q, jc, jp
-        raise SingularConfigurationError(
-            Phrase(
-                "no closed-loop configuration found at ({x}, {y}) mm (too close to cos θ_i = 0, eq. 11)",
-                x=fixed(p1, ".1f", 1e3),
-                y=fixed(p2, ".1f", 1e3),
-            )
-        )
+        return self._assembled(p, d)
 
     def _tau(
         self, q: np.ndarray, v: np.ndarray, a: np.ndarray, n: np.ndarray, jp: np.ndarray, f_ext: np.ndarray

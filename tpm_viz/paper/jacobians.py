@@ -32,13 +32,16 @@ __all__ = [
     "SingularityThresholds",
     "actuator_acceleration",
     "actuator_forces_from_platform_force",
+    "actuator_forces_through",
     "actuator_velocity",
     "check_regular",
     "classify",
     "condition_number",
+    "condition_of",
     "eq14_row",
     "jacobians",
     "platform_force_from_actuator_forces",
+    "platform_force_through",
     "platform_velocity",
     "platform_velocity_through",
     "pose_status",
@@ -87,7 +90,12 @@ def jacobians(params: Params, p: ArrayLike, d: ArrayLike | None = None) -> Jacob
 
 def condition_number(params: Params, p: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
     """2-norm condition number of ``J`` (eq. 10); ``inf`` at a singularity (shape ``(...)``)."""
-    j = jacobians(params, p, d).j
+    return condition_of(jacobians(params, p, d).j)
+
+
+def condition_of(j: np.ndarray) -> np.ndarray:
+    """2-norm condition number ``σ_max / σ_min`` of Jacobians ``j`` (..., 2, 2) of either arrangement (eq. 10 /
+    eq. P4); ``inf`` where ``j`` is singular or not finite (shape ``(...)``, dimensionless)."""
     bad = ~np.all(np.isfinite(j), axis=(-2, -1))
     sv = np.linalg.svd(np.where(bad[..., None, None], 0.0, j), compute_uv=False)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -147,6 +155,25 @@ def platform_velocity_through(jac: Jacobians, dd: ArrayLike, equations: tuple[st
     with np.errstate(over="ignore", invalid="ignore"):
         rhs = np.einsum("...ij,...j->...i", jac.jq, as_xy(dd, "dd"))
         return finite_result(np.linalg.solve(jac.jx, rhs[..., None])[..., 0], T("the platform velocity"))
+
+
+def actuator_forces_through(jac: Jacobians, f: ArrayLike, equations: tuple[str, str] = SINGULARITIES) -> np.ndarray:
+    """``τ = J⁻ᵀ f`` [N] for a platform force ``f`` [N] with the Jacobians of a pose (eq. 13; eq. P8 in the parallel
+    arrangement), computed as ``J_q J_x⁻ᵀ f`` (``J_q`` diagonal): finite at an inverse singularity, refused at a
+    direct one (``equations`` name the arrangement's singularities)."""
+    check_regular(jac, "direct", equations)
+    jxt = np.swapaxes(jac.jx, -1, -2)
+    with np.errstate(over="ignore", invalid="ignore"):
+        g = np.linalg.solve(jxt, as_xy(f, "f")[..., None])[..., 0]
+        return finite_result(np.einsum("...ij,...j->...i", jac.jq, g), T("the actuator forces"))
+
+
+def platform_force_through(jac: Jacobians, tau: ArrayLike, equations: tuple[str, str] = SINGULARITIES) -> np.ndarray:
+    """``f = Jᵀ τ`` [N] for actuator forces ``τ`` [N] with the Jacobians of a pose (eq. 13; eq. P8 in the parallel
+    arrangement), refused at an inverse singularity."""
+    check_regular(jac, "inverse", equations)
+    with np.errstate(over="ignore", invalid="ignore"):
+        return finite_result(np.einsum("...ji,...j->...i", jac.j, as_xy(tau, "tau")), T("the platform force"))
 
 
 def actuator_velocity(params: Params, p: ArrayLike, dp: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
@@ -231,19 +258,11 @@ def actuator_forces_from_platform_force(
     singularity (eq. 11: the leg carries the load with no actuator force along it); raises only
     at the direct singularity (eq. 12).
     """
-    jac = jacobians(params, p, d)
-    check_regular(jac, "direct")
-    jxt = np.swapaxes(jac.jx, -1, -2)
-    with np.errstate(over="ignore", invalid="ignore"):
-        g = np.linalg.solve(jxt, as_xy(f, "f")[..., None])[..., 0]
-        return finite_result(np.einsum("...ij,...j->...i", jac.jq, g), T("the actuator forces"))
+    return actuator_forces_through(jacobians(params, p, d), f)
 
 
 def platform_force_from_actuator_forces(
     params: Params, p: ArrayLike, tau: ArrayLike, d: ArrayLike | None = None
 ) -> np.ndarray:
     """Platform force ``f = J^T τ`` [N] for actuator forces ``τ`` [N], eq. (13)."""
-    jac = jacobians(params, p, d)
-    check_regular(jac, "inverse")
-    with np.errstate(over="ignore", invalid="ignore"):
-        return finite_result(np.einsum("...ji,...j->...i", jac.j, as_xy(tau, "tau")), T("the platform force"))
+    return platform_force_through(jacobians(params, p, d), tau)

@@ -22,7 +22,9 @@ from tpm_viz.errors import InputError, InvalidParametersError, SingularConfigura
 from tpm_viz.numbers import fixed
 from tpm_viz.paper.jacobians import (
     Jacobians,
-    check_regular,
+    actuator_forces_through,
+    condition_of,
+    platform_force_through,
     platform_velocity_through,
     pose_status,
     velocity_through,
@@ -262,12 +264,7 @@ def jacobians(params: Params, p: ArrayLike, d: ArrayLike | None = None) -> Jacob
 def condition_number(params: Params, p: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
     """2-norm condition number of ``J`` (eq. P4); ``inf`` at a singularity. In the working mode it equals
     ``max(|p_2|/u, u/|p_2|)`` (eq. P6)."""
-    j = jacobians(params, p, d).j
-    bad = ~np.all(np.isfinite(j), axis=(-2, -1))
-    sv = np.linalg.svd(np.where(bad[..., None, None], 0.0, j), compute_uv=False)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        cond = sv[..., 0] / sv[..., -1]
-    return np.where(bad | ~np.isfinite(cond), np.inf, cond)
+    return condition_of(jacobians(params, p, d).j)
 
 
 def classify(params: Params, p: ArrayLike, thresholds: SingularityThresholds = WARN) -> np.ndarray:
@@ -318,22 +315,14 @@ def actuator_forces_from_platform_force(
     """``τ = J⁻ᵀ f`` [N] for a platform force ``f`` [N] (eq. P8, the analogue of eq. 13); holding an external load
     ``f_ext`` at rest takes ``f = -f_ext``. Computed as ``J_q J_x⁻ᵀ f``: finite at the inverse singularity, raises
     at the direct one."""
-    jac = jacobians(params, p, d)
-    check_regular(jac, "direct", SINGULARITIES)
-    jxt = np.swapaxes(jac.jx, -1, -2)
-    with np.errstate(over="ignore", invalid="ignore"):
-        g = np.linalg.solve(jxt, as_xy(f, "f")[..., None])[..., 0]
-        return finite_result(np.einsum("...ij,...j->...i", jac.jq, g), T("the actuator forces"))
+    return actuator_forces_through(jacobians(params, p, d), f, SINGULARITIES)
 
 
 def platform_force_from_actuator_forces(
     params: Params, p: ArrayLike, tau: ArrayLike, d: ArrayLike | None = None
 ) -> np.ndarray:
     """``f = Jᵀ τ`` [N] for actuator forces ``τ`` [N] (eq. P8)."""
-    jac = jacobians(params, p, d)
-    check_regular(jac, "inverse", SINGULARITIES)
-    with np.errstate(over="ignore", invalid="ignore"):
-        return finite_result(np.einsum("...ji,...j->...i", jac.j, as_xy(tau, "tau")), T("the platform force"))
+    return platform_force_through(jacobians(params, p, d), tau, SINGULARITIES)
 
 
 def home(params: Params) -> np.ndarray:
