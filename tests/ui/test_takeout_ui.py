@@ -138,9 +138,9 @@ def test_player_records_a_gif_through_the_tabs_camera_and_stays_usable(connect):
     wait_for(lambda: abs(view.session.state.trajectory.t - 0.1) < 1e-6, what="the seek during the recording")
     assert take.recording is not None and take.recording.done < take.recording.total
     assert "Recording the clip" in take.line.content
-    wait_for(lambda: sent, timeout=300, what="the clip")
+    wait_for(lambda: sent and "Clip ready" in take.line.content, timeout=300, what="the clip and its line")
     name, data = sent[0]
-    assert name == "tpm-line-T0.2s-640x360-10fps.gif" and "Clip ready" in take.line.content
+    assert name == "tpm-line-T0.2s-640x360-10fps.gif"
     im = Image.open(io.BytesIO(data))
     assert (im.n_frames, im.size) == (len(run.t), (640, 360)) == (401, (640, 360))
     frames = []
