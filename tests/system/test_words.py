@@ -49,6 +49,10 @@ WORD = re.compile(r"[A-Za-z]{2,}")
 TEXT_NODE = re.compile(r">([^<>]+)<")
 STYLE = re.compile(r"<style>.*?</style>", re.S)
 HANGUL = re.compile("[\uac00-\ud7a3]")
+LIVE = re.compile(r"<math\b|\bdata-q=")
+"""HTML with numbers (``data-q`` values, MathML): viser sends an element's creation with the content written last
+(the first frame's readouts), rendered by its producer from the phrases of the source route; of its texts only the
+whole phrases of the catalogue count as used on the wire (static tables of numbers are translated text by text)."""
 
 
 def _literal(node: ast.AST | None, constants: dict[str, str]) -> str | None:
@@ -130,6 +134,11 @@ def wire_texts(port: int, seconds: float = 4.0) -> set[str]:
         ws.close()
     for message, after in zip(messages, [*messages[1:], {}], strict=True):
         if message["type"].startswith("Gui") and message["type"] != "GuiUpdateMessage":
+            props = message.get("props")
+            if isinstance(props, dict) and LIVE.search(str(props.get("content", ""))):
+                texts = _texts_of(message)
+                message = {**message, "props": {k: v for k, v in props.items() if k != "content"}}
+                seen.update(set(texts) & set(catalogue(Lang.KO)))
             seen.update(_texts_of(message))
             if after.get("type") == "GuiUpdateMessage" and after.get("uuid") == message.get("uuid"):
                 seen.update(_texts_of({"props": after.get("updates")}))  # add_markdown's own content

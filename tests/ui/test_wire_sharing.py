@@ -54,7 +54,7 @@ def test_the_second_tab_reuses_the_first_serialisation():
 
 
 def test_a_changed_copy_is_serialised_again():
-    """ui/language.py rewrites copies of GUI messages per tab: a copy never reuses its original's wire dict."""
+    """A changed copy of a message (``dataclasses.replace``, ``copy.copy``) never reuses its original's wire dict."""
     original = _messages.GuiUpdateMessage("uuid-1", {"label": "Move"})
     assert shared_serialize(original, [])["updates"] == {"label": "Move"}
     replaced = dataclasses.replace(original, updates={"label": "이동"})

@@ -61,6 +61,8 @@ class View(Protocol):
     session: Session
     client: Any
     """The tab's ``viser.ClientHandle`` (its own scene, GUI, downloads)."""
+    gui: Any
+    """The tab's GUI (a ``tpm_viz.ui.worded.TabGui``): every element made through it is shown in the tab's language."""
 
     def render(self, frame: Snapshot, *, dragging: bool) -> None:
         """Draw ``frame``; ``dragging`` is True while this tab's own gizmo is being dragged."""

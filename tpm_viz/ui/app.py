@@ -163,7 +163,7 @@ class TpmApp:
         who = self.room.identify(client)  # before the view moves the camera
         view = self.room.build(who, lambda saved: ClientView(client, self.hub, self.services, saved=saved))
         if self.access.enabled:
-            view.login = LoginPanel(client.gui, lambda event, view=view: self._login(event, view))
+            view.login = LoginPanel(view.gui, lambda event, view=view: self._login(event, view))
         with self._views_lock:
             self.views[client.client_id] = view
         self.keyboard.join(view)

@@ -30,7 +30,7 @@ from tpm_viz.classroom.session import Hub, Session
 from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.params import Params
 from tpm_viz.ui.fields import Place, Typing, control
-from tpm_viz.ui.language import TabWords
+from tpm_viz.ui.language import TabWords, first_language
 from tpm_viz.ui.login import LoginPanel
 from tpm_viz.ui.look import Look
 from tpm_viz.ui.panels import Panel
@@ -38,8 +38,9 @@ from tpm_viz.ui.scene import MechanismScene
 from tpm_viz.ui.share import ShareBox
 from tpm_viz.ui.tabscene import TabScene
 from tpm_viz.ui.teaching.tabs import Services, Teaching
+from tpm_viz.ui.worded import TabGui
 from tpm_viz.viserkit.core import widget_value
-from tpm_viz.words import Lang, Phrase, say
+from tpm_viz.words import Phrase, say
 
 __all__ = ["ClientView"]
 
@@ -73,8 +74,10 @@ class ClientView:
         """The session this tab shows, set when it joins (:meth:`Hub.join`); until then (the tab being built under
         the hub's lock) the shared one, so a callback that arrives meanwhile finds it, then waits for the lock."""
         self.closed = False
-        self.lang = Lang.EN
+        self.lang = first_language(client)
         """The language of this tab's words (:mod:`tpm_viz.words`): render a phrase with ``say(view.lang, ...)``."""
+        self.gui = TabGui(client.gui, self.lang)
+        """This tab's GUI: every element made through it shows its fixed texts in ``lang`` (:mod:`.worded`)."""
         self.login: LoginPanel | None = None
         """The presenter login of this tab (presenter mode only)."""
         self._notified: tuple[str, float] = ("", 0.0)
@@ -86,12 +89,13 @@ class ClientView:
         """The gizmo drags of this tab (:mod:`.dragging`)."""
         with hub.lock, client.atomic():  # built and drawn, then sent as one: no wake-up of the loop per widget
             state = hub.shared.state if saved is None else saved.state
-            self.words = TabWords(self)  # the Language selector, first in the panel; sets self.lang (ui/language.py)
+            self.words = TabWords(self)  # the Language selector, first in the panel; switches lang (ui/language.py)
             self.scene = TabScene(client, cast(MechanismScene, hub.shared.scene))
             self.teaching = Teaching(self, services)  # player, explorer, lessons (ui/teaching/)
-            self.panel = Panel(client.gui, state, extra_tabs=self.teaching.build_tabs)
+            later = None if services.later is None else self.teaching.open  # Player, Equations, Lab: a moment later
+            self.panel = Panel(self.gui, state, extra_tabs=self.teaching.build_tabs, later=later)
             with self.panel.tabs["setup"].add_tab("Share", icon=viser.Icon.SHARE):
-                self.share = ShareBox(self, client.gui)  # *Copy share link* beside Class & view (ui/share.py)
+                self.share = ShareBox(self, self.gui)  # *Copy share link* beside Class & view (ui/share.py)
             self.look = Look(self)  # phone layout, presentation mode, camera framed for the canvas (ui/look.py)
             self._wire()
             self.frame_camera(state.params)
@@ -256,7 +260,7 @@ class ClientView:
 
     def run_changed(self) -> None:
         """The session's run changed: redraw this tab's player."""
-        self.teaching.player.refresh()
+        self.teaching.run_changed()
 
     def _apply_p(self, values) -> None:
         """The typed platform position (mm), settled (under the lock)."""

@@ -292,7 +292,7 @@ class Typing:
         self.view = view
         self.boxes: list[tuple[TypedBox, Apply]] = []
         self.waker = Waker(self._tick)
-        self.style = view.client.gui.add_html(ONE_LINE_CSS)
+        self.style = view.gui.add_html(ONE_LINE_CSS)
         """The tab's :data:`ONE_LINE_CSS` (in the panel's root: a tab's contents are drawn only while it is open)."""
 
     def add(self, box: TypedBox, apply: Apply) -> None:

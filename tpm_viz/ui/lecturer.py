@@ -17,6 +17,7 @@ import viser
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES
 from tpm_viz.classroom.guard import guarded
 from tpm_viz.ui.classroom import is_loopback_address, qr_data_uri
+from tpm_viz.ui.worded import TabGui
 from tpm_viz.words import T
 
 __all__ = ["Lecture", "LecturerPanel", "join_html"]
@@ -58,7 +59,7 @@ def join_html(urls: list[str]) -> str:
 class LecturerPanel:
     """The *Lecturer* folder of one tab."""
 
-    def __init__(self, gui: viser.GuiApi, lecture: Lecture, view: Any, urls: list[str] | None, presenter: bool):
+    def __init__(self, gui: TabGui, lecture: Lecture, view: Any, urls: list[str] | None, presenter: bool):
         self._lecture, self._view = lecture, view
         self.folder = gui.add_folder("Lecturer", expand_by_default=urls is not None)
         with self.folder:

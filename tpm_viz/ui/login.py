@@ -17,9 +17,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-import viser
-
 from tpm_viz.ui.fields import one_line
+from tpm_viz.ui.worded import TabGui
 from tpm_viz.viserkit.core import widget_uuid
 from tpm_viz.words import Lang, T, say
 
@@ -35,7 +34,7 @@ def mask_css(uuid: str) -> str:
 class LoginPanel:
     """The *Presenter login* folder of one tab: a masked token field, a button and a status line."""
 
-    def __init__(self, gui: viser.GuiApi, on_login: Callable[[Any], None]) -> None:
+    def __init__(self, gui: TabGui, on_login: Callable[[Any], None]) -> None:
         with gui.add_folder("Presenter login", expand_by_default=False):
             self.status = gui.add_markdown(
                 say(Lang.EN, T("Students: you watch the presenter here, or work on your own copy."))

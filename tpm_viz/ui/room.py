@@ -135,7 +135,10 @@ class Room:
             if self.app.access.enabled and (here or back):
                 self.app.access.grant(view)  # this computer, or the presenter's device back after a drop
                 if view.login is not None:
-                    view.login.show("**You are the presenter**" + (" (this computer)." if here else ": welcome back."))
+                    here_or_back = T("**You are the presenter** (this computer).")
+                    if not here:
+                        here_or_back = T("**You are the presenter**: welcome back.")
+                    view.login.show(say(Lang.EN, here_or_back))  # shown in the tab's language by its handle
             if self.lecturer(view):
                 self._add_lecturer(view)
             self._set_lesson_step(view)
@@ -205,14 +208,14 @@ class Room:
             if panel is not None:
                 panel.remove()
             if view.login is not None:
-                view.login.show(say(Lang.EN, STUDENT))  # shown in the tab's language on the way out
+                view.login.show(say(Lang.EN, STUDENT))  # shown in the tab's language by its handle
             view.tell(LOGGED_OUT)
             view.client.flush()
             log.info("client %s logged out as presenter", view.client.client_id)
         self.app.hub.membership_changed()
 
     def _add_lecturer(self, view: Any) -> None:
-        panel = LecturerPanel(view.client.gui, self, view, self.urls, presenter=self.app.access.enabled)
+        panel = LecturerPanel(view.gui, self, view, self.urls, presenter=self.app.access.enabled)
         panel.show_notice(self.notice)
         self._lecturers[view] = panel
 

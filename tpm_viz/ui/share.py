@@ -32,6 +32,7 @@ from tpm_viz.errors import TpmVizError
 from tpm_viz.ui.classroom import PENDING, is_loopback_address, qr_data_uri, shared_token
 from tpm_viz.ui.continuity import restore, saved_of
 from tpm_viz.ui.fields import Note
+from tpm_viz.ui.worded import TabGui
 from tpm_viz.words import Phrase, T
 
 __all__ = ["ShareBox", "ShareDesk", "describe", "origin_of"]
@@ -149,7 +150,7 @@ class ShareBox:
     """*Copy share link* in one tab (``view``: its :class:`~.client.ClientView`, whose ``shares`` is the app's
     :class:`ShareDesk` once it is connected)."""
 
-    def __init__(self, view: Any, gui: viser.GuiApi) -> None:
+    def __init__(self, view: Any, gui: TabGui) -> None:
         self.view = view
         self.button = gui.add_button(
             "Copy share link",

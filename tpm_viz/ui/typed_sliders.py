@@ -69,7 +69,7 @@ class TypedSlider:
         on_change: Callable[[], None] | None = None,
         hint: str | None = None,
     ) -> None:
-        gui = view.client.gui
+        gui = view.gui
         self.view = view
         self.on_change = on_change
         form = gui.add_form(None)

@@ -14,7 +14,8 @@ tpm-viz needs these things viser's public API does not offer:
   message dispatch (``_handle_incoming_message``, wrapped to drop malformed messages), its message buffers (the
   shared one and each tab's: :mod:`.patches` puts the senders' patches on them), its outgoing backlog
   (``_client_state_from_id``), the raw connections (``_live_connections``, to refuse or drop a tab);
-- a tab's GUI texts and the values it sends (:func:`reword`).
+- a tab's handshake headers (:func:`client_request`), a tab's label (:func:`relabel_tab`: viser's ``GuiTabHandle`` has
+  no setter) and whether a handle was removed with its container (:func:`removed`), for :mod:`tpm_viz.ui.worded`.
 
 :func:`check_viser` runs when the server is built: the installed viser must be the tested minor version
 (:data:`TESTED`, pinned in ``pyproject.toml``) and every internal above must exist, else the app stops at start with
@@ -24,8 +25,6 @@ one line saying what to install, instead of serving blank pages. ``tests/viserki
 from __future__ import annotations
 
 import asyncio
-import copy
-import dataclasses
 import uuid
 from collections.abc import Callable
 from typing import Any, cast
@@ -43,8 +42,8 @@ from tpm_viz.viserkit.wire import Malformed
 ws_server = _infra.websockets.asyncio.server  # websockets' server, as viser imported it (not a tpm-viz dependency)
 
 __all__ = ["TESTED", "ClientDoor", "IncompatibleViserError", "Malformed", "ServerDoor", "check_viser"]
-__all__ += ["connection_request", "disable_share_url", "drop_gizmo_echo", "enable_share_url", "reword"]
-__all__ += ["thread_pool", "widget_uuid", "widget_value", "ws_server"]
+__all__ += ["client_request", "connection_request", "disable_share_url", "drop_gizmo_echo", "enable_share_url"]
+__all__ += ["relabel_tab", "removed", "thread_pool", "widget_uuid", "widget_value", "ws_server"]
 
 TESTED = "1.1"
 """The viser minor version tpm-viz is tested with (``pyproject.toml`` pins ``viser>=1.1.1,<1.2``)."""
@@ -281,36 +280,18 @@ def connection_request(server: viser.ViserServer, client_id: int) -> tuple[Any, 
     return (remote if client is None else (client, *remote[1:])), connection.request.headers
 
 
-# -- words on the wire (ui/language.py) ------------------------------------------------------------------------------
-_TEXTS = ("label", "hint", "content", "_markdown", "options", "_tab_labels", "title", "series", "axes")
+# -- a tab's own words (ui/worded.py) --------------------------------------------------------------------------------
+def client_request(client: viser.ClientHandle) -> tuple[Any, Any] | None:
+    """:func:`connection_request` of a tab's own connection (its ``Accept-Language``: the tab's first language)."""
+    return connection_request(client._viser_server, client.client_id)
 
 
-def reword(client: viser.ClientHandle, out: Callable[[str, Any, str], Any], back: Callable[[str, Any], Any]) -> Any:
-    """GUI texts go out as ``out(uuid, texts, kind)`` returns them (kind new, update, gone; texts: props in
-    :data:`_TEXTS`, an option's ``value``), values in by ``back(uuid, value)``. -> ``(send(uuid, texts), headers)``"""
-    conn, request = client._websock_connection, connection_request(client._viser_server, client.client_id)
-    queue, dispatch = conn.queue_message, conn._handle_incoming_message
+def relabel_tab(tab: Any, label: str) -> None:
+    """Show ``label`` as the name of a tab of a tab group or panel (viser's ``GuiTabHandle`` has no label setter)."""
+    tab._label = label
+    tab._parent._rebuild_tab_props()
 
-    def queue_message(message: Any) -> None:
-        uuid_, props = getattr(message, "uuid", ""), getattr(message, "props", None)
-        if isinstance(message, _messages.GuiUpdateMessage) and isinstance(message.updates, dict):
-            message = copy.copy(message)
-            message.updates = out(uuid_, message.updates, "update")
-        elif isinstance(message, _messages.GuiRemoveMessage):
-            out(uuid_, None, "gone")
-        elif isinstance(message, _messages._CreateGuiComponentMessage) and dataclasses.is_dataclass(props):
-            choice = {"value": getattr(message, "value", "")} if hasattr(props, "options") else {}
-            texts = out(uuid_, {k: getattr(props, k) for k in _TEXTS if hasattr(props, k)} | choice, "new")
-            message = copy.copy(message)
-            message.__dict__.update({"value": texts.pop("value")} if choice else {})
-            message.props = dataclasses.replace(cast(Any, props), **texts)
-        queue(message)
 
-    async def handle(client_id: Any, message: Any) -> None:
-        u = getattr(message, "updates", None)  # a malformed one (an id that is a list) goes on: transport drops it
-        if isinstance(message, _messages.GuiUpdateMessage) and isinstance(message.uuid, str) and isinstance(u, dict):
-            message.updates = {**u, "value": back(message.uuid, u["value"])} if "value" in u else u
-        await dispatch(client_id, message)
-
-    conn.queue_message, conn._handle_incoming_message = queue_message, handle  # type: ignore[method-assign]
-    return lambda uuid_, texts: queue_message(_messages.GuiUpdateMessage(uuid_, texts)), request and request[1]
+def removed(handle: Any) -> bool:
+    """Whether a GUI handle (a tab's too) was removed, by itself or with its container."""
+    return bool(getattr(getattr(handle, "_impl", handle), "removed", False))

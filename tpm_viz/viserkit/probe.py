@@ -6,7 +6,8 @@ private viser or websockets name is written outside :mod:`tpm_viz.viserkit`.
   (:func:`lean_buffer`), viser's own window loop and serialisation (:data:`VISER_WINDOW_LOOP`,
   :data:`VISER_SERIALIZE`) and the shared one (:func:`shared_serialize`), its buffer alignment (:func:`align`);
 - a widget's uuid, a value arriving without its callbacks (:func:`arrive`), a tab's uploads in progress, the
-  connections a server still holds, viser's tunnel class.
+  connections a server still holds, viser's tunnel class, whether a tab's sending is viser's own
+  (:func:`outgoing_replaced`).
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from tpm_viz.viserkit.core import ServerDoor, thread_pool, widget_uuid, widget_v
 __all__ = ["VISER_SERIALIZE", "VISER_WINDOW_LOOP", "align", "arrive", "connection_states", "lean_buffer"]
 __all__ += ["message_buffer", "messages", "shared_serialize", "tunnel_class", "upload_states", "widget_uuid"]
 __all__ += ["event_loop", "gizmo_echoes", "share_tunnel", "shared_buffer", "thread_pool", "wake_safely"]
-__all__ += ["widget_value"]
+__all__ += ["outgoing_replaced", "widget_value"]
 
 messages = _messages
 """viser's message classes (``viser._messages``)."""
@@ -61,6 +62,11 @@ def wake_safely(buffer: Any) -> None:
 def arrive(handle: Any, value: Any) -> None:
     """Store ``value`` in a GUI handle as viser does when it arrives from the page, before its callbacks run."""
     handle._impl.value = value
+
+
+def outgoing_replaced(client: viser.ClientHandle) -> bool:
+    """Whether a tab's connection sends through a ``queue_message`` of its own instead of viser's."""
+    return "queue_message" in vars(client._websock_connection)
 
 
 def upload_states(client: viser.ClientHandle) -> dict[str, Any]:

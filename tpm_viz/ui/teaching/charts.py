@@ -31,11 +31,11 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import viser
 
 from tpm_viz.app.palette import hex_colour
 from tpm_viz.app.runs import Run
 from tpm_viz.ui.chart_axes import Ticks, text_width, time_ticks, value_ticks
+from tpm_viz.ui.worded import TabGui
 from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["CHART_POINTS", "LARGE", "NORMAL", "AxisLook", "Charts", "axes_for", "chart_height", "marker"]
@@ -199,7 +199,7 @@ _PLACEHOLDER = (np.array([0.0, 1.0]), np.zeros(2))  # the axes of a chart before
 class Charts:
     """Four uPlot charts in the current GUI container (a tab): forces, ``d``, ``ḋ``, ``d̈``; words in ``lang``."""
 
-    def __init__(self, gui: viser.GuiApi, lang: Lang = Lang.EN) -> None:
+    def __init__(self, gui: TabGui, lang: Lang = Lang.EN) -> None:
         n = 2
         x = np.linspace(0.0, 1.0, n)
         zero = np.zeros(n)

@@ -52,6 +52,7 @@ from tpm_viz.ui.teaching.playing import RunHub
 from tpm_viz.ui.teaching.settings import CONTROL_SETTINGS
 from tpm_viz.ui.teaching.stage import CONTROL, ControlNodes, bring, front
 from tpm_viz.ui.typed_sliders import TypedSlider, add_sliders
+from tpm_viz.ui.worded import TabGui
 from tpm_viz.words import Phrase, T, say
 
 __all__ = ["CONTROLLERS", "MAGNIFY", "ControlView"]
@@ -94,7 +95,7 @@ class ControlView:
         self._last_push = 0.0
         self._request = 0
 
-    def build(self, gui: viser.GuiApi) -> None:
+    def build(self, gui: TabGui) -> None:
         """The *Control* tab's widgets (inside the tab's context)."""
         gui.add_markdown(
             "Track a reference with a controller on the multibody plant (Pinocchio). The green ghost is the "

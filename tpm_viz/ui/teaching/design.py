@@ -37,6 +37,7 @@ from tpm_viz.ui.teaching.design_map import CHUNK, INDICES, MAX_COUNT, SWEPT, Axi
 from tpm_viz.ui.teaching.design_map import values as map_values
 from tpm_viz.ui.teaching.design_scene import PENDING, DesignScene, comparison_designs
 from tpm_viz.ui.typed import Quantity, TypedField, TypedGroup
+from tpm_viz.ui.worded import TabGui
 from tpm_viz.words import Phrase, T, say
 
 __all__ = ["DesignView"]
@@ -76,7 +77,7 @@ class DesignView:
         self._hold = Hold.LINK
 
     # -- widgets -------------------------------------------------------------------------------------------
-    def build(self, gui: viser.GuiApi) -> None:
+    def build(self, gui: TabGui) -> None:
         """The *Design* tab's widgets (inside the tab's context)."""
         gui.add_markdown(
             "Size the machine for a task: a map of designs over two dimensions, coloured by an index; click a cell "

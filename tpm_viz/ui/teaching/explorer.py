@@ -31,6 +31,7 @@ from tpm_viz.classroom.text import num
 from tpm_viz.classroom.worker import Worker
 from tpm_viz.errors import BusyError
 from tpm_viz.params import Params
+from tpm_viz.ui.worded import TabGui
 from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["ELLIPSE_COLOURS", "ELLIPSE_SCALE", "ExplorerView", "MapService"]
@@ -166,7 +167,7 @@ class ExplorerView:
         self._frame: Snapshot | None = None
         maps.subscribers.add(self)
 
-    def build(self, gui: viser.GuiApi) -> None:
+    def build(self, gui: TabGui) -> None:
         """The *Explorer* tab's widgets (inside the tab's context)."""
         gui.add_markdown(
             "Colour the floor with a map of the workspace and draw the manipulability ellipses at the platform. "

@@ -31,6 +31,7 @@ from tpm_viz.errors import TpmVizError
 from tpm_viz.ui.scene import camera_pose
 from tpm_viz.ui.teaching.explorer import ExplorerView
 from tpm_viz.ui.teaching.playing import RunHub
+from tpm_viz.ui.worded import TabGui
 from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["DemosView"]
@@ -99,7 +100,7 @@ class DemosView:
         self._facts: object = PRESS_SHOW
         """What the line under the paragraph says: the numbers of the lesson applied last (a text or a phrase)."""
 
-    def build(self, gui: viser.GuiApi) -> None:
+    def build(self, gui: TabGui) -> None:
         """The *Demos* tab's widgets (inside the tab's context)."""
         gui.add_markdown(
             "A guided tour for a lecture. Each scene sets the mechanism (shared with the class unless you work on "

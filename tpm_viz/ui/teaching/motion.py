@@ -18,7 +18,6 @@ from collections.abc import Callable
 from typing import Any, Protocol
 
 import numpy as np
-import viser
 
 from tpm_viz.app.moves import place
 from tpm_viz.app.readouts import Load
@@ -27,6 +26,7 @@ from tpm_viz.classroom.guard import report
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.params import Params
 from tpm_viz.ui.teaching.charts import LARGE, NORMAL, TICK_PX, AxisLook, marker
+from tpm_viz.ui.worded import TabGui
 from tpm_viz.words import Phrase, T
 
 __all__ = ["FPS", "Motion", "MotionPlayer", "TimeChart"]
@@ -209,7 +209,7 @@ class TimeChart:
     ``lines``: ``(label, colour, dash or None)`` per series. Values never contain NaN or infinity (checked).
     """
 
-    def __init__(self, gui: viser.GuiApi, title: str, y_label: str, lines, height: int = 200) -> None:
+    def __init__(self, gui: TabGui, title: str, y_label: str, lines, height: int = 200) -> None:
         self.lines = tuple(lines)
         self.y_label, self.height, self.look = y_label, height, NORMAL
         n = 2

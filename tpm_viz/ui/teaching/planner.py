@@ -32,6 +32,7 @@ from tpm_viz.ui.teaching.settings import PLANNER_SETTINGS
 from tpm_viz.ui.teaching.stage import PLAN, bring, front, show
 from tpm_viz.ui.teaching.trace import TRACE_Z, segments
 from tpm_viz.ui.typed_sliders import TypedSlider, add_sliders
+from tpm_viz.ui.worded import TabGui
 from tpm_viz.words import Phrase, T
 
 __all__ = ["BAR_HEIGHT", "PlanMotion", "PlannerView", "bar_segments", "floor_point"]
@@ -117,7 +118,7 @@ class PlannerView:
         self._last_push = 0.0
         self.charts: tuple[TimeChart, ...] = ()  # built with the tab
 
-    def build(self, gui: viser.GuiApi) -> None:
+    def build(self, gui: TabGui) -> None:
         """The *Planner* tab's widgets (inside the tab's context)."""
         gui.add_markdown(
             "The fastest cycle the motors allow: the platform runs the path there and back (the circle: one turn), "

@@ -34,6 +34,7 @@ from tpm_viz.ui.teaching.playing import RunHub, following
 from tpm_viz.ui.teaching.stage import PLAYER, bring, front, show
 from tpm_viz.ui.teaching.trace import PathTrace
 from tpm_viz.ui.typed import QUIET, Quantity, TypedField, TypedGroup, duration_note, force_note
+from tpm_viz.ui.worded import TabGui
 from tpm_viz.words import Phrase, T
 
 __all__ = ["CHART_HZ", "SPEEDS", "PlayerView"]
@@ -73,7 +74,7 @@ class PlayerView:
         self._in_front = True  # the path and trace are shown (another run's drawing is in front: hidden)
         self._frame: Snapshot | None = None
 
-    def build(self, gui: viser.GuiApi) -> None:
+    def build(self, gui: TabGui) -> None:
         """The *Player* tab's widgets (inside the tab's context)."""
         gui.add_markdown(
             "Play a trajectory: the platform follows it, leaves a trace, and the charts mark the current time. "

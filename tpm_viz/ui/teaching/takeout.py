@@ -24,6 +24,7 @@ from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.reports.report import report_html
 from tpm_viz.ui.teaching.materials import control_material, planner_material, player_material
 from tpm_viz.ui.teaching.recording import SLOTS, Material, Recording
+from tpm_viz.ui.worded import TabGui, Worded
 from tpm_viz.views3d import Camera
 from tpm_viz.words import Phrase, T, say
 
@@ -63,9 +64,9 @@ class TakeOut:
         self.where = where
         self.recording: Recording | None = None
         self.reporting = False
-        self.line: viser.GuiHtmlHandle | None = None
+        self.line: Worded | None = None
 
-    def build(self, gui: viser.GuiApi) -> None:
+    def build(self, gui: TabGui) -> None:
         """The folder of widgets (inside the tab's context)."""
         with gui.add_folder("Clip and report", expand_by_default=False):
             self.size = gui.add_dropdown("Clip size", tuple(SIZE_PRESETS), initial_value="800×450")
@@ -219,7 +220,7 @@ def _words(error) -> Phrase | str:
     return Phrase("internal error ({kind}), logged on the server", kind=type(error).__name__)
 
 
-def takeout_for(view, worker, owner, where: str, gui: viser.GuiApi) -> TakeOut:
+def takeout_for(view, worker, owner, where: str, gui: TabGui) -> TakeOut:
     """The clip and report widgets for ``owner`` (the Player, Control or Planner view of ``view``, ``where`` =
     ``"player"``, ``"control"`` or ``"planner"``), built at the end of its tab."""
     material = MATERIALS[where]
