@@ -103,7 +103,8 @@ def test_the_control_and_planner_charts_follow_presentation_mode_too(connect):
     assert len(charts) == 3
     before = [(c.handle.axes, c.handle.height, c.handle.padding) for c in charts]
     client.set_value(view.panel.presentation, True)
-    wait_for(lambda: all("font" in a for c in charts for a in c.handle.axes), what="the large axes sent")
+    grown = lambda: all(c.handle.height > b[1] for c, b in zip(charts, before, strict=True))  # noqa: E731 - set last
+    wait_for(lambda: all("font" in a for c in charts for a in c.handle.axes) and grown(), what="the large axes sent")
     bold = _font(True)
     hangul = ImageFont.truetype(font_manager.findfont(font_manager.FontProperties(family="NanumGothic")), SIZE)
     for chart, (axes0, height0, _padding0) in zip(charts, before, strict=True):
@@ -120,5 +121,6 @@ def test_the_control_and_planner_charts_follow_presentation_mode_too(connect):
         assert bold.getlength(y["label"]) <= room and chart.handle.height > height0
         assert hangul.getlength("힘 (N)") <= room  # the Korean title of the force charts
     client.set_value(view.panel.presentation, False)
-    wait_for(lambda: not any("font" in a for c in charts for a in c.handle.axes), what="the usual axes sent")
+    back = lambda: all(c.handle.height == b[1] for c, b in zip(charts, before, strict=True))  # noqa: E731 - set last
+    wait_for(lambda: not any("font" in a for c in charts for a in c.handle.axes) and back(), what="the usual axes")
     assert [(c.handle.axes, c.handle.height, c.handle.padding) for c in charts] == before

@@ -169,7 +169,7 @@ def test_the_comparison_table_and_drawings_hold_the_library_numbers(connect):
     client, view = connect()
     dv = view.teaching.design
     client.click(dv.compare_button)  # hold the link length, the task of 100 x 100 mm
-    wait_for(lambda: len(dv.compared) == 4, timeout=120, what="the comparison")
+    wait_for(lambda: len(dv.compared) == 4 and dv.table.content, timeout=120, what="the comparison and its table")
     table = dv.table.content
     for n, kind in enumerate(Arrangement):  # the given rows: the task centred on each home pose
         mid = math.sqrt(P.l_a**2 - (P.a - P.b - P.stroke / 2) ** 2)  # parallel home: p1 = 0, sliders at mid-stroke

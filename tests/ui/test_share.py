@@ -24,6 +24,7 @@ from tpm_viz.ui.app import TpmApp, build_server
 from tpm_viz.ui.classroom import SHARE_COOKIE, Handshakes, shared_token
 from tpm_viz.ui.continuity import lecture_store
 from tpm_viz.ui.share import origin_of
+from tpm_viz.viserkit.probe import widget_uuid
 from tpm_viz.words import Lang, Phrase, say
 
 RUN_SECONDS = 120.0  # a run is computed in the worker: generous under a loaded machine (no timed assert)
@@ -133,8 +134,8 @@ def _visit(app: TpmApp, url: str, lang: str | None = None):
 
 
 def _link_of(page: Page, view) -> str:
-    share = view.teaching.player.share
-    page.set("Copy share link", True)
+    share = view.teaching.player.share  # the Player's (the Share tab of Setup has the same button)
+    page.send(type="GuiUpdateMessage", uuid=widget_uuid(share.button), updates={"value": True})
     return wait_for(lambda: share.text.value, what="the link in the field")
 
 

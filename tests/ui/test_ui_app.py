@@ -388,8 +388,12 @@ def test_a_class_pulling_the_shared_platform_at_once_is_paced_and_the_latest_dra
     assert 2 <= len(commits) < sends  # merged: latest value wins
     # each drain sets the earliest time of the next one (its own start + the interval); a commit can start late
     # (the GIL), so the gaps between commits are not checked, the rule is: no commit before the time the last allowed
-    for (_, allowed), (began, due) in itertools.pairwise(commits):
+    # one drain may commit more than once (a tab's drag end is not merged into another tab's move): the commits of
+    # one drain share its next_at, and the first commit of each drain is the one that may not come early
+    firsts = [c for k, c in enumerate(commits) if k == 0 or c[1] != commits[k - 1][1]]
+    for (_, allowed), (began, _) in itertools.pairwise(firsts):
         assert began >= allowed - 1e-3
+    for began, due in commits:
         assert due - began <= dragging.SHARED_DRAG_INTERVAL + 1e-9  # next_at = the drain's start + the interval
     assert len({id(f) for f in drawn}) == len(drawn) <= len(commits)  # one broadcast drawing per commit
     assert not hub.shared.drags.scheduled

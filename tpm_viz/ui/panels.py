@@ -18,6 +18,7 @@ The actuators have both: a slider each, to drive by dragging (a phone's thumb), 
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 
 import viser
 
@@ -31,6 +32,7 @@ from tpm_viz.classroom.text import legend_html
 from tpm_viz.params import PARAM_INFO, Params
 from tpm_viz.ui.fields import Note, TypedBox
 from tpm_viz.ui.typed import QUIET, Quantity, TypedField, TypedGroup, force_note
+from tpm_viz.ui.worded import TabGui, Tabs, Worded
 from tpm_viz.viserkit.core import widget_uuid
 from tpm_viz.words import Lang
 
@@ -196,10 +198,17 @@ def _params_group(params: Params) -> TypedGroup:
 
 
 class Panel:
-    """GUI handles of one tab (``client.gui``); callbacks are attached by the client view."""
+    """GUI handles of one tab (its :class:`~.worded.TabGui`); callbacks are attached by the client view."""
 
-    def __init__(self, gui: viser.GuiApi, state: AppState, extra_tabs=None) -> None:
+    def __init__(
+        self, gui: TabGui, state: AppState, extra_tabs=None, later: Callable[[str], object] | None = None
+    ) -> None:
+        """``extra_tabs(group, tabs)`` adds the teaching layer's tabs of each group; with ``later`` (which builds a
+        group's deferred tabs: :meth:`.teaching.tabs.Teaching.open`) the *Equations* tab waits for
+        :meth:`add_equations`, after the *Player*."""
         self._gui = gui
+        self._later = later
+        self._equations: Worded | None = None  # the Equations tab's text (None until that tab is built)
         self._shown_params: Params | None = None
         self._shown_load: Load | None = None
         self._written: dict[int, object] = {}
@@ -220,7 +229,7 @@ class Panel:
         )
         self.groups = gui.add_tab_group()
         """The four groups of tabs (:data:`GROUPS`), each a tab holding a tab group of its own: two rows at most."""
-        self.tabs: dict[str, viser.GuiTabGroupHandle] = {}
+        self.tabs: dict[str, Tabs] = {}
         explore = self.groups.add_tab(GROUPS["explore"], icon=viser.Icon.HAND_FINGER)
         with explore:
             tabs = self.tabs["explore"] = gui.add_tab_group()
@@ -255,12 +264,8 @@ class Panel:
         with self.groups.add_tab(GROUPS["teach"], icon=viser.Icon.SCHOOL):
             tabs = self.tabs["teach"] = gui.add_tab_group()
         extra("teach", tabs)
-        with tabs.add_tab("Equations"):
-            gui.add_markdown(
-                "The paper's procedure (a)-(e) with the current numbers (refreshed when you release the platform "
-                "and at every trajectory sample you pause on or scrub to)."
-            )
-            self.equations = gui.add_html("")
+        if later is None:
+            self.add_equations()
         with self.groups.add_tab(GROUPS["lab"], icon=viser.Icon.FLASK):
             tabs = self.tabs["lab"] = gui.add_tab_group()
         extra("lab", tabs)
@@ -292,8 +297,9 @@ class Panel:
         if due:  # mid-drag the numbers are refreshed at most 4 times a second, less on a busy server (bench_load.py)
             self.dashboard.content = frame.dashboard_in(lang)
             self._dashboard_at = now
-        if not frame.in_drag or not self.equations.content:
-            self.equations.content = frame.equations_in(lang)
+        equations = self._equations
+        if equations is not None and (not frame.in_drag or not equations.content):
+            equations.content = frame.equations_in(lang)
         stroke_mm = state.params.stroke * 1e3
         for i, slider in enumerate(self.d):
             if slider.max != stroke_mm:
@@ -315,6 +321,26 @@ class Panel:
             tau = readout.forces.tau
             self.forces_note.notes = (note,) if (note := force_note(_largest(tau))) is not None else ()
             self.draw_notes(lang, now)
+
+    @property
+    def equations(self) -> Worded:
+        """The *Equations* tab's text (the tab built now if it was not yet)."""
+        if self._equations is None and self._later is not None:
+            self._later("teach")
+        if self._equations is None:
+            raise AttributeError("the Equations tab is not built (the tab is closed or still being built)")
+        return self._equations
+
+    def add_equations(self, frame: Snapshot | None = None, lang: Lang = Lang.EN) -> None:
+        """The *Equations* tab, last of the *Teach* group, with ``frame``'s numbers in ``lang`` (once)."""
+        if self._equations is not None:
+            return
+        with self.tabs["teach"].add_tab("Equations"):
+            self._gui.add_markdown(
+                "The paper's procedure (a)-(e) with the current numbers (refreshed when you release the platform "
+                "and at every trajectory sample you pause on or scrub to)."
+            )
+            self._equations = self._gui.add_html("" if frame is None else frame.equations_in(lang))
 
     def draw_notes(self, lang: Lang, now: float | None = None) -> None:
         """Every note of the panel, in ``lang`` (viser gets only the changed ones)."""

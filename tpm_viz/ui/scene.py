@@ -12,19 +12,17 @@ root ``/own``). What one tab sees of them (its gizmo, its view options) is :mod:
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 import viser
 
 from tpm_viz import meshes
-from tpm_viz.app.overlays import arrow_length, arrow_vector, cached_map
+from tpm_viz.app.overlays import arrow_length, arrow_vector
 from tpm_viz.app.palette import PALETTE
 from tpm_viz.app.readouts import Readout
 from tpm_viz.app.state import AppState
 from tpm_viz.classroom.snapshot import Snapshot
-from tpm_viz.paper.workspace import direct_singularity_locus, inverse_singularity_loci
 from tpm_viz.params import Params
+from tpm_viz.ui.scene_shapes import circle, floor, made, part
 
 __all__ = [
     "ARROW_SHORTEST",
@@ -45,7 +43,6 @@ ARROW_SHORTEST = 1e-3
 """[m] A force arrow shorter than this is hidden. Lengths: :func:`tpm_viz.app.overlays.arrow_length` (linear for small
 forces, bounded: every arrow stays near the mechanism however large the force near a singularity)."""
 ARROW_Z = meshes.PIN_Z[1] + 0.02  # m, above every part so that no part hides an arrow
-LOCI_Z = 0.0008  # m
 GIZMO_Z = meshes.PLATFORM_Z[1] + 0.02  # m
 FAMILIES = ("labels", "loci", "circles", "forces")
 """The families of nodes a viewer may hide (*Class & view* tab); ``region`` (the workspace floor) is hidden while
@@ -56,12 +53,6 @@ LINE_SCALE = 2.0
 """Presentation mode: the lines (loci, leg circles) are this many times thicker."""
 LABEL_SCALE = 1.6
 """Presentation mode: the 3D labels are this many times larger."""
-
-
-@functools.lru_cache(maxsize=128)
-def _made(make, params: Params, *args):
-    """``make(params, *args)`` of :mod:`tpm_viz.meshes`, made once per mechanism (a reconnect storm: 100 own copies)."""
-    return make(params, *args)
 
 
 def _mesh(scene: viser.SceneApi, name: str, mesh, color, **kwargs):
@@ -161,7 +152,7 @@ class MechanismScene:
         self.params = params
         self._sent.clear()
         lo, hi = meshes.base_extent(params)
-        _mesh(s, f"{r}/base", _made(meshes.base_plate, params), COLORS["base"])
+        _mesh(s, f"{r}/base", made(meshes.base_plate, params), COLORS["base"])
         size = hi - lo
         s.add_grid(
             f"{r}/grid",
@@ -176,9 +167,9 @@ class MechanismScene:
             shadow_opacity=0.0,
         )
         for i in range(2):
-            _mesh(s, f"{r}/rail{i + 1}", _made(meshes.rail, params, i), COLORS["rail"])
-            _mesh(s, f"{r}/stops{i + 1}", _made(meshes.end_stops, params, i), COLORS["stop"])
-            body = _made(meshes.slider, params, i)
+            _mesh(s, f"{r}/rail{i + 1}", made(meshes.rail, params, i), COLORS["rail"])
+            _mesh(s, f"{r}/stops{i + 1}", made(meshes.end_stops, params, i), COLORS["stop"])
+            body = made(meshes.slider, params, i)
             self.slider_bodies[i] = _mesh(s, f"{r}/slider{i + 1}/body", body, COLORS["slider"])
             offsets = meshes.slider_pin_offsets(params, i)
             self._pins(f"{r}/slider{i + 1}/pins", offsets)
@@ -186,7 +177,7 @@ class MechanismScene:
             centre[i] = params.b  # C_i = A_i + b e_i
             self.circles[i] = s.add_line_segments(
                 f"{r}/slider{i + 1}/circle",
-                meshes.circle_segments(params.l_a, LOCI_Z + 0.001) + centre,
+                circle(params.l_a) + centre,
                 COLORS["circle"],
                 thickness=CIRCLE_WIDTH * self._line_scale,
                 thickness_units="screen",
@@ -195,7 +186,7 @@ class MechanismScene:
             self.labels[1 + 2 * i].position = (0.0, 0.0, meshes.SLIDER_Z[1])
             b_label = meshes.platform_pin_offsets(params)[2 * i] + (0.0, 0.0, meshes.PLATFORM_Z[1])
             self.labels[2 + 2 * i].position = tuple(b_label)
-        link = _made(meshes.link, params)
+        link = made(meshes.link, params)
         self.links = s.add_batched_meshes_simple(
             f"{r}/links",
             link.vertices,
@@ -207,16 +198,16 @@ class MechanismScene:
             cast_shadow=False,
             receive_shadow=False,
         )
-        self.platform_body = _mesh(s, f"{r}/platform/body", _made(meshes.platform, params), COLORS["platform"])
-        _mesh(s, f"{r}/platform/marker", meshes.tool_marker(), COLORS["marker"])
+        self.platform_body = _mesh(s, f"{r}/platform/body", made(meshes.platform, params), COLORS["platform"])
+        _mesh(s, f"{r}/platform/marker", part(meshes.tool_marker), COLORS["marker"])
         self._pins(f"{r}/platform/pins", meshes.platform_pin_offsets(params))
         self.label_p.position = (0.0, 0.0, meshes.PLATFORM_Z[1] + 0.01)
-        _mesh(s, f"{r}/ghost/body", _made(meshes.platform, params), COLORS["circle"], opacity=0.22)
+        _mesh(s, f"{r}/ghost/body", made(meshes.platform, params), COLORS["circle"], opacity=0.22)
         self.ghost_label.position = (0.0, 0.0, meshes.PLATFORM_Z[1])
         self._loci(params)
 
     def _pins(self, name: str, offsets: np.ndarray) -> None:
-        pin = meshes.pin()
+        pin = part(meshes.pin)
         self._scene.add_batched_meshes_simple(
             name,
             pin.vertices,
@@ -232,21 +223,17 @@ class MechanismScene:
         """The floor overlay: the workspace inside the stroke (eq. 4), the inverse singularity square (eq. 11)
         and the direct singularity arcs (eq. 12), all in the working mode."""
         s, r = self._scene, self.root
-        ws = cached_map(params, 100)  # once per parameter set for all tabs
-        region = meshes.region_mesh(ws.in_stroke, ws.xs, ws.ys, LOCI_Z / 2)
+        region, lines = floor(params)
         self.loci = []
         self.region = None
         if region is not None:
             self.region = _mesh(s, f"{r}/loci/workspace", region, COLORS["workspace"], opacity=0.45, side="double")
             self.loci.append(self.region)
-        for kind, curves in (
-            ("inverse", inverse_singularity_loci(params)),
-            ("direct", direct_singularity_locus(params)),
-        ):
+        for kind, segments in lines.items():
             self.loci.append(
                 s.add_line_segments(
                     f"{r}/loci/{kind}",
-                    meshes.polyline_segments(curves, LOCI_Z),
+                    segments,
                     COLORS[f"locus_{kind}"],
                     thickness=LOCUS_WIDTH * self._line_scale,
                     thickness_units="screen",

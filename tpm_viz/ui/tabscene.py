@@ -94,10 +94,13 @@ class TabScene:
             self._cover = self._api.add_frame(self.shared.root, show_axes=False, visible=False)
         if self.private is None:  # each update one atomic window of this tab (flushed by the tab's render)
             self.private = MechanismScene(self._api, params, root=PRIVATE_ROOT, sink=self._client, flush=False)
-            self.private.set_style(self.presentation)
+            if self.presentation:  # a new drawing is in the normal style, everything shown: only what differs
+                self.private.set_style(True)
             for what in FAMILIES:
-                self.private.set_visible(what, self.show[what])
-            self.private.set_visible("region", not self.region_hidden)
+                if not self.show[what]:
+                    self.private.set_visible(what, False)
+            if self.region_hidden:
+                self.private.set_visible("region", False)
         return self.private
 
     def close_private(self) -> None:

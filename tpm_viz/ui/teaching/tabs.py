@@ -5,16 +5,25 @@ map cache, trajectory runs).
 :class:`~.client.ClientView` needs four calls: :meth:`Teaching.build_tabs` while its panel builds the tab group,
 :meth:`Teaching.attach` once it has joined a session, :meth:`Teaching.render` for every frame (under the hub's
 lock) and :meth:`Teaching.close`; :meth:`Teaching.switched` when the tab moves to another session.
+
+A tab is built in two steps, so that a class reconnecting at once gets its mechanisms back first
+(``benchmarks/bench_reconnect.py``): *Explorer* and *Demos* with the panel, the tabs of :data:`LATER` (*Player* and
+the panel's *Equations* in *Teach*; *Control*, *Planner* and *Design* in *Lab*) by :meth:`Teaching.open`, which the
+tab hands to the hub's :class:`~tpm_viz.classroom.later.Later` (run once no tab has arrived for a moment) and which
+runs at once for anyone who asks for one of those views (:attr:`Teaching.player`, ...). Each group's tabs are
+appended in their usual order, after the ones built first: the tab looks the same either way.
 """
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import viser
 
 from tpm_viz.app.lessons import DEMOS, PROBLEMS, Demo
+from tpm_viz.classroom.later import Later
 from tpm_viz.classroom.session import Hub, Session, View
 from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.classroom.worker import Worker
@@ -26,8 +35,13 @@ from tpm_viz.ui.teaching.planner import PlannerView
 from tpm_viz.ui.teaching.player import PlayerView
 from tpm_viz.ui.teaching.playing import RunHub
 from tpm_viz.ui.teaching.takeout import TakeOut, takeout_for
+from tpm_viz.ui.worded import Tabs
 
-__all__ = ["Services", "Teaching"]
+__all__ = ["LATER", "Services", "Teaching"]
+
+LATER = {"teach": ("player",), "lab": ("control", "planner", "design")}
+"""The groups whose tabs :meth:`Teaching.open` builds after the rest of the tab, and the views in them (the panel's
+*Equations* follows the *Player*)."""
 
 
 @dataclass
@@ -44,13 +58,16 @@ class Services:
     """The lessons of the *Demos* tab: the packaged ones, or a lecturer's (``tpm-viz serve --lessons DIR``)."""
     problems: tuple[str, ...] = PROBLEMS
     """One line per lesson file that was refused (``file:line: what is wrong``), shown in the tab."""
+    later: Later | None = None
+    """Where a tab's :data:`LATER` groups wait for a quiet moment (None: every tab is built whole at once)."""
 
     @classmethod
     def create(cls, hub: Hub, lessons: Sequence[Demo] = DEMOS, problems: Sequence[str] = PROBLEMS) -> Services:
         """The services of ``hub``: one fair worker pool for slow computations (maps, runs, control simulations,
         the planner's live re-plans), the floor maps, the runs and the lessons."""
         worker = Worker()
-        return cls(worker, MapService(worker), RunHub(hub, worker), worker, tuple(lessons), tuple(problems))
+        runs = RunHub(hub, worker)
+        return cls(worker, MapService(worker), runs, worker, tuple(lessons), tuple(problems), Later())
 
 
 class Teaching:
@@ -59,81 +76,193 @@ class Teaching:
     def __init__(self, view: View, services: Services) -> None:
         self.view = view
         self.services = services
-        self.player = PlayerView(view, self.services.runs)
+        if services.later is not None:
+            services.later.arrived()  # a tab is being built: the deferred tabs of the others wait
+        self._player = PlayerView(view, self.services.runs)
         self.explorer = ExplorerView(view, self.services.maps)
         self.demos = DemosView(
-            view, services.runs, self.explorer, self.player.speed_value, services.lessons, services.problems
+            view, services.runs, self.explorer, lambda: self.player.speed_value(), services.lessons, services.problems
         )
-        self.control = ControlView(view, self.services.worker, self.services.runs)
-        self.planner = PlannerView(view, self.services.plans)
-        self.design = DesignView(view, self.services.worker)  # the Design studio (ui/teaching/design.py)
-        self.takeouts: list[TakeOut] = []  # Record clip and Download report of the player, control and planner
+        self._control = ControlView(view, self.services.worker, self.services.runs)
+        self._planner = PlannerView(view, self.services.plans)
+        self._design = DesignView(view, self.services.worker)  # the Design studio (ui/teaching/design.py)
+        self._takeouts: list[TakeOut] = []  # Record clip and Download report of the player, control and planner
+        self._tabs: dict[str, Tabs] = {}  # the tab groups of LATER's groups, to build them in
+        self.waiting: set[str] = set()
+        """The groups of :data:`LATER` not built yet (:meth:`open` builds one)."""
+        self._attached = False
 
-    def build_tabs(self, group: str, tabs: viser.GuiTabGroupHandle) -> None:
+    # -- the views of the deferred tabs: built when asked for --------------------------------------------------
+    @property
+    def player(self) -> PlayerView:
+        """The *Player* tab (built now if it was not yet: :meth:`open`)."""
+        self.open("teach")
+        return self._player
+
+    @property
+    def control(self) -> ControlView:
+        """The *Control* tab (built now if it was not yet)."""
+        self.open("lab")
+        return self._control
+
+    @property
+    def planner(self) -> PlannerView:
+        """The *Planner* tab (built now if it was not yet)."""
+        self.open("lab")
+        return self._planner
+
+    @property
+    def design(self) -> DesignView:
+        """The *Design* tab (built now if it was not yet)."""
+        self.open("lab")
+        return self._design
+
+    @property
+    def takeouts(self) -> list[TakeOut]:
+        """*Record clip* and *Download report* of the player, control and planner (every tab built now)."""
+        for group in LATER:
+            self.open(group)
+        return self._takeouts
+
+    def built(self, group: str) -> bool:
+        """Whether ``group``'s tabs exist (the groups not in :data:`LATER` always do)."""
+        return group not in self.waiting
+
+    # -- building --------------------------------------------------------------------------------------------
+    def build_tabs(self, group: str, tabs: Tabs) -> None:
         """Add this layer's tabs of ``group`` (a key of :data:`~tpm_viz.ui.panels.GROUPS`) to its tab group:
         *Explorer* (the maps) in *explore*; *Demos* and *Player* in *teach* (before the panel's *Equations*);
-        *Control* and *Planner* in *lab*."""
-        gui = self.view.client.gui
+        *Control*, *Planner* and *Design* in *lab*. The tabs of :data:`LATER` are left to :meth:`open` when the
+        services defer them (:attr:`Services.later`)."""
+        gui = self.view.gui
         if group == "explore":
             with tabs.add_tab("Explorer", icon=viser.Icon.MAP):
                 self.explorer.build(gui)
         if group == "teach":
             with tabs.add_tab("Demos", icon=viser.Icon.SCHOOL):
                 self.demos.build(gui)
+        if group in LATER:
+            self._tabs[group] = tabs
+            if self.services.later is None:
+                self._build(group)
+            else:
+                self.waiting.add(group)
+
+    def _build(self, group: str) -> None:
+        """The tabs of ``group`` in :data:`LATER`, appended to its tab group."""
+        gui, tabs, worker = self.view.gui, self._tabs[group], self.services.worker
+        if group == "teach":
             with tabs.add_tab("Player", icon=viser.Icon.PLAYER_PLAY):
-                self.player.build(gui)
-                self.takeouts.append(takeout_for(self.view, self.services.worker, self.player, "player", gui))
+                self._player.build(gui)
+                self._takeouts.append(takeout_for(self.view, worker, self._player, "player", gui))
         if group == "lab":
             with tabs.add_tab("Control", icon=viser.Icon.ADJUSTMENTS):
-                self.control.build(gui)
-                self.takeouts.append(takeout_for(self.view, self.services.worker, self.control, "control", gui))
+                self._control.build(gui)
+                self._takeouts.append(takeout_for(self.view, worker, self._control, "control", gui))
             with tabs.add_tab("Planner", icon=viser.Icon.ROUTE):
-                self.planner.build(gui)
-                self.takeouts.append(takeout_for(self.view, self.services.worker, self.planner, "planner", gui))
+                self._planner.build(gui)
+                self._takeouts.append(takeout_for(self.view, worker, self._planner, "planner", gui))
             with tabs.add_tab("Design", icon=viser.Icon.RULER_MEASURE):
-                self.design.build(gui)
+                self._design.build(gui)
+
+    def open(self, group: str) -> bool:
+        """Build the tabs of ``group`` (a key of :data:`LATER`) now if they are not yet, drawn from the session's
+        current frame, in presentation mode if the tab is in it (takes the hub's lock; idempotent). True: built
+        now; False: built already, or the tab is closed or still being built (its panel does not exist yet)."""
+        view = self.view
+        with view.hub.lock:
+            panel = getattr(view, "panel", None)
+            if group not in self.waiting or panel is None or getattr(view, "closed", False):
+                return False
+            self.waiting.discard(group)
+            with view.client.atomic():
+                self._build(group)
+                frame = view.session.frame
+                if group == "teach":
+                    panel.add_equations(frame, view.lang)
+                if getattr(getattr(view, "look", None), "presentation", False):
+                    self._present(group, True)
+                if self._attached:
+                    self._attach(group)
+                if frame is not None:
+                    for name in LATER[group]:
+                        getattr(self, f"_{name}").render(frame)
+            view.client.flush()
+        return True
+
+    def _attach(self, group: str) -> None:
+        """The views of a built ``group`` of :data:`LATER` for the session the tab has joined."""
+        if group == "teach":
+            with self.view.hub.lock:
+                self._player.refresh()
+        if group == "lab":
+            self._control.attach()
+            self._planner.attach()
 
     def attach(self) -> None:
-        """The tab has joined its session: draw the session's run (the first render came before that)."""
-        with self.view.hub.lock:
-            self.player.refresh()
-        self.control.attach()
-        self.planner.attach()
+        """The tab has joined its session: draw the session's run (the first render came before that); the groups
+        not built yet wait for a quiet moment (:attr:`Services.later`)."""
+        self._attached = True
+        for group in LATER:
+            if self.built(group):
+                self._attach(group)
+        later = self.services.later
+        if later is not None:
+            later.arrived()
+            for group in LATER:
+                if not self.built(group):
+                    later.add(functools.partial(self.open, group))
 
     def switched(self, old: Session) -> None:
         """The tab moved from ``old`` to its current session (own copy on / off)."""
         with self.view.hub.lock:
             self.services.runs.adopt(self.view.session, old)
-            self.player.refresh()
+            self.run_changed()
+
+    def run_changed(self) -> None:
+        """The session's run changed: redraw the player (if its tab exists: it draws the run when built)."""
+        if self.built("teach"):
+            self._player.refresh()
 
     def render(self, frame: Snapshot) -> None:
         """Draw the teaching layer's part of ``frame`` (under the hub's lock)."""
-        self.player.render(frame)
+        if self.built("teach"):
+            self._player.render(frame)
         self.explorer.render(frame)
         self.demos.render(frame)
-        self.control.render(frame)
-        self.planner.render(frame)
-        self.design.render(frame)
+        if self.built("lab"):
+            self._control.render(frame)
+            self._planner.render(frame)
+            self._design.render(frame)
 
     def set_presentation(self, on: bool) -> None:
         """Presentation mode on or off for every chart of the tab (player, control, planner)."""
-        self.player.charts.set_presentation(on)
-        for chart in (*self.control.charts, *self.planner.charts):
-            chart.set_presentation(on)
+        for group in LATER:
+            if self.built(group):
+                self._present(group, on)
+
+    def _present(self, group: str, on: bool) -> None:
+        if group == "teach":
+            self._player.charts.set_presentation(on)
+        if group == "lab":
+            for chart in (*self._control.charts, *self._planner.charts):
+                chart.set_presentation(on)
 
     def words_changed(self) -> None:
         """The tab's language changed: the texts the tabs wrote themselves, again in it (under the hub's lock)."""
-        self.player.refresh()
+        if self.built("teach"):
+            self._player.refresh()
         self.demos.retell()
-        self.control.retell()
-        self.planner.retell()
+        if self.built("lab"):
+            self._control.retell()
+            self._planner.retell()
+            self._design.retell()
         self.explorer.retell()
-        self.design.retell()
 
     def close(self) -> None:
         """The tab went away."""
-        self.player.close()
+        self._player.close()
         self.explorer.close()
-        self.control.player.stop()
-        self.planner.player.stop()
+        self._control.player.stop()
+        self._planner.player.stop()
         self.services.worker.leave(self.view)  # its pending maps, simulations and plans are dropped

@@ -1,0 +1,92 @@
+"""Work that can wait for a quiet moment: the parts of a tab nobody needs in its first second.
+
+A reconnect storm (a lecture hall's wifi blip: 100 tabs back at once) is served one tab at a time under the hub's
+lock, so every millisecond of a tab's build delays every tab behind it. A tab therefore builds at once only what
+it shows first (its mechanism, the *Explore* and *Setup* tabs, its own copy) and hands the rest (the *Player*,
+*Equations* and *Lab* tabs: :mod:`tpm_viz.ui.teaching.tabs`) to :class:`Later`, which runs those jobs one at a time
+on a thread of its own once no tab has arrived for :data:`QUIET` seconds: the storm first, then everyone's remaining
+tabs. A job is also run at once by whoever needs its result (a test or a lesson asking for the player: the job's
+owner makes it idempotent), so nothing ever depends on the timing here.
+
+Bounded: at most :data:`LIMIT` jobs wait (a job beyond it is run by the thread at once, never dropped); the thread
+exists only while jobs wait.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+
+from tpm_viz.classroom.guard import report
+
+__all__ = ["LIMIT", "QUIET", "Later"]
+
+QUIET = 0.25
+"""Seconds without a tab arriving before a waiting job runs (tabs of a storm arrive every ~50 ms)."""
+LIMIT = 2000
+"""Jobs kept waiting at most (a class of 150 tabs leaves two jobs each)."""
+
+
+class Later:
+    """A queue of jobs run one at a time on a daemon thread, each after :data:`QUIET` seconds without an arrival."""
+
+    def __init__(self, quiet: float = QUIET, limit: int = LIMIT, name: str = "tpm-viz-later") -> None:
+        self.quiet = quiet
+        self.limit = limit
+        self.name = name
+        self._jobs: deque[Callable[[], object]] = deque()
+        self._cond = threading.Condition()
+        self._last = float("-inf")  # time.monotonic() of the last arrival
+        self._thread: threading.Thread | None = None
+        self._running = 0
+
+    def arrived(self) -> None:
+        """A tab arrived (its build is starting): waiting jobs give it the next :data:`QUIET` seconds."""
+        with self._cond:
+            self._last = time.monotonic()
+
+    def add(self, job: Callable[[], object]) -> None:
+        """Run ``job()`` once the server is quiet (its exceptions are logged, never raised here)."""
+        with self._cond:
+            self._jobs.append(job)
+            urgent = len(self._jobs) > self.limit
+            if self._thread is None:
+                self._thread = threading.Thread(target=self._run, name=self.name, daemon=True)
+                self._thread.start()
+            self._cond.notify_all()
+        if urgent:  # a queue this long is a bug or an attack: the oldest job runs now on this thread
+            self._take_and_run()
+
+    def pending(self) -> int:
+        """Jobs waiting or running (tests and benchmarks wait for 0)."""
+        with self._cond:
+            return len(self._jobs) + self._running
+
+    def _take_and_run(self) -> None:
+        with self._cond:
+            if not self._jobs:
+                return
+            job = self._jobs.popleft()
+            self._running += 1
+        try:
+            job()
+        except Exception as exc:  # a job's bug: logged, the next jobs still run
+            report(exc, "a deferred job")
+        finally:
+            with self._cond:
+                self._running -= 1
+
+    def _run(self) -> None:
+        while True:
+            with self._cond:
+                while True:
+                    if not self._jobs:
+                        self._thread = None  # the next add() starts a new thread
+                        return
+                    wait = self._last + self.quiet - time.monotonic()
+                    if wait <= 0:
+                        break
+                    self._cond.wait(wait)
+            self._take_and_run()
