@@ -5,9 +5,10 @@ mechanism (the base plate's corners, which hold the rails, sliders and links) la
 paper's parameters and for l_a = 240 mm (which cut rail 1 and A₁ at the left edge before); the drag handle is a
 target a finger can hold: touch drags that start 20 px left, right, above and below its middle (a square at least
 44 px across) all move the platform, and a 30 px finger move moves it by at most 30 mm (1 mm per CSS px); viser's
-software-WebGL notice does not cover the handle. The handle's middle is where viser's gizmo draws its square (drei's
-``PivotControls``: at 1.7/7 of its size from the platform diagonally, 0.225 of its size across); a touch that missed
-it would orbit the camera and move nothing.
+software-WebGL notice is a one-line strip clear of the whole mechanism and the handle; the first visit's guide and its
+colour legend (in Korean, the longer words) fit the phone's width. The handle's middle is where viser's gizmo draws
+its square (drei's ``PivotControls``: at 1.7/7 of its size from the platform diagonally, 0.225 of its size across); a
+touch that missed it would orbit the camera and move nothing.
 """
 
 from __future__ import annotations
@@ -34,6 +35,8 @@ IPHONE = (
 )
 CANVAS = """() => { const r = document.querySelector('canvas[data-engine]').getBoundingClientRect();
   return [r.left, r.top, r.right, r.bottom]; }"""
+GUIDE_EDGES = """() => [...document.querySelectorAll('[data-guide] *')]
+  .map(e => { const r = e.getBoundingClientRect(); return [r.left, r.right]; })"""
 NOTICE = """() => { const e = document.getElementById('webgl-software-rendering'); if (!e) return null;
   const r = e.getBoundingClientRect(); return [r.left, r.top, r.right, r.bottom]; }"""
 
@@ -107,8 +110,13 @@ def _touch_drag(cdp, page, x: float, y: float, dx: float) -> None:
 
 @pytest.mark.parametrize("size", [(390, 844), (844, 390)], ids=["portrait", "landscape"])
 def test_a_phone_holds_the_handle_moves_finely_and_sees_the_whole_mechanism(served, chromium, size):
+    portrait = size[0] < size[1]
     context = chromium.new_context(
-        viewport={"width": size[0], "height": size[1]}, has_touch=True, is_mobile=True, user_agent=IPHONE
+        viewport={"width": size[0], "height": size[1]},
+        has_touch=True,
+        is_mobile=True,
+        user_agent=IPHONE,
+        locale="ko-KR" if portrait else "en-US",  # the longer words of the guide's legend
     )
     try:
         before = set(served.views)
@@ -120,6 +128,18 @@ def test_a_phone_holds_the_handle_moves_finely_and_sees_the_whole_mechanism(serv
         with view.hub.lock:  # the paper's mechanism at home (the module's other test changed the shared one)
             view.hub.commit(view.session, transitions.home(transitions.paper_params(view.session.state)))
         _framed(page, view)
+        rect = _settled(page, view)
+        lo, hi = meshes.base_extent(view.session.state.params)
+        corners = [(x, y, z) for x in (lo, hi) for y in (lo, hi) for z in (-0.012, meshes.PIN_Z[1])]
+        px = _project(view, corners, rect)
+        notice = page.evaluate(NOTICE)
+        if notice is not None:  # a computer without a GPU: a one-line strip clear of the whole mechanism
+            assert notice[3] - notice[1] <= 30, notice
+            assert notice[3] <= px[:, 1].min() or notice[2] <= px[:, 0].min(), (notice, px.min(axis=0))
+        if portrait:  # the first visit's guide and its colour legend fit the phone's width
+            page.wait_for_selector("[data-guide]")
+            edges = page.evaluate(GUIDE_EDGES)
+            assert edges and all(0 <= left and right <= size[0] for left, right in edges), edges
         cdp = context.new_cdp_session(page)
         for dx, dy in ((0, 0), (-20, 0), (20, 0), (0, -20), (0, 20)):  # a target at least 40 px + 2 x 2 px
             rect = _settled(page, view)

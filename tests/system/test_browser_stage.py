@@ -19,7 +19,9 @@ import pytest
 from tests.support.protocol import wait_for
 from tests.support.stage import GROUP_OF, STAGE, open_tab
 from tests.system.test_browser_layout import _in_view, chromium, served  # noqa: F401  (fixtures)
+from tpm_viz.ui.look import PANEL_WIDTH
 from tpm_viz.viserkit.probe import widget_uuid
+from tpm_viz.words import Lang, T, say, shown
 
 pytestmark = pytest.mark.browser
 
@@ -33,11 +35,53 @@ LIVE_SHOWN = """
         return !!w && getComputedStyle(w).visibility === 'visible' && w.getBoundingClientRect().height > 0; }
 """
 SINGULARITY_BUTTONS = ("Near an inverse singularity", "Near the direct singularity", "At a stroke end")
+FORCE_ROOM = """
+() => {  // each force readout's right edge [px] and the right edge of the panel's content box (its scroll bar off)
+  const marker = document.querySelector('[data-tpmviz-keys]');
+  const region = marker.closest('[data-dock-region]');
+  const viewport = region.querySelector('.mantine-ScrollArea-viewport').getBoundingClientRect();
+  const bars = [...region.querySelectorAll('.mantine-ScrollArea-scrollbar[data-orientation=vertical]')]
+    .map(e => e.getBoundingClientRect()).filter(r => r.width > 0);
+  const content = Math.min(viewport.right, ...bars.map(r => r.left));
+  const spans = [...region.querySelectorAll('[data-q=tau1], [data-q=tau2]')].filter(e => e.getClientRects().length)
+    .map(e => e.parentElement.getBoundingClientRect().right);
+  return {content, spans};
+}
+"""
+TIP_CLEAR = """
+() => {  // the hint shown, and the panel's inputs and buttons its box intersects
+  const tip = [...document.querySelectorAll('.mantine-Tooltip-tooltip')].find(e => e.getClientRects().length
+    && parseFloat(getComputedStyle(e).opacity) > 0.5);
+  if (!tip) return null;
+  const t = tip.getBoundingClientRect();
+  const region = document.querySelector('[data-tpmviz-keys]').closest('[data-dock-region]');
+  const hit = [...region.querySelectorAll('input:not([type=hidden]), textarea, button, [role=slider], [role=tab]')]
+    .filter(e => e.getClientRects().length).filter(e => { const r = e.getBoundingClientRect();
+      return r.width > 0 && r.left < t.right && t.left < r.right && r.top < t.bottom && t.top < r.bottom; })
+    .map(e => e.getAttribute('aria-label') || e.textContent.trim() || e.tagName);
+  return {text: tip.textContent.trim(), box: [t.left, t.top, t.right, t.bottom], hit};
+}
+"""
+GUIDE_BOXES = (
+    "() => [...document.querySelectorAll('[data-guide] *')].map(e => { const r = e.getBoundingClientRect(); "
+    "return [r.left, r.right]; })"
+)
+"""Left and right edges [CSS px] of every element of the first visit's guide (its lines and its colour legend)."""
+FOLDED = "() => !!document.querySelector('[data-dock-rail-root]')"
+"""The panel folded to its rail."""
+
+
+def _room_for_the_forces(page, where: str) -> None:
+    room = page.evaluate(FORCE_ROOM)
+    assert len(room["spans"]) == 2, room
+    assert all(right <= room["content"] - 4 for right in room["spans"]), f"{where}: {room}"
 
 
 @pytest.fixture(scope="module")
 def shots():
-    folder = tempfile.mkdtemp(prefix="tpm-viz-stage-")
+    """Where the screenshots go: ``TPM_VIZ_SCREENSHOTS`` (the README's come from there), else a temporary folder."""
+    folder = os.environ.get("TPM_VIZ_SCREENSHOTS") or tempfile.mkdtemp(prefix="tpm-viz-stage-")
+    os.makedirs(folder, exist_ok=True)
     yield folder
     print(f"screenshots: {folder}")
 
@@ -113,6 +157,23 @@ def test_the_projector_in_presentation_mode(served, chromium, shots):  # noqa: F
         bottoms = _every_tab(page, "projector, presentation mode, panel open")
         _buttons_in_view(page, "projector, presentation mode, panel open")
         print(f"projector, presentation mode, panel open: first control bottoms {bottoms}")
+
+        # ... or one key, P, from anywhere but a text field (the keyboard alone from here on)
+        field = page.locator('textarea[aria-label="Platform p1 (mm)"]')
+        field.focus()
+        page.keyboard.press("End")
+        page.keyboard.press("p")  # typed into the field: the panel stays
+        page.wait_for_function("document.activeElement.value.endsWith('p')")
+        assert not page.evaluate(FOLDED)
+        page.keyboard.press("Backspace")
+        page.keyboard.press("Escape")
+        page.locator("canvas[tabindex]").first.focus()  # the 3D view (Tab reaches it)
+        page.keyboard.press("p")
+        page.wait_for_function(FOLDED)
+        wait_for(lambda: page.evaluate(LIVE_SHOWN), what="the box of live numbers with the panel folded by P")
+        page.keyboard.press("p")  # the focus is on the page: P again brings the panel back
+        page.wait_for_function(f"!({FOLDED})()")
+        wait_for(lambda: page.evaluate(STAGE)["rows"], what="the panel back by P")
     finally:
         context.close()
 
@@ -138,6 +199,7 @@ def test_a_laptop_in_normal_mode_and_the_first_visit(served, chromium, shots, si
         legend = page.get_by_text("workspace: poses inside the stroke", exact=False)
         legend.scroll_into_view_if_needed()
         assert legend.is_visible()  # the colour legend is on the Move tab
+        _room_for_the_forces(page, name)
         print(f"{name}: canvas width {width:.0f} px ({width / size[0]:.2f}); first control bottoms {after}")
         print(f"{name} with the guide open: {with_guide}")
         page.screenshot(path=os.path.join(shots, f"laptop-{name}.png"))
@@ -155,10 +217,44 @@ def test_a_laptop_in_normal_mode_and_the_first_visit(served, chromium, shots, si
         context.close()
 
 
+def _tip(page, where: str) -> dict:
+    tip = wait_for(lambda: page.evaluate(TIP_CLEAR), what=f"the hint shown ({where})")
+    assert tip["hit"] == [], f"{where}: the hint {tip}"
+    return tip
+
+
+def test_hints_beside_the_panel_and_room_for_the_forces_in_korean(served, chromium, shots):  # noqa: F811
+    context, page, _ = _open(served, chromium, (1366, 768), locale="ko-KR")
+    try:
+        _room_for_the_forces(page, "1366x768, Korean")
+        field = page.locator(f'textarea[aria-label="{shown(Lang.KO, "Platform p2 (mm)")}"]')
+        field.hover()  # a hint of a field with one above it: drawn beside the panel, over the 3D view
+        hovered = _tip(page, "hover")
+        page.mouse.move(5, 700)
+        page.wait_for_function(f"!({TIP_CLEAR})()")
+        field.focus()  # keyboard focus shows it too, in the same place
+        focused = _tip(page, "keyboard focus")
+        assert focused["text"] == hovered["text"] and hovered["box"][2] <= 1366 - PANEL_WIDTH  # over the 3D view
+        page.screenshot(path=os.path.join(shots, "hint-1366x768-ko.png"))
+        # viser's own names in the tab's language
+        collapse = page.locator("[data-dock-region-collapse]").first
+        expected = say(Lang.KO, T("Collapse panel area"))
+        assert expected != "Collapse panel area"
+        wait_for(lambda: collapse.get_attribute("aria-label") == expected, what="viser's names in Korean")
+    finally:
+        context.close()
+
+
 def test_a_phone(served, chromium, shots):  # noqa: F811
     context, page, view = _open(served, chromium, (390, 844))
     try:
         _in_view(page, view, "the mechanism framed above the sheet")
+        legend = page.evaluate(GUIDE_BOXES)
+        assert legend and all(0 <= left and right <= 390 for left, right in legend), legend
+        notice = page.locator("#webgl-software-rendering")
+        if notice.count():  # a computer without a GPU: one line at the top, not the 3D view's middle
+            box = notice.bounding_box()
+            assert box is not None and box["height"] <= 30 and box["y"] + box["height"] <= 40, box
         stage = page.evaluate(STAGE)
         assert stage["share"] >= 0.5 and len(stage["rows"]) <= 2, stage
         page.get_by_role("button", name="Got it").click()

@@ -185,7 +185,7 @@ def _get(port: int, path: str) -> tuple[int, bytes]:
 def test_http_serves_the_page_and_nothing_else(app, connect):
     index_status, index = _get(app.port, "/")
     assert index_status == 200 and b"<html" in index.lower()
-    secrets = [b"root:", b"[project]", b"import viser", b"PATH=", b"repositoryformatversion", b"python"]
+    secrets = [b"root:x:0:0", b"[project]", b"import viser", b"PATH=", b"repositoryformatversion", b"python"]
     for path in TRAVERSALS:
         status, body = _get(app.port, path)
         assert status == 404 or (path.startswith("/?") and body == index), (path, status)

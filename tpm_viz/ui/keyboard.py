@@ -63,7 +63,7 @@ MOVES: dict[str, tuple[str, int, float]] = {
 
 LABEL = T(
     "3D view of the mechanism. Arrow keys move the platform, Q and A slider 1, W and S slider 2; with Shift the "
-    "steps are 10 mm instead of 1 mm."
+    "steps are 10 mm instead of 1 mm. In presentation mode P folds and unfolds the panel."
 )
 """The 3D view's name for assistive technology (the page script reads it from the tab's hidden element)."""
 
@@ -78,10 +78,39 @@ def _marker(nonce: str) -> str:
     """The hidden element of a tab's panel: its nonce, and the words the page script gives the 3D view and the
     close buttons (English here; in the tab's language on the wire, :mod:`.language`)."""
     words = "".join(f'<span data-w="{key}">{html.escape(str(text))}</span>' for key, text in WORDS.items())
+    words += "".join(f'<span data-en="{html.escape(str(text))}">{html.escape(str(text))}</span>' for text in VISER)
     return f'<div data-tpmviz-keys="{nonce}" hidden>{words}</div>'
 
 
 WORDS = {"view": LABEL, "close": CLOSE, "settings": SETTINGS}
+
+VISER = (
+    CLOSE,
+    SETTINGS,
+    T("Collapse panel area"),
+    T("Collapse column"),
+    T("Expand column"),
+    T("Minimize panel"),
+    T("Expand panel"),
+    T("Minimize panels"),
+    T("Expand panels"),
+    T("Collapse"),
+    T("Expand"),
+    T("Minimize"),
+    T("Expand plot"),
+    T("Expand image"),
+    T("Collapse panel {name}"),
+    T("Expand panel {name}"),
+    T("Edit props for {name}"),
+    T("Software WebGL rendering detected"),
+    T(
+        "WebGL is running in software mode, not on your GPU. Performance may be degraded. If this is unexpected, "
+        "check that hardware acceleration is enabled in your browser settings."
+    ),
+)
+"""viser's own English names (``aria-label``, ``title``, tooltip texts, the software-WebGL notice; ``{name}``: a
+panel's or a node's name) that the page script shows in the tab's language (each as ``<span data-en="English">shown
+</span>`` of the hidden element)."""
 
 
 @dataclass
@@ -117,7 +146,7 @@ class Keyboard:
     def join(self, view: Any) -> str:
         """Give ``view`` (a :class:`~tpm_viz.ui.client.ClientView`) its nonce, in a hidden element of its panel."""
         nonce = secrets.token_urlsafe(16)
-        view.client.gui.add_html(_marker(nonce))
+        view.gui.add_html(_marker(nonce))
         with self._lock:
             self._tabs[nonce] = _Tab(view)
             self._nonces[id(view)] = nonce

@@ -87,7 +87,7 @@ LIVE_CHROME = 64
 """Height of that box's frame [CSS px]: its grip, its tab and :data:`LIVE_GAP`; the box, frame included, stays
 within the bottom :data:`~tpm_viz.ui.framing.LIVE_BAND` of the window that the framing keeps free."""
 LIVE_LABEL = T("Warnings and forces")
-"""Tab name of the box of banner and forces (presentation mode; shown in the tab's language on the way out)."""
+"""Tab name of the box of banner and forces (presentation mode; shown in the tab's language by its handle)."""
 
 _PHONE = "(max-width: 36em)"  # viser's mobile breakpoint (Mantine's xs): the panel is a bottom sheet
 _SHEET_CSS = '.mantine-Paper-root[style*="position: fixed"]'  # viser's sheet (its only fixed Paper)
@@ -97,8 +97,13 @@ HANDLE = 48
 """Height of the phone sheet's handle [CSS px] (viser: 3.5em of its 13.3 px type): the canvas is the rest while the
 sheet is collapsed to it."""
 _SHEET_PCT = round(SHEET * 100)
+INSET = 16
+"""Room at the right of the readout and the force column [CSS px]: the panel's scroll bar (11 px, drawn over its
+content) and 5 px to spare, so "N" never touches the panel's edge."""
 PHONE_CSS = f"""<style>
+div:has(> [data-q="banner"]) {{ padding-right: {INSET}px; }}
 @media {_PHONE} {{
+  [data-guide] > div > span {{ max-width: 100%; overflow-wrap: anywhere; }}
   {_SHEET_CSS} {{ width: 100% !important; left: 0 !important; right: 0 !important; }}
   {_SHEET_CSS} {{ max-height: {_SHEET_PCT}vh !important; }}
   {_SHEET_CSS}:has({_OPEN}) {{ height: {_SHEET_PCT}vh !important; }}
@@ -117,13 +122,14 @@ PHONE_CSS = f"""<style>
   .mantine-ActionIcon-root {{ min-width: {BUTTON_TOUCH}px !important; min-height: {BUTTON_TOUCH}px !important; }}
 }}
 </style>"""
-"""The phone layout and touch targets (by viewport and pointer: no switch), in every tab."""
+"""The readout's room at the panel's edge (:data:`INSET`), the phone layout and touch targets (by viewport and
+pointer: no switch), in every tab."""
 
 BANNER_PX = 20
 """Font size of the pose status and its warnings in the box of live numbers [CSS px]."""
 
 PRESENTATION_CSS = f"""<style>
-div:has(> [data-q="banner"]) {{ color: #0f172a; }}
+div:has(> [data-q="banner"]) {{ color: #0f172a; padding-right: {INSET}px; }}
 [data-q="banner"] {{ font-size: {BANNER_PX}px !important; }}
 div:has(> [data-q="banner"]) td {{ font-size: 17px !important; color: #0f172a !important; }}
 div:has(> [data-q="banner"]) > div:last-child, div:has(> [data-q="banner"]) > div:last-child div {{
@@ -199,7 +205,7 @@ class Look:
         self._aspect: float | None = None  # the canvas aspect the camera was last framed for
         self._asks: list[threading.Timer] = []
         self._nudge = 1.0
-        gui = view.client.gui
+        gui = view.gui
         self.style = gui.add_html(PHONE_CSS)
         self.live: Any = None  # the box of banner and forces (a viser panel), made when first needed
         self.live_html: Any = None
@@ -284,11 +290,11 @@ class Look:
         else:
             client.gui.main_panel.expand()
         if on and self.live is None:
-            self.live = client.gui.add_panel()
+            self.live = self.view.gui.add_panel()
             with self.live.add_tab(LIVE_LABEL.template):
-                self.live_html = client.gui.add_html("")
+                self.live_html = self.view.gui.add_html("")
                 # the panel's style sheets are unmounted with it when it collapses: this box carries its own
-                self.live_style = client.gui.add_html("")
+                self.live_style = self.view.gui.add_html("")
             self.live.float(x=LIVE_GAP, y=-LIVE_GAP, width=LIVE_WIDTH)
         if self.live is not None:
             self.live.visible = on

@@ -17,7 +17,7 @@ the metres per reported pixel are at most those per CSS px: the gain computed fr
 gives :data:`MM_PER_PX` per CSS px (at a pixel ratio of 2, half of it).
 
 :data:`TOUCH_CSS` keeps viser's "Software WebGL rendering detected" notice (a computer without a GPU, e.g. headless
-Chromium) to its title in a corner, where it covers neither the mechanism's middle nor the handle.
+Chromium) to a one-line strip of its title at the canvas's top edge, clear of the mechanism and the handle.
 """
 
 from __future__ import annotations
@@ -29,6 +29,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from tpm_viz.viserkit.page import NOTICE_CSS
+
 __all__ = ["MM_PER_PX", "TOUCH_CSS", "TOUCH_GIZMO_PX", "TOUCH_SQUARE", "drag_gain", "is_touch"]
 
 TOUCH_GIZMO_PX = 400.0
@@ -39,12 +41,9 @@ MM_PER_PX = 1.0
 """Most platform travel [mm] per CSS px of a finger's drag on a touch tab."""
 _MOBILE = re.compile(r"Mobi|Android|iPhone|iPad|iPod", re.IGNORECASE)
 
-TOUCH_CSS = """<style>
-#webgl-software-rendering { max-width: 15em !important; padding: 2px 8px !important; }
-#webgl-software-rendering .mantine-Notification-description { display: none !important; }
-#webgl-software-rendering .mantine-Notification-title { font-size: 11px !important; margin: 0 !important; }
-</style>"""
-"""viser's software-WebGL notice reduced to its title, 15em wide at most, in its corner (every tab)."""
+TOUCH_CSS = f"<style>{NOTICE_CSS}</style>"
+"""viser's software-WebGL notice as a one-line strip at the canvas's top-left corner in a touch tab, whatever its width
+(the page script does the same in every window at most 36em wide or with a coarse pointer)."""
 
 
 def is_touch(request: tuple[Any, Any] | None) -> bool:
