@@ -10,6 +10,7 @@ from __future__ import annotations
 import threading
 import time
 import uuid
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -277,3 +278,19 @@ def test_a_keystroke_not_yet_seen_by_the_tab_is_never_written_over(connect):
         assert handle.value == "4" and box.group.typing
         box.show({"p1": 12.0, "p2": 20.0}, force=True)  # new values asked for elsewhere (e.g. the paper's)
         assert handle.value == "12"
+
+
+def test_a_frame_drawn_while_a_slider_input_is_on_its_way_does_not_turn_it_into_an_echo(connect):
+    """A student moves d2 to 250 mm right after *Work on my own copy*: viser stores the value on arrival, then a
+    frame of the (unchanged) copy is drawn before the slider's callback runs. The frame must not write 130 mm back
+    over it, or the callback reads the server's own value, takes it for an echo and the input is lost (seen under
+    load in tests/system/test_security.py). The state after the callback: 250 mm."""
+    client, view = connect()
+    slider = view.panel.d[1]
+    assert slider.value == pytest.approx(130.0)
+    with view.hub.lock:
+        arrive(slider, 250.0)  # arrived; its callback not run yet
+        view.render(view.session.frame)  # a frame of the unchanged state, drawn meanwhile
+        assert slider.value == 250.0 and not view.panel.is_echo(slider)
+    view._on_d(SimpleNamespace(client=view.client), 1)  # then the callback viser queued for that message runs
+    assert view.session.state.pose.d[1] == pytest.approx(0.25, abs=1e-12)

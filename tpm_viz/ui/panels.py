@@ -366,7 +366,11 @@ class Panel:
         self._written.clear()
 
     def _put(self, handle, value) -> None:
-        """Write a widget value and remember it (see :meth:`is_echo`)."""
+        """Write a widget value and remember it (see :meth:`is_echo`). The value the server wrote last is not
+        written again over one the page sent since: that input's callback is on its way and applies it (or refuses
+        it and shows the state again); writing first would make it look like an echo and lose it."""
+        if self._written.get(id(handle), _UNSET) == value and handle.value != value:
+            return
         handle.value = value
         self._written[id(handle)] = handle.value
 
