@@ -17,6 +17,7 @@ appended in their usual order, after the ones built first: the tab looks the sam
 from __future__ import annotations
 
 import functools
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -36,6 +37,15 @@ from tpm_viz.ui.teaching.player import PlayerView
 from tpm_viz.ui.teaching.playing import RunHub
 from tpm_viz.ui.teaching.takeout import TakeOut, takeout_for
 from tpm_viz.ui.worded import Tabs
+
+
+def _open_if_open(opener: weakref.WeakMethod, group: str) -> None:
+    """A deferred build that does not keep its tab alive: a tab that left before the quiet moment is freed at once
+    (a storm of short visits leaves no waiting job holding a whole tab)."""
+    open_ = opener()
+    if open_ is not None:
+        open_(group)
+
 
 __all__ = ["LATER", "Services", "Teaching"]
 
@@ -211,7 +221,7 @@ class Teaching:
             later.arrived()
             for group in LATER:
                 if not self.built(group):
-                    later.add(functools.partial(self.open, group))
+                    later.add(functools.partial(_open_if_open, weakref.WeakMethod(self.open), group))
 
     def switched(self, old: Session) -> None:
         """The tab moved from ``old`` to its current session (own copy on / off)."""
