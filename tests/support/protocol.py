@@ -239,8 +239,9 @@ class Tab:
             await asyncio.wait([self._reader], timeout=5.0)
 
 
-def wait_for(predicate, timeout: float = 10.0, interval: float = 0.01, what: str = "condition"):
-    """Poll ``predicate`` until it returns a truthy value (returned) or fail after ``timeout`` seconds."""
+def wait_for(predicate, timeout: float = 30.0, interval: float = 0.01, what: str = "condition"):
+    """Poll ``predicate`` until it returns a truthy value (returned) or fail after ``timeout`` seconds (a bound,
+    not a speed: 30 s holds while a second full run loads the machine, where 10 s did not always)."""
     deadline = time.monotonic() + timeout
     while True:
         value = predicate()
