@@ -112,7 +112,10 @@ def test_presentation_mode_styles_this_tabs_lines_and_labels_only(connect):
     client.enter(view.panel.params, {"l_a": "280"})  # the shared drawing is rebuilt: its copies too
     wait_for(lambda: view.session.state.params.l_a == pytest.approx(0.28), what="l_a = 280 mm")
     wait_for(
-        lambda: np.array_equal(view.scene._styled["/tpm/loci/direct"].points, shared.loci[-1].points),
+        lambda: (
+            (c := view.scene._styled.get("/tpm/loci/direct")) is not None  # gone for a moment while rebuilt
+            and np.array_equal(c.points, shared.loci[-1].points)
+        ),
         what="the direct locus copied again for the new links",
     )
 
