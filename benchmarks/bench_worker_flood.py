@@ -38,6 +38,7 @@ from timing import p95
 from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz.app.overlays import MAP_KINDS
 from tpm_viz.classroom import worker
+from tpm_viz.classroom.runtime import tune_for_serving
 from tpm_viz.ui.app import TpmApp, build_server
 
 FLOODERS = 10
@@ -182,6 +183,7 @@ def main() -> None:
     print(f"pool: {getattr(worker, 'THREADS', 'one worker and one planner')} thread(s)")
     waits = Waits()
     app = TpmApp(build_server("127.0.0.1", 0))
+    tune_for_serving()  # the runtime as python app.py sets it up
     clients = []
     try:
         flooders = [open_tab(app) for _ in range(FLOODERS)]

@@ -3,10 +3,14 @@ logged without stopping the next job."""
 
 from __future__ import annotations
 
+import gc
+import sys
 import threading
+import time
+import weakref
 
 from tests.support.protocol import wait_for
-from tpm_viz.classroom import guard
+from tpm_viz.classroom import guard, runtime
 from tpm_viz.classroom.later import Later
 
 
@@ -47,3 +51,49 @@ def test_a_queue_past_its_limit_runs_the_oldest_job_at_once_never_drops_one():
     later.add(lambda: ran.append(3))
     wait_for(lambda: later.pending() == 0, what="the rest")
     assert ran == [0, 1, 2, 3]
+
+
+class _Cycle:
+    """Garbage only the cyclic collector frees (as a closed tab's view: its handles' callbacks point back at it)."""
+
+    def __init__(self) -> None:
+        self.me = self
+
+
+def test_tidy_frees_cyclic_garbage_at_the_next_quiet_moment_once():
+    gc.disable()  # the collector's own schedule must not free it first
+    try:
+        later = Later(quiet=3600.0)
+        later.arrived()  # a storm is on
+        left = _Cycle()
+        gone = weakref.ref(left)
+        del left
+        later.tidy()
+        later.tidy()  # a second tab leaving adds no second collection
+        assert later.pending() == 1
+        time.sleep(0.2)
+        assert gone() is not None  # not while tabs are arriving
+        later.quiet = 0.0
+        later.add(lambda: None)  # wakes the thread
+        wait_for(lambda: later.pending() == 0, what="the collection")
+        assert gone() is None
+        again = _Cycle()
+        gone = weakref.ref(again)
+        del again
+        later.tidy()  # the next departure is collected again (the first collection cleared the flag)
+        wait_for(lambda: gone() is None, what="the second collection")
+    finally:
+        gc.enable()
+
+
+def test_tune_for_serving_sets_the_collector_and_the_switch_interval():
+    thresholds, switch = gc.get_threshold(), sys.getswitchinterval()
+    try:
+        runtime.tune_for_serving()
+        assert gc.get_threshold() == (10_000, 10, 100)
+        assert abs(sys.getswitchinterval() - 0.001) < 1e-9
+        assert gc.get_freeze_count() > 10_000  # the start-up heap (numpy, ...) is out of every full collection
+    finally:
+        gc.unfreeze()
+        gc.set_threshold(*thresholds)
+        sys.setswitchinterval(switch)

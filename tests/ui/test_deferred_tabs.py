@@ -5,9 +5,12 @@ arrives with its copy ticked and drawn before them; whoever asks for a deferred 
 
 from __future__ import annotations
 
+import gc
 import re
 import threading
+import weakref
 
+from tests.support.fixtures import open_tab
 from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz.app.sessions import Saved
 from tpm_viz.classroom.later import Later
@@ -181,3 +184,19 @@ def test_a_returning_own_copy_comes_with_its_copy_before_its_deferred_tabs(app, 
         app.services.later = later
         for client in opened:
             client.close()
+
+
+def test_a_closed_tab_is_freed_by_the_app_without_the_collectors_schedule(app):
+    client, view = open_tab(app, [])
+    gone = weakref.ref(view)
+    del view
+    later = app.services.later
+    wait_for(lambda: later.pending() == 0, what="the tab's deferred tabs")
+    gc.disable()
+    try:
+        count = len(app.views)
+        client.close()
+        wait_for(lambda: len(app.views) < count, what="the app to drop the closed tab")
+        wait_for(lambda: gone() is None, what="the closed tab's view to be collected")
+    finally:
+        gc.enable()

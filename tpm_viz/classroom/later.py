@@ -8,12 +8,16 @@ on a thread of its own once no tab has arrived for :data:`QUIET` seconds: the st
 tabs. A job is also run at once by whoever needs its result (a test or a lesson asking for the player: the job's
 owner makes it idempotent), so nothing ever depends on the timing here.
 
+A tab that leaves asks for a collection of its garbage at the next quiet moment (:meth:`Later.tidy`), so that it is
+not collected in the middle of the next storm.
+
 Bounded: at most :data:`LIMIT` jobs wait (a job beyond it is run by the thread at once, never dropped); the thread
 exists only while jobs wait.
 """
 
 from __future__ import annotations
 
+import gc
 import threading
 import time
 from collections import deque
@@ -41,6 +45,7 @@ class Later:
         self._last = float("-inf")  # time.monotonic() of the last arrival
         self._thread: threading.Thread | None = None
         self._running = 0
+        self._tidying = False  # a collection of the garbage of tabs that left is waiting
 
     def arrived(self) -> None:
         """A tab arrived (its build is starting): waiting jobs give it the next :data:`QUIET` seconds."""
@@ -58,6 +63,22 @@ class Later:
             self._cond.notify_all()
         if urgent:  # a queue this long is a bug or an attack: the oldest job runs now on this thread
             self._take_and_run()
+
+    def tidy(self) -> None:
+        """A tab left: collect the garbage it left (its view's reference cycles, a few thousand objects that only
+        Python's cyclic collector frees) once, at the next quiet moment. Left to the collector's own schedule, the
+        garbage of 100 tabs is freed by a full collection of ~0.3-0.7 s in the middle of the next storm."""
+        with self._cond:
+            self._last = max(self._last, time.monotonic())  # after the departure is over, like an arrival's
+            if self._tidying:
+                return
+            self._tidying = True
+        self.add(self._tidy)
+
+    def _tidy(self) -> None:
+        with self._cond:
+            self._tidying = False
+        gc.collect()
 
     def pending(self) -> int:
         """Jobs waiting or running (tests and benchmarks wait for 0)."""

@@ -14,7 +14,6 @@ guarded (:mod:`.guard`): one bad tab never stops the server.
 
 from __future__ import annotations
 
-import gc
 import ipaddress
 import logging
 import signal
@@ -35,6 +34,7 @@ from tpm_viz.app.state import AppState
 from tpm_viz.classroom.access import Access
 from tpm_viz.classroom.guard import guarded, log, log_fault, report
 from tpm_viz.classroom.identity import Keys
+from tpm_viz.classroom.runtime import tune_for_serving
 from tpm_viz.classroom.session import Hub
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.params import Params
@@ -188,6 +188,8 @@ class TpmApp:
             self.room.leaving(view)  # kept 30 minutes for a tab that comes back
             self.access.logout(view)
             view.close()
+            if self.services.later is not None:
+                self.services.later.tidy()  # its garbage freed at the next quiet moment, not in the next storm
 
     @guarded
     def _login(self, event, view: ClientView) -> None:
@@ -330,9 +332,7 @@ def main(
     keys = None if store is None else store.keys
     server = build_server(host, port, HostRules(network, addresses or local_addresses, bound=host), keys)
     app = TpmApp(server, presenter_token=presenter_token, classroom=room, store=store, lessons=tour)
-    gc.collect()
-    gc.freeze()  # the start-up heap (numpy, trimesh, Pinocchio, viser) is never scanned again: full collections
-    # with 30 tabs take ~7 ms instead of ~90 ms (a pause every tab would feel in the middle of a drag)
+    tune_for_serving()  # the collector and the threads' turns of a serving process (classroom/runtime.py)
     if not block:
         _serving(app, host, room)
         return app
