@@ -247,6 +247,9 @@ def test_too_many_tabs_are_told_and_closed():
         assert getattr(closed, "rcvd", None) is not None and closed.rcvd.code == 1013
         assert len(application.views) == 2
         clients.pop().close()
+        guard = guard_of(application.server)
+        assert guard is not None
+        wait_for(lambda: len(guard.accepted) == 1, what="the closed tab's place freed")  # not before: refused again
         clients.append(ProtocolClient(application.port))  # a place is free again
         wait_for(lambda: len(application.views) == 2 and len(application.server.get_clients()) == 2, what="a new tab")
     finally:

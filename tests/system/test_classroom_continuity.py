@@ -187,14 +187,16 @@ def test_a_restart_finds_the_lecturers_state(tmp_path):
         wait_for(lambda: page.value("Time t (s)") == pytest.approx(0.1), what="the player time from the file")
         page.set("l_a, link length (mm)", "275")  # the lecturer's changes after the start
         page.set("Apply parameters", True)
-        deadline = time.monotonic() + 30
-        while time.monotonic() < deadline:  # saved within SAVE_SECONDS
+
+        def saved() -> bool:  # within SAVE_SECONDS of each change
             shared, _ = stored_lecture(store) or (None, 0)
             if shared is not None and shared.state.params.l_a == pytest.approx(0.275):
                 if shared.state.trajectory.t == 0.2:
-                    break
+                    return True
                 page.set("Time t (s)", 0.2)  # again until the run recomputed for the new mechanism takes it
-            time.sleep(0.5)
+            return False
+
+        wait_for(saved, interval=0.5, what="the lecturer's changes saved")
         page.close()
     finally:
         first.stop()

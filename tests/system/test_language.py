@@ -149,19 +149,20 @@ def test_a_restart_brings_a_tab_back_in_its_language(tmp_path):
         page = Shown(first.port, cookie=cookie)
         page.set("Language", "한국어")
         wait_for(lambda: page.uuid("파라미터 적용"), what="Korean")
-        deadline = time.monotonic() + 15
-        while time.monotonic() < deadline:  # the live tab is saved within SAVE_SECONDS
-            tabs = stored_tabs(path, time.time())
-            if any(r["saved"].lang == "ko" for records in tabs.values() for r in records):
-                break
-            time.sleep(0.2)
+        wait_for(  # the live tab is saved within SAVE_SECONDS (a bound of 30 s holds on a loaded machine)
+            lambda: any(
+                r["saved"].lang == "ko" for records in stored_tabs(path, time.time()).values() for r in records
+            ),
+            interval=0.2,
+            what="the tab saved in Korean",
+        )
         page.close()
     finally:
         first.stop()
     second = ServerProcess(session=path)  # same file, new process
     try:
         back = Shown(second.port, cookie=cookie)
-        wait_for(lambda: back.uuid("파라미터 적용"), timeout=20, what="the tab back in Korean after the restart")
+        wait_for(lambda: back.uuid("파라미터 적용"), what="the tab back in Korean after the restart")
         back.close()
     finally:
         second.stop()

@@ -206,6 +206,10 @@ def test_a_refused_upload_gets_no_success_toast_and_its_refusal_is_under_the_upl
         bad = b"t,p1,p2\n0,0,0\n0.1,0.1,0\n0.2,0.4,0\n0.3,0.1,0\n"  # 400 mm: out of reach
         transfer = _upload(client, player.upload, "far.csv", bad)
         wait_for(lambda: "out of reach" in player.note.handle.content, what="the refusal under the upload button")
+        wait_for(  # the server's state first, then what it sent: wait for the acknowledgement to arrive too
+            lambda: any(m.get("transfer_uuid") == transfer and m["type"] == "FileTransferPartAck" for m in client.seen),
+            what="the upload's acknowledgement",
+        )
         with client.lock:
             seen = [
                 m for m in client.seen if m.get("transfer_uuid") == transfer or m.get("uuid") == f"upload-{transfer}"

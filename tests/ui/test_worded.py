@@ -191,3 +191,19 @@ def test_an_element_made_outside_the_list_is_refused(plain_gui):
     with pytest.raises(AttributeError, match="add_image"):
         gui.add_image  # noqa: B018  (viser's, untranslated: not offered)
     assert gui.main_panel is not None  # everything else is viser's
+
+
+@pytest.mark.slow  # a served app
+def test_a_choice_that_arrives_during_a_language_switch_is_not_written_over(app):
+    """The page's choice is stored by viser before its callback runs; the switch's redraw of the panel must not
+    write the state's value over it (it did: the callback then read the old value as an echo and the choice was
+    lost, seen on a loaded machine in tests/system/test_language.py)."""
+    tab, view = _open(app, "en")
+    try:
+        with view.hub.lock:  # the callback waits for the lock while the switch runs, as it would
+            arrive(view.panel.load_mode.handle, "dynamic")  # the page's choice, not handled yet
+            view.words.set(Lang.KO)
+            assert view.panel.load_mode.value == "dynamic"  # still the choice the page sent
+        wait_for(lambda: view.lang is Lang.KO, what="Korean")
+    finally:
+        _close(app, tab)

@@ -182,10 +182,12 @@ class TpmApp:
     @guarded
     def _disconnect(self, client: viser.ClientHandle) -> None:
         with self._views_lock:
-            view = self.views.pop(client.client_id, None)
+            view = self.views.get(client.client_id)
         if view is not None:
+            self.room.leaving(view)  # kept 30 minutes for a tab that comes back: kept before the tab is gone
+            with self._views_lock:
+                self.views.pop(client.client_id, None)
             self.keyboard.leave(view)
-            self.room.leaving(view)  # kept 30 minutes for a tab that comes back
             self.access.logout(view)
             view.close()
             if self.services.later is not None:

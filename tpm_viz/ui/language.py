@@ -83,7 +83,7 @@ class TabWords:
     def _redraw(self) -> None:
         """The live parts of the tab (dashboard, equations, the teaching tabs' texts) drawn again in its language."""
         view = self.view
-        view.panel.forget()
+        view.panel.forget(inputs=False)  # a choice the page sent during the switch still reaches its callback
         frame = view.session.frame
         if frame is not None:
             view.render(frame)

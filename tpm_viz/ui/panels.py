@@ -360,10 +360,11 @@ class Panel:
             "params": self.params,
         }
 
-    def forget(self) -> None:
-        """Write every widget again at the next :meth:`show` (after a refused input left the browser's value)."""
+    def forget(self, inputs: bool = True) -> None:
+        """Write every widget again at the next :meth:`show` (``inputs=False``: not over what the page sent since)."""
         self._shown_params = self._shown_load = None
-        self._written.clear()
+        if inputs:
+            self._written.clear()
 
     def _put(self, handle, value) -> None:
         """Write a widget value and remember it (see :meth:`is_echo`). The value the server wrote last is not
