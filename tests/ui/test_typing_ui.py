@@ -160,8 +160,10 @@ def test_the_field_follows_the_value_in_use_unless_it_is_being_typed_in(connect)
     client, view = connect()
     other_client, other = connect()
     other_client.enter(other.panel.p, {"p1": "30", "p2": "20"})  # another tab moves the shared platform
-    wait_for(lambda: view.panel.p.inputs["p1"].value == "30", what="p1 shown in this tab")
-    assert view.panel.p.inputs["p2"].value == "20"
+    wait_for(  # both: on a loaded machine the other tab's quiet time may apply p1 before its p2 arrives
+        lambda: (view.panel.p.inputs["p1"].value, view.panel.p.inputs["p2"].value) == ("30", "20"),
+        what="p = (30, 20) shown in this tab",
+    )
     client.set_value(view.panel.p.inputs["p1"], "4")  # this tab starts typing
     other_client.enter(other.panel.p, {"p1": "10"})
     wait_for(lambda: np.allclose(_state(view).pose.p, (0.01, 0.02)), what="the other tab's move")
