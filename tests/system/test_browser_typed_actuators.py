@@ -52,7 +52,7 @@ def test_typing_1_5e2_into_d1_puts_the_actuator_at_150_mm(app, browser):
     x, y = node_positions(page, frames)[-1][:2]
     assert (x, y) == (pytest.approx(0.15 - A, abs=1e-12), pytest.approx(0.0, abs=1e-12))  # on rail 1, eq. (1)
     wait_for(lambda: page.locator("[data-q=d1]").first.inner_text().startswith("150.0"), what="the readout")
-    assert field.input_value() == "1.5e2"  # the text typed stays: it means the value in use
+    wait_for(lambda: field.input_value() == "1.5e2", what="the text typed, kept: it means the value in use")
 
     # Beyond the stroke: refused under the fields, in mm; the actuator stays.
     time.sleep(PAUSE)
