@@ -10,6 +10,7 @@ import math
 import threading
 
 import msgspec
+import numpy as np
 import pytest
 from websockets.exceptions import ConnectionClosed
 
@@ -22,6 +23,7 @@ from tpm_viz.viserkit.probe import (
     event_loop,
     gizmo_echoes,
     messages,
+    props_api,
     share_tunnel,
     thread_pool,
     tunnel_class,
@@ -127,6 +129,35 @@ def test_serialization(serve, tab, monkeypatch, on):
     tabs = [tab(server) for _ in range(4)]
     _broadcast_to(server, tabs)
     assert max(counts.values()) == (1 if on else 4), counts
+
+
+@ON_OFF
+def test_casts(serve, tab, monkeypatch, on):
+    """viser asks ``np.allclose`` whether each new node's pose changed, and builds four ``npt.NDArray`` aliases for
+    each property write; the casts patch does the same checks on plain floats and prebuilt aliases (a returning tab's
+    own copy: ~40 nodes, its panel ~400 writes)."""
+    server, _ = serve(skip=set() if on else {"casts"})
+    tab(server)
+    (client,) = server.get_clients().values()
+    calls = collections.Counter()
+    allclose, aliases = np.allclose, props_api.npt
+
+    class Aliases:
+        """numpy.typing as viser's props module sees it, counting ``NDArray[...]``."""
+
+        class NDArray:
+            def __class_getitem__(cls, kind):
+                calls["alias"] += 1
+                return aliases.NDArray[kind]
+
+    monkeypatch.setattr(np, "allclose", lambda *a, **k: (calls.update(["allclose"]), allclose(*a, **k))[1])
+    monkeypatch.setattr(props_api, "npt", Aliases)
+    frame = client.scene.add_frame("/probe", show_axes=False, position=(0.1, 0.2, 0.0))
+    frame.position = (0.3, 0.2, 0.0)
+    button = client.gui.add_button("Probe")
+    button.label = "Probe again"
+    assert tuple(frame.position) == (0.3, 0.2, 0.0) and button.label == "Probe again"
+    assert (calls["allclose"], calls["alias"]) == (0, 0) if on else calls["allclose"] >= 3 and calls["alias"] >= 4
 
 
 @ON_OFF

@@ -40,6 +40,7 @@ from tpm_viz.ui.framing import LIVE_BAND, frame_box
 from tpm_viz.ui.language import KEEP_ALL
 from tpm_viz.ui.panels import FOLDED
 from tpm_viz.ui.scene import camera_pose
+from tpm_viz.viserkit.core import point_camera
 from tpm_viz.words import Lang, T
 
 __all__ = [
@@ -183,8 +184,7 @@ def frame_camera(client: viser.ClientHandle, params: Params, presentation: bool 
     else:
         framing = frame_box(*mechanism_box(params), canvas[0], canvas[1], presentation)
         position, look_at = framing.position, framing.look_at
-    client.camera.position = position
-    client.camera.look_at = look_at
+    point_camera(client.camera, position, look_at)  # viser's two setters in one step (viserkit/core.py)
     return None if canvas is None else canvas[1]
 
 

@@ -24,7 +24,7 @@ from tpm_viz.viserkit.wire import Handshake
 
 __all__ = ["PATCHES", "Installed", "install", "installed_on", "new_server"]
 
-PATCHES = ("share_url", "wakeups", "senders", "serialization", "callbacks", "limits", "frames", "decoding")
+PATCHES = ("share_url", "wakeups", "senders", "serialization", "casts", "callbacks", "limits", "frames", "decoding")
 """The patches :func:`install` puts on a server, in this order (names for ``skip``). Besides them: ``handshakes``
 (:func:`new_server`'s ``handshake``), ``transport`` (each tab's filters, :func:`~.transport.harden`, a no-op when
 skipped) and ``gizmo_echo`` (:func:`~.core.drop_gizmo_echo`, a no-op when skipped)."""
@@ -106,7 +106,7 @@ def install(server: viser.ViserServer, *, skip: frozenset[str] | set[str] = froz
     )
     if done.guard is not None and loop_patches.max_frame_bytes is not None:
         loop_patches.max_frame_bytes = done.guard.limits.max_frame_bytes
-    patches.register(server, loop, loop_patches, skip)  # guarded class-level: frames, decoding, producer, hints
+    patches.register(server, loop, loop_patches, skip)  # guarded class-level: frames, decoding, producer, hints, casts
     done._undo.append(lambda: patches.unregister(server, loop))
     setattr(server, _ATTR, done)
     return done

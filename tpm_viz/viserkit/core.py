@@ -14,6 +14,8 @@ tpm-viz needs these things viser's public API does not offer:
   message dispatch (``_handle_incoming_message``, wrapped to drop malformed messages), its message buffers (the
   shared one and each tab's: :mod:`.patches` puts the senders' patches on them), its outgoing backlog
   (``_client_state_from_id``), the raw connections (``_live_connections``, to refuse or drop a tab);
+- a tab's camera pointed in one step (:func:`point_camera`: viser's two setters compute its orientation twice and
+  ask ``np.allclose`` four times, a tenth of a reconnect storm's CPU);
 - a tab's handshake headers (:func:`client_request`), a tab's label (:func:`relabel_tab`: viser's ``GuiTabHandle`` has
   no setter) and whether a handle was removed with its container (:func:`removed`), for :mod:`tpm_viz.ui.worded`.
 
@@ -25,17 +27,19 @@ one line saying what to install, instead of serving blank pages. ``tests/viserki
 from __future__ import annotations
 
 import asyncio
+import time
 import uuid
 from collections.abc import Callable
 from typing import Any, cast
 
+import numpy as np
 import viser
 from viser import _messages
 from viser.infra import _infra
 from viser.infra._async_message_buffer import AsyncMessageBuffer
 
 from tpm_viz.errors import TpmVizError
-from tpm_viz.viserkit import wire
+from tpm_viz.viserkit import casts, wire
 from tpm_viz.viserkit.patches import skipped
 from tpm_viz.viserkit.wire import Malformed
 
@@ -43,7 +47,7 @@ ws_server = _infra.websockets.asyncio.server  # websockets' server, as viser imp
 
 __all__ = ["TESTED", "ClientDoor", "IncompatibleViserError", "Malformed", "ServerDoor", "check_viser"]
 __all__ += ["client_request", "connection_request", "disable_share_url", "drop_gizmo_echo", "enable_share_url"]
-__all__ += ["relabel_tab", "removed", "thread_pool", "widget_uuid", "widget_value", "ws_server"]
+__all__ += ["point_camera", "relabel_tab", "removed", "thread_pool", "widget_uuid", "widget_value", "ws_server"]
 
 TESTED = "1.1"
 """The viser minor version tpm-viz is tested with (``pyproject.toml`` pins ``viser>=1.1.1,<1.2``)."""
@@ -57,7 +61,8 @@ _WEBSOCK_ATTRS: tuple[str, ...] = (
 )
 _WEBSOCK_ATTRS += ("_client_connect_cb", "_client_disconnect_cb")
 _GUI_METHODS = ("_handle_gui_updates", "_handle_file_transfer_start", "_handle_file_transfer_part")
-_MESSAGES = ("GuiUpdateMessage", "FileTransferStartUpload", "FileTransferPart")
+_MESSAGES: tuple[str, ...] = ("GuiUpdateMessage", "FileTransferStartUpload", "FileTransferPart")
+_MESSAGES += ("SetCameraPositionMessage", "SetCameraLookAtMessage")
 
 
 class IncompatibleViserError(TpmVizError):
@@ -81,6 +86,8 @@ def check_viser(version: str | None = None) -> None:
         if not hasattr(_infra, f)
     ]
     missing += [] if hasattr(AsyncMessageBuffer, "_window_loop") else ["AsyncMessageBuffer._window_loop"]
+    missing += casts.missing()
+    missing += [] if hasattr(viser.CameraHandle, "_update_wxyz") else ["CameraHandle._update_wxyz"]
     if not hasattr(ws_server, "ServerProtocol"):
         missing.append("websockets.asyncio.server.ServerProtocol")
     if missing:
@@ -284,6 +291,30 @@ def connection_request(server: viser.ViserServer, client_id: int) -> tuple[Any, 
 def client_request(client: viser.ClientHandle) -> tuple[Any, Any] | None:
     """:func:`connection_request` of a tab's own connection (its ``Accept-Language``: the tab's first language)."""
     return connection_request(client._viser_server, client.client_id)
+
+
+def point_camera(camera: viser.CameraHandle, position: Any, look_at: Any) -> None:
+    """``camera.position = position`` then ``camera.look_at = look_at`` (the same state and the same final messages,
+    [m]) with the orientation computed once. Raises ValueError for a non-finite point or ``position == look_at``
+    (the camera left as it was)."""
+    state = camera._state
+    new_position = np.asarray(position, dtype=np.float64)
+    new_look_at = np.asarray(look_at, dtype=np.float64)
+    if not (np.all(np.isfinite(new_position)) and np.all(np.isfinite(new_look_at))):
+        raise ValueError(f"Camera position and look_at must be finite, got {new_position} and {new_look_at}.")
+    place, aim = casts.cast_vector(new_position, 3), casts.cast_vector(new_look_at, 3)
+    if casts.close(place, state.position.tolist()) and casts.close(aim, state.look_at.tolist()):
+        return
+    before = (state.position, state.look_at, state.update_timestamp)
+    state.position, state.look_at, state.update_timestamp = new_position, new_look_at, time.time()
+    try:
+        camera._update_wxyz()
+    except Exception:
+        state.position, state.look_at, state.update_timestamp = before
+        raise
+    queue = state.client._websock_connection.queue_message
+    queue(_messages.SetCameraPositionMessage(cast(Any, place)))
+    queue(_messages.SetCameraLookAtMessage(cast(Any, aim)))
 
 
 def relabel_tab(tab: Any, label: str) -> None:

@@ -12,7 +12,9 @@ process, by functions that do what the original does unless the object at hand b
 - ``websockets.asyncio.server.ServerProtocol``: on a registered loop, a smaller frame limit and no HTTP 500
   (:class:`GuardedProtocol`); elsewhere every method is the original's;
 - ``AssignablePropsBase._prop_hints``: a handle of a registered server reads its props' types from a cache per props
-  class; any other handle from viser's own per-handle cache.
+  class; any other handle from viser's own per-handle cache;
+- ``viser._scene_handles._set_pose_vector`` and ``AssignablePropsBase._cast_value_recursive``: for a handle of a
+  registered server, the same checks on plain floats and prebuilt aliases (:mod:`.casts`); for any other, viser's.
 
 ``websockets.asyncio.server.serve`` is replaced only while :func:`building` is entered, and hooks only the server
 built inside it (found by its event loop). :func:`unregister` puts every original back once no server is left.
@@ -32,10 +34,10 @@ from collections.abc import Callable, Iterator
 from typing import Any, cast, get_type_hints
 
 import viser
-from viser import _assignable_props_api, _messages
+from viser import _assignable_props_api, _messages, _scene_handles
 from viser.infra import _infra
 
-from tpm_viz.viserkit import wire
+from tpm_viz.viserkit import casts, wire
 from tpm_viz.viserkit.wakeups import Wakeups, thread_safe_set
 from tpm_viz.viserkit.windows import Encode, Frames, Tick, encoder, producer, window_loop
 from tpm_viz.viserkit.wire import Malformed
@@ -69,6 +71,7 @@ class LoopPatches:
 _LOOPS: weakref.WeakKeyDictionary[asyncio.AbstractEventLoop, LoopPatches] = weakref.WeakKeyDictionary()
 _SKIPS: weakref.WeakKeyDictionary[viser.ViserServer, frozenset[str]] = weakref.WeakKeyDictionary()
 _HINTED: weakref.WeakSet[viser.ViserServer] = weakref.WeakSet()
+_CAST: weakref.WeakSet[viser.ViserServer] = weakref.WeakSet()
 _WAKEUPS: weakref.WeakKeyDictionary[asyncio.AbstractEventLoop, Wakeups] = weakref.WeakKeyDictionary()
 _LOCK = threading.RLock()  # re-entrant: a server collected while it is held restores under it
 
@@ -90,6 +93,21 @@ def _prop_hints(self: Any) -> dict[str, Any]:
         hints: dict[str, Any] = _HINTS(cast(Any, type(self._impl.props)))
         return hints
     return cast("dict[str, Any]", _ORIGINAL["hints"].__get__(self, type(self)))
+
+
+def _set_pose_vector(current: Any, value: Any, length: int, queue: Any, make_message: Any) -> None:
+    api = getattr(queue, "__self__", None)  # the scene API whose node this is
+    owner = getattr(api, "_owner", None)
+    if getattr(owner, "_viser_server", owner) in _CAST:
+        casts.set_pose_vector(current, value, length, queue, make_message)
+    else:
+        casts.VISER["pose"](current, value, length, queue, make_message)
+
+
+def _cast_value_recursive(self: Any, hint: Any, value: Any, prop_name: str) -> Any:
+    if _owner_server(self) in _CAST:
+        return casts.cast_value(hint, value, prop_name)
+    return casts.VISER["cast"](self, hint, value, prop_name)
 
 
 async def _message_producer(
@@ -188,6 +206,8 @@ def _put_guards() -> None:
     _infra._message_consumer = _message_consumer
     ws_server.ServerProtocol = GuardedProtocol
     _Props._prop_hints = property(_prop_hints)  # type: ignore[assignment]
+    _Props._cast_value_recursive = _cast_value_recursive  # type: ignore[method-assign]
+    _scene_handles._set_pose_vector = _set_pose_vector
 
 
 def _put_originals() -> None:
@@ -195,6 +215,8 @@ def _put_originals() -> None:
     _infra._message_consumer = _ORIGINAL["consumer"]
     ws_server.ServerProtocol = _ORIGINAL["protocol"]
     _Props._prop_hints = _ORIGINAL["hints"]  # type: ignore[method-assign]
+    _Props._cast_value_recursive = casts.VISER["cast"]  # type: ignore[method-assign]
+    _scene_handles._set_pose_vector = casts.VISER["pose"]
 
 
 def register(
@@ -210,6 +232,8 @@ def register(
         weakref.finalize(server, _restore_if_none)  # a server collected without unregister: originals back
         if "serialization" not in skip:
             _HINTED.add(server)
+        if "casts" not in skip:
+            _CAST.add(server)
 
 
 def unregister(server: viser.ViserServer, loop: asyncio.AbstractEventLoop | None) -> None:
@@ -217,6 +241,7 @@ def unregister(server: viser.ViserServer, loop: asyncio.AbstractEventLoop | None
     with _LOCK:
         _SKIPS.pop(server, None)
         _HINTED.discard(server)
+        _CAST.discard(server)
         if loop is not None:
             _LOOPS.pop(loop, None)
             _WAKEUPS.pop(loop, None)

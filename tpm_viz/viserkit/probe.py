@@ -2,6 +2,7 @@
 private viser or websockets name is written outside :mod:`tpm_viz.viserkit`.
 
 - :data:`messages`: viser's message classes (its ``_messages`` module), to build what a browser would send;
+  :data:`props_api`, the module of its handles' property writes;
 - message buffers as viser makes them (:func:`message_buffer`) or with tpm-viz's senders on them
   (:func:`lean_buffer`), viser's own window loop and serialisation (:data:`VISER_WINDOW_LOOP`,
   :data:`VISER_SERIALIZE`) and the shared one (:func:`shared_serialize`), its buffer alignment (:func:`align`);
@@ -17,7 +18,7 @@ from typing import Any
 
 import viser
 import viser._tunnel
-from viser import _messages
+from viser import _assignable_props_api, _messages
 from viser.infra import _infra
 from viser.infra._async_message_buffer import AsyncMessageBuffer
 
@@ -27,10 +28,12 @@ from tpm_viz.viserkit.core import ServerDoor, thread_pool, widget_uuid, widget_v
 __all__ = ["VISER_SERIALIZE", "VISER_WINDOW_LOOP", "align", "arrive", "connection_states", "lean_buffer"]
 __all__ += ["message_buffer", "messages", "shared_serialize", "tunnel_class", "upload_states", "widget_uuid"]
 __all__ += ["event_loop", "gizmo_echoes", "share_tunnel", "shared_buffer", "thread_pool", "wake_safely"]
-__all__ += ["outgoing_replaced", "widget_value"]
+__all__ += ["outgoing_replaced", "props_api", "widget_value"]
 
 messages = _messages
 """viser's message classes (``viser._messages``)."""
+props_api = _assignable_props_api
+"""viser's module of handle properties (``viser._assignable_props_api``): the names its casts look up."""
 VISER_WINDOW_LOOP = AsyncMessageBuffer._window_loop
 """viser's own window loop (``AsyncMessageBuffer._window_loop``), to compare :func:`~.windows.window_loop` with."""
 VISER_SERIALIZE = patches.SERIALIZE

@@ -32,6 +32,7 @@ from tpm_viz.ui.scene import camera_pose
 from tpm_viz.ui.teaching.explorer import ExplorerView
 from tpm_viz.ui.teaching.playing import RunHub
 from tpm_viz.ui.worded import TabGui
+from tpm_viz.viserkit.core import point_camera
 from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["DemosView"]
@@ -200,8 +201,7 @@ class DemosView:
                 view.refuse(exc)
                 return
             position, look_at = (np.asarray(v, dtype=float) for v in camera)  # the canvas is free (docked panel)
-            view.client.camera.position = position
-            view.client.camera.look_at = look_at
+            point_camera(view.client.camera, position, look_at)
             self.explorer.set(kind=demo.map_kind, ellipses=demo.ellipses)
             view.client.flush()
         if source is not None:
