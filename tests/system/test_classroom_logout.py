@@ -43,8 +43,10 @@ def test_log_out_ends_the_presenter_right_of_the_tab_and_of_a_dropped_presenter_
     before = lecturer.value(L_A)
     lecturer.set("Log out as presenter", True)
     wait_for(lambda: not app.access.is_presenter_tab(lv), what="the logout")
-    wait_for(lambda: lv not in app.room._lecturers, what="the Lecturer folder gone")
-    assert "logged out as presenter" in lv.panel.message.content  # told (after the folder went, under the lock)
+    wait_for(
+        lambda: lv not in app.room._lecturers and "logged out as presenter" in lv.panel.message.content,
+        what="the Lecturer folder gone, and the tab told (after the folder went, under the lock)",
+    )
     lecturer.set(L_A, "300")  # a student's change to the shared mechanism: refused
     lecturer.set("Apply parameters", True)
     wait_for(lambda: lecturer.value(L_A) == before, what="the refused change undone in the tab")

@@ -39,6 +39,14 @@ def _params(view) -> Params:
         return view.session.state.params
 
 
+def _picked(view) -> int | None:
+    """The Design tab's picked cell once its description is written (both under the lock: the cell is picked, then
+    described)."""
+    with view.hub.lock:
+        dv = view.teaching.design
+        return dv.picked if dv.cell.content else None
+
+
 def _computed(client, view, ranges: dict[str, str]):
     dv = view.teaching.design
     client.enter(dv.range_box, ranges)
@@ -89,7 +97,7 @@ def test_the_map_is_the_library_at_every_cell_and_a_cell_loads_its_design(connec
     bad = next(k for k in range(len(expected)) if k not in feasible)
     before = _params(view)
     _click(client, "/design/map/cells", bad)  # an infeasible cell: picked, said so, not loaded
-    wait_for(lambda: dv.picked == bad, timeout=30, what="the infeasible cell picked")
+    wait_for(lambda: _picked(view) == bad, timeout=30, what="the infeasible cell picked and described")
     assert "infeasible" in dv.cell.content and not re.search(r"cell-\w+'>[\d.]", dv.cell.content)
     assert _params(view) == before
 

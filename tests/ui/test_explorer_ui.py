@@ -113,7 +113,7 @@ def test_the_ellipses_follow_the_platform_and_say_their_axes(connect):
     assert vel.points[:, 0, :2].mean(axis=0) == pytest.approx(p, abs=1e-6)  # centred on the platform
     assert "nan" not in ex.readout.content.lower()
     client.set_value(ex.ellipses, False)
-    wait_for(lambda: not vel.visible, what="ellipses hidden")
+    wait_for(lambda: not vel.visible and ex.readout.content == "", what="ellipses hidden, and their readout")
     assert ex.readout.content == ""
 
 

@@ -102,7 +102,7 @@ def test_new_parameters_discard_the_control_run_and_say_so(connect):
     client.set_value(view.panel.params.inputs["m_p"], "2.5")
     client.click(view.panel.apply)
     wait_for(lambda: _state(view).params.m_p == pytest.approx(2.5), what="m_p = 2.5 kg")
-    wait_for(lambda: cv.run is None, what="the run discarded")
+    wait_for(lambda: cv.run is None and "discarded" in cv.summary.content, what="the run discarded, and said so")
     assert "the control run was discarded" in cv.summary.content
     assert not cv.nodes.ghost.visible and not any(h.visible for h in cv.nodes.paths.values())
     after = _state(view)

@@ -111,13 +111,13 @@ def test_presentation_mode_styles_this_tabs_lines_and_labels_only(connect):
 
     client.enter(view.panel.params, {"l_a": "280"})  # the shared drawing is rebuilt: its copies too
     wait_for(lambda: view.session.state.params.l_a == pytest.approx(0.28), what="l_a = 280 mm")
-    wait_for(
-        lambda: (
-            (c := view.scene._styled.get("/tpm/loci/direct")) is not None  # gone for a moment while rebuilt
-            and np.array_equal(c.points, shared.loci[-1].points)
-        ),
-        what="the direct locus copied again for the new links",
-    )
+
+    def copied_again() -> bool:
+        with view.hub.lock:  # the shared drawing and its copies are rebuilt under the lock: read them whole
+            c = view.scene._styled.get("/tpm/loci/direct")
+            return c is not None and bool(shared.loci) and np.array_equal(c.points, shared.loci[-1].points)
+
+    wait_for(copied_again, what="the direct locus copied again for the new links")
 
     client.set_value(view.panel.own_copy, True)  # a private copy is styled in place, no copy left over the shared
     wait_for(lambda: view.scene.private is not None, what="own copy")

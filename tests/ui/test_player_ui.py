@@ -90,7 +90,10 @@ def test_a_tab_that_connects_later_sees_the_loaded_run(connect):
     _choose(client, view, "circle (Fig. 5)", "circle", 0.5)
     _late_client, late = connect()
     pl = late.teaching.player
-    wait_for(lambda: pl.charts.forces.visible and pl.choice.value == "circle (Fig. 5)", what="the run in the new tab")
+    wait_for(
+        lambda: pl.charts.forces.visible and pl.choice.value == "circle (Fig. 5)" and "T = 0.5 s" in pl.summary.content,
+        what="the run in the new tab",
+    )
     assert "circle (Fig. 5), T = 0.5 s" in pl.summary.content and pl.trace.path.visible
 
 
@@ -128,7 +131,7 @@ def test_play_runs_to_the_end_in_slow_motion_and_any_other_input_stops_it(connec
     wait_for(lambda: _state(view).trajectory.t == pytest.approx(0.5), timeout=10, what="the end of the circle")
     assert time.monotonic() - t0 > 0.8  # 0.5 s of motion at 0.5x takes 1 s of wall clock
     np.testing.assert_allclose(_state(view).pose.p, circle_state(0.5, 0.5)[0], atol=1e-12)
-    wait_for(lambda: not _ps(view).playing, what="stopped at the end")
+    wait_for(lambda: not _ps(view).playing and "paused" in pl.summary.content, what="stopped at the end, and said so")
     assert "paused" in pl.summary.content and np.argmax(pl.charts.forces.data[-1]) == len(pl.charts.forces.data[0]) - 1
 
     client.set_value(pl.speed, "0.01×")
@@ -169,7 +172,14 @@ def test_a_good_upload_is_played_and_a_bad_one_is_refused_to_its_tab_only(connec
     p = np.stack([0.06 * np.sin(np.pi * t), 0.03 * np.sin(2 * np.pi * t)], -1)
     good = "t,p1,p2\n" + "".join(f"{a},{b},{c}\n" for a, (b, c) in zip(t, p, strict=True))
     _csv_upload(client, view, "wave.csv", good.encode())
-    wait_for(lambda: (r := _run(view)) is not None and r.source.kind == "csv", what="the uploaded run")
+    wait_for(
+        lambda: (
+            (r := _run(view)) is not None
+            and r.source.kind == "csv"
+            and view.teaching.player.choice.value == "your CSV: wave.csv"
+        ),
+        what="the uploaded run, shown",
+    )
     assert _run(other).source.label == "wave.csv, T = 1 s"  # the shared mechanism: every tab sees it
     assert view.teaching.player.choice.value == "your CSV: wave.csv"
     assert view.teaching.player.duration.inputs["T"].disabled

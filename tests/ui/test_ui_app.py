@@ -333,7 +333,10 @@ def test_simultaneous_drags_are_serialised_and_never_corrupt_state(app, connect)
 def test_equations_tab_follows_the_state_but_not_every_drag_frame(connect):
     client, view = connect()
     client.enter(view.panel.f_ext, {"f_y": "-2e1"})
-    wait_for(lambda: _state(view).load.f_ext == (0.0, -20.0), what="f_ext")
+    wait_for(
+        lambda: _state(view).load.f_ext == (0.0, -20.0) and "Errata" in view.panel.equations.content,
+        what="f_ext, and the equations drawn for it",
+    )
     assert "(a) Inverse kinematics" in view.panel.equations.content and "Errata" in view.panel.equations.content
     before = view.panel.equations.content
     owner = str(view.client.client_id)
