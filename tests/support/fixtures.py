@@ -5,20 +5,54 @@
   from Python, no browser) and returns ``(client, view)`` once the app built the tab's view.
 - ``browser``: a Playwright Chromium context (Debian's ``/usr/bin/chromium``, fresh profile); the test is skipped
   when Chromium or Playwright is missing.
+- ``whole_steps`` (for the whole run, automatic): a met :func:`~tests.support.protocol.wait_for` returns once the
+  locked step that wrote the awaited value is over. The app writes a step's values one after another under the hub's
+  lock (a picked cell, then its description; a commit, then each tab's widgets); a test reads them without that
+  lock, so on a busy machine it could see the first value and not yet the next.
 """
 
 from __future__ import annotations
 
 import os
 import tempfile
+import weakref
 
 import pytest
 
+from tests.support import protocol
 from tests.support.browser import CHROMIUM, CHROMIUM_ARGS
 from tests.support.protocol import ProtocolClient, wait_for
+from tpm_viz.classroom.session import Hub
 from tpm_viz.ui.app import TpmApp, build_server
 
-__all__ = ["app", "browser", "connect", "open_tab"]
+__all__ = ["app", "browser", "connect", "open_tab", "whole_steps"]
+
+STEP_BOUND = 30.0
+"""Seconds a met wait waits at most for a hub's current step (a bound, not a speed)."""
+
+
+@pytest.fixture(scope="session", autouse=True)
+def whole_steps():
+    """Every :class:`Hub` made in this run is known (weakly); a met ``wait_for`` takes and gives back its lock."""
+    hubs: weakref.WeakSet[Hub] = weakref.WeakSet()
+    made = Hub.__init__
+
+    def tracked(self, *args, **kwargs) -> None:
+        made(self, *args, **kwargs)
+        hubs.add(self)
+
+    def after_wait() -> None:
+        for hub in list(hubs):
+            if hub.lock.acquire(timeout=STEP_BOUND):
+                hub.lock.release()
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(Hub, "__init__", tracked)
+        protocol.AFTER_WAITS.append(after_wait)
+        try:
+            yield
+        finally:
+            protocol.AFTER_WAITS.remove(after_wait)
 
 
 @pytest.fixture
@@ -31,13 +65,14 @@ def app():
 
 
 def open_tab(app, opened: list[ProtocolClient]):
-    """Open a protocol client on ``app`` (appended to ``opened``); ``(client, view)`` once its first render is done."""
+    """Open a protocol client on ``app`` (appended to ``opened``); ``(client, view)`` once its first render is done
+    and its connection fully handled (its key nonce, classroom part, guide and class line)."""
     before = set(app.views)
     client = ProtocolClient(app.port)
     opened.append(client)
     new = wait_for(lambda: set(app.views) - before, what="the app to build a view for the client")
     view = app.views[next(iter(new))]
-    wait_for(lambda: view.session.readout is not None, what="the first render")
+    wait_for(lambda: view.session.readout is not None and view in app.arrived, what="the first render, and the rest")
     return client, view
 
 

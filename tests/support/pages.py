@@ -101,7 +101,7 @@ def views_of(app, n: int):
     views = list(app.views.values())
     for view in views:
         wait_for(lambda view=view: view.session.readout is not None, what="the first render")
-        wait_for(lambda view=view: view in app.room.ready, what="the classroom's part of the tab")
+        wait_for(lambda view=view: view in app.arrived, what="the classroom's part of the tab, and the rest")
     return views
 
 

@@ -239,13 +239,21 @@ class Tab:
             await asyncio.wait([self._reader], timeout=5.0)
 
 
+AFTER_WAITS: list = []
+"""Called, in order, when a :func:`wait_for` is met (:func:`tests.support.fixtures.whole_steps` puts one here: every
+live hub's lock taken and given back, so that the locked step that wrote the awaited value has written the rest)."""
+
+
 def wait_for(predicate, timeout: float = 30.0, interval: float = 0.01, what: str = "condition"):
     """Poll ``predicate`` until it returns a truthy value (returned) or fail after ``timeout`` seconds (a bound,
-    not a speed: 30 s holds while a second full run loads the machine, where 10 s did not always)."""
+    not a speed: 30 s holds while a second full run loads the machine, where 10 s did not always). Once met, each
+    of :data:`AFTER_WAITS` is called."""
     deadline = time.monotonic() + timeout
     while True:
         value = predicate()
         if value:
+            for after in list(AFTER_WAITS):
+                after()
             return value
         if time.monotonic() > deadline:
             raise AssertionError(f"timed out after {timeout} s waiting for {what}")

@@ -1,5 +1,5 @@
 """Fixtures of the system tests: a served app, protocol clients, headless Chromium (:mod:`tests.support.fixtures`)."""
 
-from tests.support.fixtures import app, browser, connect
+from tests.support.fixtures import app, browser, connect, whole_steps
 
-__all__ = ["app", "browser", "connect"]
+__all__ = ["app", "browser", "connect", "whole_steps"]

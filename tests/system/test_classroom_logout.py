@@ -24,7 +24,7 @@ def _tablet_drops_as_presenter(app):
     its view, the tablet's cookie)``."""
     lecturer = Page(app.port)
     (lv,) = views_of(app, 1)
-    wait_for(lambda: lv in app.room.ready, what="the lecturer's tab")
+    wait_for(lambda: lv in app.arrived, what="the lecturer's tab")
     cookie = page_cookie(app.port)
     tablet = Page(app.port, cookie=cookie)
     tv = next(v for v in views_of(app, 2) if v is not lv)
@@ -55,7 +55,7 @@ def test_log_out_ends_the_presenter_right_of_the_tab_and_of_a_dropped_presenter_
     again = Page(app.port, cookie=cookie)  # the tablet, back from the same address within the window
     views = views_of(app, 2)
     back = next(v for v in views if v is not lv)
-    wait_for(lambda: back in app.room.ready, what="the tablet back")
+    wait_for(lambda: back in app.arrived, what="the tablet back")
     assert not any(app.access.is_presenter_tab(v) for v in views)  # nobody is the presenter any more
     for page in (again, lecturer):
         page.close()
@@ -71,7 +71,7 @@ def test_a_new_login_ends_the_way_back_of_a_dropped_presenter_tab(classroom_app)
     wait_for(lambda: app.access.is_presenter_tab(sv), what="the new presenter's login")
     again = Page(app.port, cookie=cookie)
     back = next(v for v in views_of(app, 3) if v not in (lv, sv))
-    wait_for(lambda: back in app.room.ready, what="the tablet back")
+    wait_for(lambda: back in app.arrived, what="the tablet back")
     assert not app.access.is_presenter_tab(back)  # handed over: the tablet is a student's now
     for page in (again, student, lecturer):
         page.close()
@@ -91,7 +91,7 @@ def test_browsers_that_come_back_at_once_each_get_their_own_copy_from_the_first_
         known = set(app.views.values())
         page = Page(app.port, cookie=cookie)
         view = wait_for(lambda known=known: next((v for v in app.views.values() if v not in known), None), what="view")
-        wait_for(lambda view=view: view in app.room.ready, what="the tab connected")
+        wait_for(lambda view=view: view in app.arrived, what="the tab connected")
         page.set("Work on my own copy", True)
         wait_for(lambda view=view: not view.session.shared, what="an own copy")
         page.set(L_A, length)
@@ -113,7 +113,7 @@ def test_browsers_that_come_back_at_once_each_get_their_own_copy_from_the_first_
     for t in threads:
         t.join()
     views = views_of(app, 6)
-    wait_for(lambda: all(v in app.room.ready for v in views), what="every tab back")
+    wait_for(lambda: all(v in app.arrived for v in views), what="every tab back")
     for cookie, length in zip(cookies, lengths, strict=True):
         page = back[cookie]
         wait_for(lambda page=page, length=length: page.value(L_A) == length, what="its own l_a")

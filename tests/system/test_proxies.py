@@ -66,7 +66,7 @@ def _view_of_new_tab(app, make):
     wait_for(lambda: set(app.views) - before, what="the new tab's view")
     (client_id,) = set(app.views) - before
     view = app.views[client_id]
-    wait_for(lambda: view in app.room.ready, what="the classroom's part of the tab")
+    wait_for(lambda: view in app.arrived, what="the classroom's part of the tab")
     return tab, view
 
 

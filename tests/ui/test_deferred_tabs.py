@@ -93,7 +93,7 @@ def _open(app, opened: list[GuiClient]):
     opened.append(client)
     new = wait_for(lambda: set(app.views) - before, what="the tab's view")
     view = app.views[next(iter(new))]
-    wait_for(lambda: view in app.room.ready, what="the tab connected")
+    wait_for(lambda: view in app.arrived, what="the tab connected")
     return client, view
 
 

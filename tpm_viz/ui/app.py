@@ -21,6 +21,7 @@ import sys
 import threading
 import time
 import warnings
+import weakref
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -134,6 +135,8 @@ class TpmApp:
         self.services = Services.create(self.hub) if lessons is None else Services.create(self.hub, *lessons)
         """The worker, floor maps and trajectory runs every tab of this app shares."""
         self.views: dict[int, ClientView] = {}
+        self.arrived: weakref.WeakSet[ClientView] = weakref.WeakSet()
+        """The views whose connection is fully handled (keys, classroom, guide, share link, class line)."""
         self._views_lock = threading.Lock()
         self._class_info_timer: threading.Timer | None = None
         position, look_at = camera_pose(self.hub.shared.state.params)
@@ -172,6 +175,7 @@ class TpmApp:
         self.shares.connected(view, connection_request(self.server, client.client_id))  # a link: its own copy
         view.scene.set_touch(is_touch(connection_request(self.server, client.client_id)))  # a phone (ui/phone.py)
         self._class_info()
+        self.arrived.add(view)
 
     def _lang_of(self, client_id: int) -> Lang:
         """The language of a tab (English until its view is built)."""
