@@ -128,6 +128,27 @@ def test_the_gate_runs_a_tabs_calls_one_at_a_time_coalesced_and_capped():
     assert ran == [-1, 1, 1, 100, 101] and gate.merged == 498
 
 
+def test_clicks_in_3d_each_wait_their_turn_and_are_capped():
+    """A click in the 3D view carries its own point (a Shift+click waypoint): clicks that arrive while one runs are
+    not merged into the latest, they run in turn, still at most ``max_per_tab`` waiting."""
+    pool = concurrent.futures.ThreadPoolExecutor(4)
+    gate = Gate(pool.submit, max_per_tab=3)
+    points: list[float] = []
+    release = threading.Event()
+
+    def on_click(event):
+        release.wait(5.0)
+        points.append(event.ray_origin[0])
+
+    for x in range(6):
+        gate.submit(on_click, viser.SceneClickEvent(None, 1, (float(x), 0.0, 1.0), (0.0, 0.0, -1.0), (0.5, 0.5), None))
+    assert gate.pending(1) == 1 + 3 and gate.dropped == 2 and gate.merged == 0
+    release.set()
+    wait_for(lambda: gate.pending(1) == 0, what="the clicks to run")
+    pool.shutdown(wait=True)
+    assert points == [0.0, 1.0, 2.0, 3.0]
+
+
 def test_an_export_flood_runs_at_most_twice_and_other_tabs_stay_responsive(app, connect, monkeypatch):
     flooder, fv = connect()
     other, ov = connect()

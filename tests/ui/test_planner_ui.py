@@ -171,6 +171,20 @@ def test_shift_clicks_on_the_floor_add_waypoints(connect):
     assert _q(pv.result_html.content, "cycle-time") == f"{expected.cycle_time:.3f}"
 
 
+def test_shift_clicks_sent_at_once_each_add_their_waypoint(connect):
+    """A burst of clicks (a double click, a busy machine): each click's point is added, none is written over."""
+    client, view = connect()
+    pv = _planned(view, 200.0)
+    client.click(pv.clear)
+    wait_for(lambda: pv.path.value == "waypoints" and pv.waypoints.value == "", what="an empty list")
+    points = [(-0.06 + 0.02 * k, 0.01 * (k % 3)) for k in range(6)]
+    for x, y in points:
+        _shift_click(client, x, y)
+    wait_for(lambda: str(pv.waypoints.value).count(";") == len(points) - 1, what="six waypoints")
+    added = sorted(tuple(int(v) for v in item.split(",")) for item in str(pv.waypoints.value).split("; "))
+    assert added == sorted((round(x * 1e3), round(y * 1e3)) for x, y in points)
+
+
 def test_play_moves_the_platform_with_force_bars_at_the_limit(connect):
     client, view = connect()
     pv = _planned(view, 200.0)

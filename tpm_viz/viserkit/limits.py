@@ -4,8 +4,9 @@
 
 - **Bounded work per tab** (:class:`Gate`, in front of viser's callback thread pool): a tab's callbacks run one at a
   time (a flooding tab holds one pool thread, not 32); meanwhile each callback has at most one call waiting
-  (repeated clicks on an export coalesce into it, latest event wins), at most :attr:`Limits.max_callbacks_per_tab`
-  in all, the rest are dropped with a rate-limited log line. Connect and disconnect callbacks are never gated.
+  (repeated clicks on an export coalesce into it, latest event wins) except clicks in the 3D view, which each
+  carry their own point and wait in turn; at most :attr:`Limits.max_callbacks_per_tab` in all, the rest are
+  dropped with a rate-limited log line. Connect and disconnect callbacks are never gated.
 - **Bounded memory**: websocket messages over :attr:`Limits.max_frame_bytes` close that connection (viser accepts
   50 MiB; the largest thing a browser sends is a 512 KiB upload part; :class:`~.patches.GuardedProtocol`,
   installed by :mod:`.adapter`); a watchdog thread drops a connection whose
@@ -79,6 +80,10 @@ def _client_of(args: tuple) -> int | None:
     return client_id if isinstance(client_id, int) and not isinstance(client_id, bool) else None
 
 
+_CLICKS = (viser.SceneClickEvent, viser.ScenePointerEvent, viser.SceneNodePointerEvent, viser.SceneRectSelectEvent)
+"""Events that carry where the tab clicked: never merged with another."""
+
+
 def _done() -> concurrent.futures.Future:
     future: concurrent.futures.Future = concurrent.futures.Future()
     future.set_result(None)
@@ -88,12 +93,14 @@ def _done() -> concurrent.futures.Future:
 class Gate:
     """Per-tab admission in front of an executor's ``submit`` (see the module docstring): one call of a tab runs at a
     time; while it runs, each callback of that tab has at most one call waiting (a repeated call replaces the
-    waiting one's event: latest wins), at most ``max_per_tab`` waiting in all; waiting calls run in arrival order."""
+    waiting one's event: latest wins; a click in the 3D view waits as its own call, its point is not another's), at
+    most ``max_per_tab`` waiting in all; waiting calls run in arrival order."""
 
     def __init__(self, submit: Callable[..., concurrent.futures.Future[Any]], max_per_tab: int = 8) -> None:
         self._submit, self.max_per_tab = submit, max_per_tab
         self._lock = threading.Lock()
-        self._waiting: dict[int, dict[Any, tuple]] = {}  # tab -> callback -> (args, kwargs); present = one running
+        self._waiting: dict[int, dict[Any, tuple]] = {}  # tab -> key -> (fn, args, kwargs); present = one running
+        self._clicks = 0  # numbers the waiting 3D clicks (each its own key)
         self.blocked: set[int] = set()
         self.merged = 0
         self.dropped = 0
@@ -112,12 +119,13 @@ class Gate:
             elif waiting is None:
                 self._waiting[client_id] = {}
                 reason = ""
-            elif fn in waiting:
-                waiting[fn] = (args, kwargs)
+            elif fn in waiting and not isinstance(args[0], _CLICKS):
+                waiting[fn] = (fn, args, kwargs)
                 self.merged += 1
                 return _done()
             elif len(waiting) < self.max_per_tab:
-                waiting[fn] = (args, kwargs)
+                self._clicks += 1
+                waiting[(fn, self._clicks) if isinstance(args[0], _CLICKS) else fn] = (fn, args, kwargs)
                 return _done()
             else:
                 reason = "too many of its callbacks are queued"
@@ -151,8 +159,7 @@ class Gate:
             if not waiting:
                 self._waiting.pop(client_id, None)
                 return
-            fn = next(iter(waiting))
-            args, kwargs = waiting.pop(fn)
+            fn, args, kwargs = waiting.pop(next(iter(waiting)))
         self._start(client_id, fn, args, kwargs)
 
     def forget(self, client_id: int) -> None:

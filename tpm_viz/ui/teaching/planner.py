@@ -241,9 +241,14 @@ class PlannerView:
         if point is None:
             self._user(event, self._refuse_click)
             return
-        text = str(self.waypoints.value).strip() if self.path.value == "waypoints" else ""
-        item = f"{point[0] * 1e3:.0f},{point[1] * 1e3:.0f}"
-        self._user(event, self._set_waypoints, f"{text}; {item}" if text else item)
+        self._user(event, self._add_waypoint, f"{point[0] * 1e3:.0f},{point[1] * 1e3:.0f}")
+
+    def _add_waypoint(self, item: str) -> None:
+        """Append ``item`` (``x,y`` in mm) to the list, read and written in one locked step: clicks that arrive
+        together each add their point."""
+        with self.view.hub.lock:
+            text = str(self.waypoints.value).strip() if self.path.value == "waypoints" else ""
+            self._set_waypoints(f"{text}; {item}" if text else item)
 
     def _refuse_click(self) -> None:
         raise InputError(Phrase("Shift+click on the floor to add a waypoint"))
