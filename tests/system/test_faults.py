@@ -80,7 +80,8 @@ def test_tabs_that_disconnect_mid_drag(app, connect, caplog):
     wait_for(lambda: np.allclose(_state(kv).pose.p, (0.02, 0.03)), what="the keeper's drag end")
     assert ACTIVITY.wait_idle()
     assert ACTIVITY.snapshot()[1] == errors
-    assert not [r for r in caplog.records if r.levelno >= logging.ERROR]
+    server_side = [r for r in caplog.records if r.name != "websockets.client"]  # not the rogue tabs' own library,
+    assert not [r for r in server_side if r.levelno >= logging.ERROR]  # which reports the socket the test shut down
     assert list(app.views.values()) == [kv] and app.hub.shared.views == [kv]
     _consistent(kv)
 
