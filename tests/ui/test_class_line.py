@@ -18,7 +18,8 @@ def test_the_class_line_counts_tabs_and_is_redrawn_once_per_burst(app, connect, 
     leaving: list[ProtocolClient] = []
     tabs = [connect() for _ in range(3)] + [open_tab(app, leaving) for _ in range(3)]
     first = tabs[0][1]
-    wait_for(lambda: "6 tab(s) connected, 6 on the shared mechanism" in first.panel.class_info.content, what="6 tabs")
+    six = "6 tab(s) connected, 6 on the shared mechanism"
+    wait_for(lambda: all(six in view.panel.class_info.content for _c, view in tabs), what="6 tabs on every line")
     writes: list[str] = []
     original = type(first).set_class_info
     monkeypatch.setattr(type(first), "set_class_info", lambda self, text: writes.append(text) or original(self, text))
@@ -29,7 +30,10 @@ def test_the_class_line_counts_tabs_and_is_redrawn_once_per_burst(app, connect, 
     wait_for(lambda: len(app.views) == 3, what="three tabs gone")
     wait_for(lambda: "3 tab(s) connected, 2 on the shared mechanism" in first.panel.class_info.content, what="3")
     time.sleep(3 * app_module.CLASS_INFO_DELAY)
-    assert len(writes) <= 2 * 3  # each remaining tab written once or twice, not once per change (4 changes)
+    # the redraw runs on its own timer, not in a hub step: the last lines of the six-tab redraw may still be written
+    # after every tab shows it; the burst's own redraws are the ones after it
+    burst = [text for text in writes if six not in text]
+    assert burst and len(burst) <= 2 * 3  # each remaining tab written once or twice, not once per change (4 changes)
     assert "You see your own copy." in tabs[1][1].panel.class_info.content
     assert "You see the shared mechanism." in first.panel.class_info.content
 
