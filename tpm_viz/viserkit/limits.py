@@ -114,18 +114,22 @@ class Gate:
                 return _done()
         with self._lock:
             waiting = self._waiting.get(client_id)
+            if isinstance(args[0], _CLICKS):  # each click its own key: never merged
+                self._clicks += 1
+                key: Any = (fn, self._clicks)
+            else:
+                key = fn
             if client_id in self.blocked:
                 reason = "the tab is not reading what it is sent"
             elif waiting is None:
                 self._waiting[client_id] = {}
                 reason = ""
-            elif fn in waiting and not isinstance(args[0], _CLICKS):
-                waiting[fn] = (fn, args, kwargs)
+            elif key in waiting:
+                waiting[key] = (fn, args, kwargs)
                 self.merged += 1
                 return _done()
             elif len(waiting) < self.max_per_tab:
-                self._clicks += 1
-                waiting[(fn, self._clicks) if isinstance(args[0], _CLICKS) else fn] = (fn, args, kwargs)
+                waiting[key] = (fn, args, kwargs)
                 return _done()
             else:
                 reason = "too many of its callbacks are queued"
