@@ -219,6 +219,11 @@ def test_the_door_to_viser_refuses_an_untested_version_loudly():
         IncompatibleViserError, match=r"viser 1\.2\.0 is installed .* pip install 'viser>=1\.1\.1,<1\.2'"
     ):
         check_viser("1.2.0")
+    with pytest.raises(
+        IncompatibleViserError, match=r"websockets 17\.0 is installed .* pip install 'websockets>=15,<17'"
+    ):
+        check_viser(websockets_version="17.0")
+    check_viser(websockets_version="15.0.1")  # an older tested major is accepted
 
 
 def test_importing_the_library_and_the_command_line_loads_neither_viser_nor_pinocchio():

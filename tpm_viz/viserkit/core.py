@@ -34,6 +34,7 @@ from typing import Any, cast
 
 import numpy as np
 import viser
+import websockets
 from viser import _messages
 from viser.infra import _infra
 from viser.infra._async_message_buffer import AsyncMessageBuffer
@@ -45,12 +46,24 @@ from tpm_viz.viserkit.wire import Malformed
 
 ws_server = _infra.websockets.asyncio.server  # websockets' server, as viser imported it (not a tpm-viz dependency)
 
-__all__ = ["TESTED", "ClientDoor", "IncompatibleViserError", "Malformed", "ServerDoor", "check_viser"]
+__all__ = [
+    "TESTED",
+    "TESTED_WEBSOCKETS",
+    "ClientDoor",
+    "IncompatibleViserError",
+    "Malformed",
+    "ServerDoor",
+    "check_viser",
+]
 __all__ += ["client_request", "connection_request", "disable_share_url", "drop_gizmo_echo", "enable_share_url"]
 __all__ += ["point_camera", "relabel_tab", "removed", "thread_pool", "widget_uuid", "widget_value", "ws_server"]
 
 TESTED = "1.1"
 """The viser minor version tpm-viz is tested with (``pyproject.toml`` pins ``viser>=1.1.1,<1.2``)."""
+
+TESTED_WEBSOCKETS = ("15", "16")
+"""The websockets major versions tpm-viz is tested with (``pyproject.toml`` pins ``websockets>=15,<17``): viserkit
+replaces its ``ServerProtocol`` for the whole process."""
 
 _SERVER_ATTRS = ("_thread_executor", "request_share_url", "_websock_server")
 _WEBSOCK_ATTRS: tuple[str, ...] = (
@@ -69,13 +82,21 @@ class IncompatibleViserError(TpmVizError):
     """The installed viser is not the version tpm-viz was tested with, or lacks an internal it relies on."""
 
 
-def check_viser(version: str | None = None) -> None:
-    """Raise :class:`IncompatibleViserError` (one line: what to install) unless viser is the tested minor version
-    and has every internal this module uses. ``version`` defaults to the installed one (a test passes another)."""
+def check_viser(version: str | None = None, websockets_version: str | None = None) -> None:
+    """Raise :class:`IncompatibleViserError` (one line: what to install) unless viser is the tested minor version,
+    websockets a tested major, and viser has every internal this module uses. The versions default to the installed
+    ones (a test passes others)."""
     version = viser.__version__ if version is None else version
+    ws_version = websockets.__version__ if websockets_version is None else websockets_version
     fix = f"install the tested version: pip install 'viser>={TESTED}.1,<{wire.next_minor(TESTED)}'"
     if version.split(".")[:2] != TESTED.split("."):
         raise IncompatibleViserError(f"viser {version} is installed but tpm-viz is tested with viser {TESTED}.x; {fix}")
+    if ws_version.split(".")[0] not in TESTED_WEBSOCKETS:
+        low, high = TESTED_WEBSOCKETS[0], int(TESTED_WEBSOCKETS[-1]) + 1
+        raise IncompatibleViserError(
+            f"websockets {ws_version} is installed but tpm-viz is tested with websockets "
+            f"{'/'.join(TESTED_WEBSOCKETS)}.x; install a tested version: pip install 'websockets>={low},<{high}'"
+        )
     missing = [f"ViserServer.{a}" for a in _SERVER_ATTRS if not wire.has_attr_or_init(viser.ViserServer, a)]
     missing += [f"GuiApi.{m}" for m in _GUI_METHODS if not hasattr(viser.GuiApi, m)]
     missing += [f"_messages.{m}" for m in _MESSAGES if not hasattr(_messages, m)]
