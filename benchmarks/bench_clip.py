@@ -1,11 +1,11 @@
 """Speed and size of clips and reports (a benchmark, not a test): prints medians, 95th percentiles and sizes.
 
-1. One frame of the CLI's top-view renderer (:class:`tpm_viz.clips.ClipRenderer`) at 640×360, 800×450 and
-   1920×1080, and of the app's 3D renderer through a tab's camera (:class:`tpm_viz.views3d.View3dRenderer`, the
+1. One frame of the CLI's top-view renderer (:class:`tpm_viz.media.clips.ClipRenderer`) at 640×360, 800×450 and
+   1920×1080, and of the app's 3D renderer through a tab's camera (:class:`tpm_viz.media.views3d.View3dRenderer`, the
    app's default camera pose, 75° vertical field of view) at 640×360 and 1920×1080.
 2. A whole clip of the paper's circle (401 frames, 800×450, 20 frames/s) as GIF and MP4: render + encode time and
    bytes, and the app's recording of it through the tab's camera in jobs of
-   :data:`tpm_viz.ui.teaching.recording.CHUNK_FRAMES` frames (one job's time is what another tab's job may wait
+   :data:`tpm_viz.ui.teaching.takeout.recording.CHUNK_FRAMES` frames (one job's time is what another tab's job may wait
    behind it).
 3. The lab report of the circle (with the Pinocchio forces).
 
@@ -29,13 +29,13 @@ from timing import p95, samples_seconds
 
 from tpm_viz import Params
 from tpm_viz.app.runs import Source, build_run
-from tpm_viz.clips import ClipRenderer
+from tpm_viz.media.clips import ClipRenderer
+from tpm_viz.media.report import report_html
+from tpm_viz.media.videos import encode_clip
+from tpm_viz.media.views3d import Camera, View3dRenderer
 from tpm_viz.multibody.model import inverse_dynamics
-from tpm_viz.reports.report import report_html
 from tpm_viz.ui.scene import camera_pose
-from tpm_viz.ui.teaching.recording import CHUNK_FRAMES, SCENE_COLOURS, Material, Recording
-from tpm_viz.videos import encode_clip
-from tpm_viz.views3d import Camera, View3dRenderer
+from tpm_viz.ui.teaching.takeout.recording import CHUNK_FRAMES, SCENE_COLOURS, Material, Recording
 
 
 def main() -> None:

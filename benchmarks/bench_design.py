@@ -22,10 +22,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))  # benchmarks/timing.py
 
 from timing import p95
 
-from tpm_viz.app.atlas import Vary, designs, sweep
-from tpm_viz.app.design import Settings, Task, evaluate
+from tpm_viz.core.params import Params
+from tpm_viz.design.atlas import Vary, designs, sweep
+from tpm_viz.design.indices import Settings, Task, evaluate
 from tpm_viz.paper.arrangement import Arrangement
-from tpm_viz.params import Params
 
 TASK = Task(-0.1, 0.1, -0.05, 0.05)
 TARGET_S = 600.0

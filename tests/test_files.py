@@ -1,4 +1,4 @@
-"""The one file reader (tpm_viz/files.py) against the files that stopped, hung or leaked through the old readers:
+"""The one file reader (tpm_viz/core/files.py) against the files that stopped, hung or leaked through the old readers:
 /dev/zero, a FIFO, /proc/self/environ, a symlink out of the folder, 200 kB of ``[``, a deeply nested TOML."""
 
 from __future__ import annotations
@@ -12,8 +12,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tests.support.hypo import examples
-from tpm_viz import files
-from tpm_viz.errors import FileRefusedError, InputError
+from tpm_viz.core import files
+from tpm_viz.core.errors import FileRefusedError, InputError
 
 SECRET = "TOP-SECRET-LINE"
 

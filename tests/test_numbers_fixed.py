@@ -1,4 +1,4 @@
-"""``tpm_viz.numbers.fixed``: the one formatter of a shown number. Never ``-0.0``; a dash for what is no number."""
+"""``tpm_viz.core.numbers.fixed``: the one formatter of a shown number. Never ``-0.0``; a dash for what is no number."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tests.support.hypo import examples
-from tpm_viz.numbers import DASH, fixed
+from tpm_viz.core.numbers import DASH, fixed
 
 FIXED_POINT = [".0f", ".1f", ".2f", ".3f", ".4f", "+.1f", "+.2f", "+.3f", ",.1f", "+,.2f", ">9.2f", "<7.1f", ".1%"]
 ANY_FORMAT = [*FIXED_POINT, ".3e", "+.2e", ".3g", "g", ".4G", ".2E"]

@@ -1,4 +1,4 @@
-"""The software renderer of a tab's 3D view (tpm_viz.views3d): its pinhole projection against the textbook formula
+"""The software renderer of a tab's 3D view (tpm_viz.media.views3d): its pinhole projection against the textbook formula
 written out here, where the mechanism lands in a rendered frame (the tool marker's pixels, found by their colour),
 that a moved camera or a later time moves it by what the formula says, byte-identical frames, and one-line refusals.
 """
@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 
 from tpm_viz import Params
-from tpm_viz.app.palette import PALETTE
-from tpm_viz.errors import InputError
-from tpm_viz.meshes import PLATFORM_Z
+from tpm_viz.core.errors import InputError
+from tpm_viz.drawing.meshes import PLATFORM_Z
+from tpm_viz.drawing.palette import PALETTE
+from tpm_viz.media.videos import encode_clip
+from tpm_viz.media.views3d import Camera, View3dRenderer, focal_length, project
 from tpm_viz.paper.kinematics import inverse_kinematics
 from tpm_viz.paper.trajectories import paper_trajectory
-from tpm_viz.videos import encode_clip
-from tpm_viz.views3d import Camera, View3dRenderer, focal_length, project
 
 MARKER_TOP = PLATFORM_Z[1] + 0.008  # m, the top of the tool marker (a disc 8 mm high on the platform)
 MAGENTA = (255, 0, 255)  # the marker's colour in these tests: no other part is near it

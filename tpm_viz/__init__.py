@@ -5,13 +5,14 @@ The top level is pure numpy: importing :mod:`tpm_viz` loads neither viser nor pi
 Shapes: positions, velocities, accelerations and forces are arrays of shape ``(..., 2)`` in SI units.
 """
 
-from tpm_viz.errors import (
+from tpm_viz.core.errors import (
     InputError,
     InvalidParametersError,
     SingularConfigurationError,
     TpmVizError,
     UnreachablePoseError,
 )
+from tpm_viz.core.params import PARAM_INFO, Params
 from tpm_viz.paper.dynamics import DynamicsResult, inverse_dynamics, inverse_dynamics_detail, kinetic_energy
 from tpm_viz.paper.jacobians import (
     Jacobians,
@@ -48,7 +49,6 @@ from tpm_viz.paper.trajectories import (
     trajectory_from_samples,
 )
 from tpm_viz.paper.workspace import WorkspaceMap, direct_singularity_locus, workspace_map
-from tpm_viz.params import PARAM_INFO, Params
 
 __version__ = "0.1.0"
 

@@ -16,11 +16,11 @@ from hypothesis import strategies as st
 from tests.support.fake_viser import FakeApi
 from tests.support.hypo import examples
 from tpm_viz.app.overlays import arrow_length, arrow_reach, arrow_vector
-from tpm_viz.app.palette import PALETTE
 from tpm_viz.app.readouts import Load, evaluate
 from tpm_viz.app.state import AppState
 from tpm_viz.classroom.snapshot import Snapshot
-from tpm_viz.params import Params
+from tpm_viz.core.params import Params
+from tpm_viz.drawing.palette import PALETTE
 from tpm_viz.ui.scene import MechanismScene
 
 P = Params.paper()

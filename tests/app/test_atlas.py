@@ -1,4 +1,4 @@
-"""The atlas (tpm_viz/app/atlas.py): the grid, the process pool against one process, the Pareto front against a
+"""The atlas (tpm_viz/design/atlas.py): the grid, the process pool against one process, the Pareto front against a
 plain double loop, the optimiser within its bounds and limits and never worse than its start."""
 
 from __future__ import annotations
@@ -8,10 +8,21 @@ import math
 import numpy as np
 import pytest
 
-from tpm_viz.app.atlas import Limits, Vary, best, columns_for, design_row, designs, optimise, pareto, sweep, values_of
-from tpm_viz.app.design import INDEX_COLUMNS, Settings, Task
+from tpm_viz.core.params import Params
+from tpm_viz.design.atlas import (
+    Limits,
+    Vary,
+    best,
+    columns_for,
+    design_row,
+    designs,
+    optimise,
+    pareto,
+    sweep,
+    values_of,
+)
+from tpm_viz.design.indices import INDEX_COLUMNS, Settings, Task
 from tpm_viz.paper.arrangement import Arrangement
-from tpm_viz.params import Params
 
 TASK = Task(-0.1, 0.1, -0.05, 0.05)
 FAST = Settings(planner_grid=60)

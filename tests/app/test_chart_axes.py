@@ -1,4 +1,4 @@
-"""The axes of the player's charts (:mod:`tpm_viz.ui.chart_axes`): ticks for every run length and value range.
+"""The axes of the player's charts (:mod:`tpm_viz.ui.widgets.chart_axes`): ticks for every run length and value range.
 
 Each property is checked from the outside: the labels are read back by a parser written here (true minus, thousands
 commas, ``×10ⁿ``), the spacing and the 1-2-5 steps are recomputed from the tick values, and the claims of the
@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tests.support.hypo import examples
-from tpm_viz.ui.chart_axes import Ticks, text_width, tick_labels, time_ticks, value_ticks
+from tpm_viz.ui.widgets.chart_axes import Ticks, text_width, tick_labels, time_ticks, value_ticks
 
 SETTINGS = settings(max_examples=examples(300), deadline=None, derandomize=True)
 _SUP = str.maketrans("⁰¹²³⁴⁵⁶⁷⁸⁹⁻", "0123456789-")

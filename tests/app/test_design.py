@@ -1,4 +1,4 @@
-"""Design indices (tpm_viz/app/design.py) against independent routes: brute-force grids with Jacobians written
+"""Design indices (tpm_viz/design/indices.py) against independent routes: brute-force grids with Jacobians written
 here from the kinematics (eq. 10 and the parallel J of issue 26), the mass matrix from the kinetic energy, the
 mechanism's own joint positions, the cubic law's own sizing and the scaling law of minimum time."""
 
@@ -12,15 +12,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tpm_viz.app import design
-from tpm_viz.app.design import Settings, Task, area_means, evaluate, footprint, pick_path, pointwise, task_grid
 from tpm_viz.app.planner import Limits, plan_cycle, plan_path
 from tpm_viz.app.planning import cubic_strokes
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Lang, say
+from tpm_viz.design import indices
+from tpm_viz.design.indices import Settings, Task, area_means, evaluate, footprint, pick_path, pointwise, task_grid
 from tpm_viz.paper import arrangement as arr
 from tpm_viz.paper.arrangement import Arrangement
 from tpm_viz.paper.dynamics import inverse_dynamics
-from tpm_viz.params import Params
-from tpm_viz.words import Lang, say
 
 PERP, PAR = Arrangement.PERPENDICULAR, Arrangement.PARALLEL
 PAPER = Params.paper()
@@ -159,7 +159,7 @@ def test_footprint_is_the_bounding_box_of_the_rails_and_the_drawn_legs(arrangeme
 def test_peak_force_is_the_cubic_law_at_the_reference_stroke_sampled_densely():
     """The paper's eqs. (29)-(31) along s = L (3u² - 2u³) at 400 001 instants (either side of a corner)."""
     got = evaluate(PERP, PAPER, TASK)
-    path, duration = pick_path(TASK), design.REFERENCE_STROKE
+    path, duration = pick_path(TASK), indices.REFERENCE_STROKE
     length = path.length
     u = np.linspace(0.0, 1.0, 400001)
     s = length * (3 * u**2 - 2 * u**3)

@@ -1,4 +1,4 @@
-"""Camera framing (:mod:`tpm_viz.ui.framing`) checked through a pinhole camera written here, independently.
+"""Camera framing (:mod:`tpm_viz.ui.widgets.framing`) checked through a pinhole camera written here, independently.
 
 The reference camera follows viser's convention (OpenCV axes: x right, y down, z forward; the image's up is the
 world ``up`` projected; a vertical field of view and the canvas aspect), and returns where a point lands on the
@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from tpm_viz.ui.framing import (
+from tpm_viz.ui.widgets.framing import (
     FULL,
     LIVE_BAND,
     MARGIN,

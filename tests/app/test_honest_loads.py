@@ -12,14 +12,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tpm_viz.app import sessions, transitions
+from tpm_viz.app import transitions
 from tpm_viz.app.moves import Pose
 from tpm_viz.app.readouts import Load, evaluate
 from tpm_viz.app.runs import Source
-from tpm_viz.app.sessions import Document, Saved
 from tpm_viz.app.state import AppState, TrajectorySample, run_note
+from tpm_viz.classroom import sessionfile
+from tpm_viz.classroom.sessionfile import Document, Saved
+from tpm_viz.core.params import Params
 from tpm_viz.paper.dynamics import inverse_dynamics
-from tpm_viz.params import Params
 
 P = Params.paper()
 F_EXT = (4.0, -2.5)  # N, typed on the Forces tab before the run
@@ -77,18 +78,18 @@ def test_the_same_parameters_again_keep_the_run_and_its_load():
 def test_a_dynamic_load_typed_by_hand_is_a_question_and_stays():
     typed = AppState(P, Pose.working(P, (0.0, 0.0)), RUN)  # sample "none": typed on the Forces tab
     assert transitions.home(typed).load == RUN
-    back = sessions.loads(sessions.dumps(Document(Saved(typed))))
+    back = sessionfile.loads(sessionfile.dumps(Document(Saved(typed))))
     assert back.shared.state.load == RUN
 
 
 def _round_trip(saved: Saved) -> AppState:
     """Save, then read back as a restarted server does (a new process reads the file)."""
-    return sessions.loads(sessions.dumps(Document(saved))).shared.state
+    return sessionfile.loads(sessionfile.dumps(Document(saved))).shared.state
 
 
 def test_a_control_runs_load_is_never_saved():
     state = _on_run()
-    raw = sessions.encode_saved(Saved(state))
+    raw = sessionfile.encode_saved(Saved(state))
     assert raw["load"]["mode"] == "static" and raw["sample"]["kind"] == "none"
     back = _round_trip(Saved(state))
     assert back.load == Load("static", f_ext=F_EXT)
@@ -109,10 +110,10 @@ def test_a_played_trajectory_keeps_its_sample_to_seek_again_but_not_its_load():
 
 def test_an_old_file_with_a_phantom_load_is_read_at_rest():
     """A file saved before this fix (a run's dynamic load in it) opens at rest: 122.6 N at rest never comes back."""
-    text = sessions.dumps(Document(Saved(AppState(P, _on_run().pose))))
-    doc = sessions.json.loads(text)
+    text = sessionfile.dumps(Document(Saved(AppState(P, _on_run().pose))))
+    doc = sessionfile.json.loads(text)
     doc["shared"]["load"] = {"mode": "dynamic", "f_ext": list(F_EXT), "dp": list(RUN.dp), "ddp": list(RUN.ddp)}
     doc["shared"]["sample"] = {"kind": "plan#1a2b", "duration": 0.4, "t": 0.2}
-    back = sessions.loads(sessions.json.dumps(doc)).shared.state
+    back = sessionfile.loads(sessionfile.json.dumps(doc)).shared.state
     assert back.load == Load("static", f_ext=F_EXT) and back.trajectory.kind == "none"
     np.testing.assert_allclose(_tau_shown(back), _tau_static(back), rtol=1e-12, atol=1e-12)

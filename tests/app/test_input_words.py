@@ -13,10 +13,10 @@ from tpm_viz.app.inputs import read_choice, read_flag, read_number, read_params,
 from tpm_viz.app.overlays import colour_scale
 from tpm_viz.app.runs import Source, build_run
 from tpm_viz.app.state import AppState
-from tpm_viz.errors import InputError, TpmVizError
-from tpm_viz.numbers import parse_number, unit_factor
+from tpm_viz.core.errors import InputError, TpmVizError
+from tpm_viz.core.numbers import parse_number, unit_factor
+from tpm_viz.core.words import Lang, Phrase, T, say
 from tpm_viz.paper.trajectories import parse_trajectory_csv
-from tpm_viz.words import Lang, Phrase, T, say
 
 P = Params.paper()
 MIB = 1 << 20

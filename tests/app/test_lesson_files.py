@@ -35,9 +35,9 @@ from tpm_viz.app.lessons import (
     verify,
 )
 from tpm_viz.app.runs import Source, build_run
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.words import Lang
 from tpm_viz.paper.trajectories import parse_trajectory_csv
-from tpm_viz.words import Lang
 
 ASSETS = assets_dir()
 LESSONS = ASSETS / "lessons"

@@ -13,9 +13,9 @@ from contextlib import redirect_stderr, redirect_stdout
 import pytest
 
 from tpm_viz.app.lesson_files import assets_dir, load_lessons
+from tpm_viz.core.words import Lang
 from tpm_viz.ui.app import main as serve
 from tpm_viz.ui.teaching.lessons import problems_html
-from tpm_viz.words import Lang
 
 SECRET = "TPM-VIZ-TEST-SECRET-7f3a"
 GOOD = 'title = "{title}"\n[text]\nen = "A lesson."\n[pose]\np = [0.0, 0.0]\n'

@@ -6,11 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tpm_viz import InputError, Params, forward_kinematics_both, meshes
+from tpm_viz import InputError, Params, forward_kinematics_both
 from tpm_viz.app.lessons import DEMOS, demo_by_key, demo_params, demo_pose, demo_source, effect
 from tpm_viz.app.moves import check
 from tpm_viz.app.overlays import MAP_KINDS, cached_map
 from tpm_viz.app.runs import Source, build_run
+from tpm_viz.drawing import meshes
 from tpm_viz.multibody.model import inverse_dynamics as pinocchio_forces
 from tpm_viz.paper.ellipses import manipulability_ellipses
 from tpm_viz.paper.jacobians import jacobians

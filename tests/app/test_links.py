@@ -1,4 +1,4 @@
-"""Share-link tokens (tpm_viz.app.links): the state round trip, a large upload kept by content hash, and one-line
+"""Share-link tokens (tpm_viz.classroom.links): the state round trip, a large upload kept by content hash, and one-line
 refusals of damaged, forged, foreign-version and bomb tokens (built here by hand, not by the code under test)."""
 
 from __future__ import annotations
@@ -12,14 +12,14 @@ import numpy as np
 import pytest
 
 from tpm_viz import InputError
-from tpm_viz.app.links import LINK_VERSION, MAX_TOKEN_CHARS, decode_link, encode_link
 from tpm_viz.app.moves import Pose
 from tpm_viz.app.readouts import Load
 from tpm_viz.app.runs import Source
-from tpm_viz.app.sessions import Saved, encode_saved
 from tpm_viz.app.state import AppState, TrajectorySample
+from tpm_viz.classroom.links import LINK_VERSION, MAX_TOKEN_CHARS, decode_link, encode_link
+from tpm_viz.classroom.sessionfile import Saved, encode_saved
+from tpm_viz.core.params import Params
 from tpm_viz.paper.trajectories import Trajectory
-from tpm_viz.params import Params
 
 
 def _source(n: int) -> Source:

@@ -1,11 +1,11 @@
-"""Share links in URLs (tpm_viz.app.links): the query a page is asked with, and the tokens waiting for their tab
+"""Share links in URLs (tpm_viz.classroom.links): the query a page is asked with, and the tokens waiting for their tab
 (bounded in number, per address and in time, each read once)."""
 
 from __future__ import annotations
 
 from urllib.parse import parse_qs, urlsplit
 
-from tpm_viz.app.links import MAX_TOKEN_CHARS, PendingLinks, share_url, token_of_query
+from tpm_viz.classroom.links import MAX_TOKEN_CHARS, PendingLinks, share_url, token_of_query
 
 
 class Clock:

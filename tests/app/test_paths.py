@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 import tpm_viz as tv
 from tests.support.hypo import examples
 from tpm_viz.app import paths
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
 from tpm_viz.paper.status import MOVE_LIMITS, PoseStatus
 from tpm_viz.paper.trajectories import circle_state, line_state
 

@@ -19,7 +19,7 @@ import tpm_viz as tv
 from tests.support.hypo import examples
 from tests.support.strategies import params_sets
 from tpm_viz.app import paths, planner
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
 from tpm_viz.multibody import inverse_dynamics as pinocchio_forces
 from tpm_viz.paper.trajectories import paper_trajectory
 

@@ -9,8 +9,8 @@ import pytest
 from tpm_viz import InputError, Params, actuator_acceleration, actuator_velocity, inverse_dynamics
 from tpm_viz.app.inputs import read_upload
 from tpm_viz.app.runs import RUN_SAMPLES, Source, build_run, check_path
-from tpm_viz.csvio import format_columns, parse_columns
-from tpm_viz.figures import force_plot_png, force_plot_svg
+from tpm_viz.core.csvio import format_columns, parse_columns
+from tpm_viz.drawing.figures import force_plot_png, force_plot_svg
 from tpm_viz.paper.trajectories import circle_state, line_state
 
 P = Params.paper()
@@ -160,9 +160,9 @@ def test_the_force_plot_is_a_print_size_png_or_an_svg_with_or_without_the_refere
 
 
 def test_trace_segments_and_the_summary_never_show_nan():
-    from tpm_viz.ui.teaching.player_text import summary_html
-    from tpm_viz.ui.teaching.playing import PlayerSession
-    from tpm_viz.ui.teaching.trace import segments
+    from tpm_viz.classroom.runhub import PlayerSession
+    from tpm_viz.ui.teaching.player.text import summary_html
+    from tpm_viz.ui.teaching.player.trace import segments
 
     p = np.stack([np.linspace(0, 0.1, 1001), np.zeros(1001)], -1)
     segs = segments(p, 0.08, 150)

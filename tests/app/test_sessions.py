@@ -1,4 +1,4 @@
-"""Saved sessions (tpm_viz.app.sessions): round trip, uploaded trajectories, refusals of bad or old files."""
+"""Saved sessions (tpm_viz.classroom.sessionfile): round trip, uploaded trajectories, refusals of bad or old files."""
 
 from __future__ import annotations
 
@@ -8,14 +8,14 @@ import numpy as np
 import pytest
 
 from tpm_viz import InputError
-from tpm_viz.app import sessions
 from tpm_viz.app.moves import Pose
 from tpm_viz.app.readouts import Load
 from tpm_viz.app.runs import Source
-from tpm_viz.app.sessions import KEEP_SECONDS, Document, Saved
 from tpm_viz.app.state import AppState, TrajectorySample
+from tpm_viz.classroom import sessionfile
+from tpm_viz.classroom.sessionfile import KEEP_SECONDS, Document, Saved
+from tpm_viz.core.params import Params
 from tpm_viz.paper.trajectories import Trajectory
-from tpm_viz.params import Params
 
 
 def _csv_source() -> Source:
@@ -34,7 +34,7 @@ def test_round_trip_keeps_everything_the_lecturer_set():
     source = _csv_source()
     doc = Document(Saved(_state(), source, 0.1, {"labels": False}), lesson_step=3)
     doc.tabs["c:" + "a" * 32] = [{"private": True, "saved": Saved(_state(), Source.paper("line")), "left_at": 1e9}]
-    back = sessions.loads(sessions.dumps(doc), now=1e9 + 10)
+    back = sessionfile.loads(sessionfile.dumps(doc), now=1e9 + 10)
     s = back.shared.state
     assert s.params == _state().params and s.load == _state().load and s.trajectory == _state().trajectory
     np.testing.assert_allclose(s.pose.p, (0.02, -0.01))
@@ -47,7 +47,7 @@ def test_round_trip_keeps_everything_the_lecturer_set():
 
 def test_tabs_older_than_30_minutes_are_dropped():
     doc = Document(Saved(_state()), tabs={"k": [{"private": True, "saved": Saved(_state()), "left_at": 0.0}]})
-    assert sessions.loads(sessions.dumps(doc), now=KEEP_SECONDS + 1).tabs == {}
+    assert sessionfile.loads(sessionfile.dumps(doc), now=KEEP_SECONDS + 1).tabs == {}
 
 
 @pytest.mark.parametrize(
@@ -65,26 +65,26 @@ def test_tabs_older_than_30_minutes_are_dropped():
     ],
 )
 def test_bad_or_old_documents_are_one_line_refusals(edit, message):
-    raw = json.loads(sessions.dumps(Document(Saved(_state(), _csv_source()))))
+    raw = json.loads(sessionfile.dumps(Document(Saved(_state(), _csv_source()))))
     edit(raw)
     with pytest.raises(InputError, match=message) as info:
-        sessions.loads(json.dumps(raw))
+        sessionfile.loads(json.dumps(raw))
     assert "\n" not in str(info.value) and str(info.value).startswith("session file")
 
 
 @pytest.mark.parametrize("text", ["", "{", "[]", "null", '{"format": "tpm-viz-session"}', "x" * 100])
 def test_garbage_is_refused(text):
     with pytest.raises(InputError, match="session file"):
-        sessions.loads(text)
+        sessionfile.loads(text)
 
 
 def test_write_is_atomic_and_leaves_no_temporary_file(tmp_path):
     path = tmp_path / "deep" / "session.json"
-    sessions.write_atomic(path, "one")
-    sessions.write_atomic(path, "two")
+    sessionfile.write_atomic(path, "one")
+    sessionfile.write_atomic(path, "two")
     assert path.read_text() == "two" and [p.name for p in path.parent.iterdir()] == ["session.json"]
     with pytest.raises(InputError, match="session file"):
-        sessions.read_file(tmp_path / "missing.json")
+        sessionfile.read_file(tmp_path / "missing.json")
 
 
 @pytest.mark.parametrize(
@@ -97,15 +97,15 @@ def test_write_is_atomic_and_leaves_no_temporary_file(tmp_path):
 )
 def test_open_session_refuses_deep_or_binary_files_in_one_plain_line(data, message):
     with pytest.raises(InputError, match=message) as info:
-        sessions.loads(data)
+        sessionfile.loads(data)
     text = str(info.value)
     assert text.startswith("session file") and "\n" not in text and "codec" not in text and "\\x" not in text
 
 
 def test_open_session_checks_the_lesson_step_against_the_lessons():
-    raw = json.loads(sessions.dumps(Document(Saved(_state()), lesson_step=3)))
-    assert sessions.loads(json.dumps(raw), steps=4).lesson_step == 3
+    raw = json.loads(sessionfile.dumps(Document(Saved(_state()), lesson_step=3)))
+    assert sessionfile.loads(json.dumps(raw), steps=4).lesson_step == 3
     for bad in (999, 4, -1, 2.5, True, "2"):
         raw["lesson_step"] = bad
         with pytest.raises(InputError, match="lesson step"):
-            sessions.loads(json.dumps(raw), steps=4)
+            sessionfile.loads(json.dumps(raw), steps=4)

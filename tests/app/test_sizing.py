@@ -13,7 +13,7 @@ import tpm_viz as tv
 from tests.support.hypo import examples
 from tpm_viz.app import paths, planner
 from tpm_viz.app.sizing import SIZING_COLUMNS, format_sizing, size_motion, size_trajectory, sizing_columns
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
 from tpm_viz.multibody import inverse_dynamics as pinocchio_forces
 from tpm_viz.paper.trajectories import paper_trajectory
 

@@ -16,8 +16,8 @@ import pytest
 from tpm_viz import Params
 from tpm_viz.app import transitions
 from tpm_viz.app.state import AppState
-from tpm_viz.errors import InputError
-from tpm_viz.ui.typed import Quantity, TypedField, TypedGroup
+from tpm_viz.core.errors import InputError
+from tpm_viz.ui.widgets.typed import Quantity, TypedField, TypedGroup
 
 P = Params.paper()
 D1 = Quantity("d1", "mm", 1.0, 0.0, 300.0)

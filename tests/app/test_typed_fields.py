@@ -1,4 +1,4 @@
-"""Typed number fields (``tpm_viz.ui.typed``): what is read from a text, when it is applied, what the note says.
+"""Typed number fields (``tpm_viz.ui.widgets.typed``): what is read from a text, when it is applied, what the note says.
 
 The expected values are written out by hand (``1e9`` kg is 1 000 000 000 kg, ``-100000`` mm is -100 m) or come from
 the arithmetic of the test itself, never from the module under test. The keyboard is simulated with explicit times:
@@ -15,8 +15,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tests.support.hypo import examples
-from tpm_viz.errors import InputError
-from tpm_viz.ui.typed import (
+from tpm_viz.core.errors import InputError
+from tpm_viz.ui.widgets.typed import (
     QUIET,
     Quantity,
     TypedField,

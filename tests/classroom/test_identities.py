@@ -10,10 +10,10 @@ import stat
 
 import pytest
 
-from tpm_viz.app.sessions import Saved
 from tpm_viz.app.state import AppState
 from tpm_viz.classroom.away import MAX_PER_ADDRESS, PRESENTER_SECONDS, Away
 from tpm_viz.classroom.identity import SECRET_FILE, Keys
+from tpm_viz.classroom.sessionfile import Saved
 from tpm_viz.ui.classroom import identity
 
 

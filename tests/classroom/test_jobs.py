@@ -11,7 +11,7 @@ import threading
 import pytest
 
 from tpm_viz.classroom.jobs import BURST, FLOODER, TAU, Demand, FairJobs
-from tpm_viz.errors import BusyError, InputError
+from tpm_viz.core.errors import BusyError, InputError
 
 WAIT = 30.0  # s: only a bound against a hung test, never reached when it passes
 

@@ -23,12 +23,12 @@ ROOT = Path(__file__).resolve().parents[2]
 _WRITER = """
 import resource, sys, time
 from pathlib import Path
-from tpm_viz.app.sessions import Document, Saved
+from tpm_viz.classroom.sessionfile import Document, Saved
 from tpm_viz.app.state import AppState
 from tpm_viz.classroom.records import Records
 from tpm_viz.classroom.saver import Saver
 from tpm_viz.classroom.store import SqliteStore
-from tpm_viz.params import Params
+from tpm_viz.core.params import Params
 
 path, mode = Path(sys.argv[1]), sys.argv[2]
 store = SqliteStore(path)

@@ -15,12 +15,12 @@ import numpy as np
 import pytest
 
 from tpm_viz.app.runs import Source
-from tpm_viz.app.sessions import Document, Saved
 from tpm_viz.app.state import AppState
 from tpm_viz.classroom.records import Records
+from tpm_viz.classroom.sessionfile import Document, Saved
 from tpm_viz.classroom.store import Copy, Limits, SqliteStore, open_store
+from tpm_viz.core.params import Params
 from tpm_viz.paper.trajectories import Trajectory
-from tpm_viz.params import Params
 from tpm_viz.ui.continuity import lecture_store as Store
 
 OLD = Path(__file__).resolve().parents[1] / "fixtures" / "session-v1.json"

@@ -27,7 +27,7 @@ README_CLIP = [
     "--output", str(ROOT / "docs" / "images" / "clip.gif"),
 ]  # fmt: skip
 """The command that makes the README's clip (the circle of Fig. 5, 101 frames, 5 s at 20 frames/s)."""
-BLUE, RED = (31, 119, 180), (214, 39, 40)  # tpm_viz.clips.BAR_COLOURS, written out: the test reads pixels
+BLUE, RED = (31, 119, 180), (214, 39, 40)  # tpm_viz.media.clips.BAR_COLOURS, written out: the test reads pixels
 
 
 def trajectory_forces(kind: str, samples: int, capsys) -> tuple[np.ndarray, np.ndarray]:

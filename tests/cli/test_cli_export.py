@@ -12,7 +12,7 @@ import tpm_viz as tv
 from tests.support.cli import parser_for
 from tpm_viz.cli import export as cli_export
 from tpm_viz.cli.common import common_parent
-from tpm_viz.errors import InputError, InvalidParametersError
+from tpm_viz.core.errors import InputError, InvalidParametersError
 from tpm_viz.exchange.mjcf import DEFAULT_SETTINGS, MjcfSettings, mjcf_text
 from tpm_viz.exchange.topology import joint_motion, topology
 from tpm_viz.exchange.urdf import urdf_text

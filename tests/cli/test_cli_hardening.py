@@ -19,8 +19,8 @@ import pytest
 
 from tpm_viz.cli.common import write_output
 from tpm_viz.cli.serve import check_bind
-from tpm_viz.csvio import MAX_BYTES, MAX_ROWS
-from tpm_viz.errors import InputError
+from tpm_viz.core.csvio import MAX_BYTES, MAX_ROWS
+from tpm_viz.core.errors import InputError
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 

@@ -16,7 +16,7 @@ import pytest
 import tpm_viz as tv
 from tests.support.cli import parser_for
 from tpm_viz.cli import plan as cli_plan
-from tpm_viz.errors import TpmVizError
+from tpm_viz.core.errors import TpmVizError
 from tpm_viz.multibody import inverse_dynamics as pinocchio_forces
 
 P = tv.Params.paper()

@@ -18,7 +18,7 @@ import pytest
 
 from tests.support.browser import CHROMIUM, CHROMIUM_ARGS
 from tpm_viz.cli import main
-from tpm_viz.words import Lang, catalogue
+from tpm_viz.core.words import Lang, catalogue
 
 DATE = "2026-01-02"
 

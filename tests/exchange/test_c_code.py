@@ -14,12 +14,12 @@ import numpy as np
 import pytest
 
 from tests.support import cbuild
-from tpm_viz.errors import InputError, SingularConfigurationError, UnreachablePoseError
+from tpm_viz.core.errors import InputError, SingularConfigurationError, UnreachablePoseError
+from tpm_viz.core.params import Params
 from tpm_viz.paper.control import ControlLaw, ControllerKind, Gains, task_space_command
 from tpm_viz.paper.dynamics import inverse_dynamics
 from tpm_viz.paper.jacobians import jacobians
 from tpm_viz.paper.kinematics import in_stroke, inverse_kinematics
-from tpm_viz.params import Params
 
 TOL = 1e-12
 

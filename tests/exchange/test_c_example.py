@@ -12,9 +12,9 @@ import pytest
 from tests.support import cbuild
 from tests.support.cli import parser_for
 from tpm_viz.cli import export as cli_export
-from tpm_viz.errors import InputError
-from tpm_viz.exchange.c_code import c_files
-from tpm_viz.params import Params
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.params import Params
+from tpm_viz.exchange.c.code import c_files
 
 EXAMPLE = pathlib.Path(__file__).resolve().parents[2] / "examples" / "ctc_loop.c"
 

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from tests.support import cbuild
-from tpm_viz.errors import InputError, SingularConfigurationError, UnreachablePoseError
+from tpm_viz.core.errors import InputError, SingularConfigurationError, UnreachablePoseError
+from tpm_viz.core.params import Params
 from tpm_viz.paper import parallel
-from tpm_viz.params import Params
 
 D, RC_D, J, RC_J, TAU, RC_TAU, ACC, RC_ACC = slice(18, 20), 20, slice(21, 25), 25, slice(26, 28), 28, slice(29, 31), 31
 

@@ -7,10 +7,10 @@ import pytest
 
 from tests.support.cli import parser_for
 from tpm_viz.cli import control as cli_control
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.params import Params
 from tpm_viz.multibody.control import ControlSetup, simulate
 from tpm_viz.paper.control import Gains
-from tpm_viz.params import Params
 
 P = Params.paper()
 GAINS = Gains(10.0, 1.0)  # the README's settings: ω_n = 10 Hz, ζ = 1

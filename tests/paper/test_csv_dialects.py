@@ -11,8 +11,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tests.support.hypo import examples
-from tpm_viz.csvio import decode_text, format_columns, parse_columns, parse_lines, time_unit_note
-from tpm_viz.errors import InputError
+from tpm_viz.core.csvio import decode_text, format_columns, parse_columns, parse_lines, time_unit_note
+from tpm_viz.core.errors import InputError
 from tpm_viz.paper.trajectories import parse_trajectory_csv
 
 T = [0.0, 0.1, 0.2, 0.3]

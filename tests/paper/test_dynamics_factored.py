@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 
 from tests.support.strategies import random_states
+from tpm_viz.core.params import Params
 from tpm_viz.paper.dynamics import _procedure, _v_leg, _w_leg
 from tpm_viz.paper.jacobians import eq14_row
 from tpm_viz.paper.kinematics import inverse_kinematics, leg_components
-from tpm_viz.params import Params
 
 
 def printed(params: Params, p1, p2, dp1, dp2, ddp1, ddp2, c1, c2, f1, f2):

@@ -1,4 +1,4 @@
-"""Parametric parts (tpm_viz.meshes): sizes follow the parameters, poses put the links on their pivots."""
+"""Parametric parts (tpm_viz.drawing.meshes): sizes follow the parameters, poses put the links on their pivots."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from tpm_viz import Params, mechanism_pose
-from tpm_viz import meshes as m
+from tpm_viz.drawing import meshes as m
 
 P = Params.paper()
 
@@ -76,7 +76,7 @@ def test_segments_helpers():
 def test_workspace_region_covers_exactly_the_in_stroke_poses():
     """The floor overlay, probed at random points, agrees with eq. (4) and the stroke (not only with the mask)."""
     from tpm_viz import in_stroke, inverse_kinematics, reachable, workspace_map
-    from tpm_viz.meshes import region_mesh
+    from tpm_viz.drawing.meshes import region_mesh
 
     P = Params.paper()
     ws = workspace_map(P, n=120)

@@ -1,4 +1,5 @@
-"""Parts of the parallel mechanism (tpm_viz.meshes_parallel): links on their pivots, sliders between the stops."""
+"""Parts of the parallel mechanism (tpm_viz.drawing.meshes_parallel): links on their pivots, sliders between the
+stops."""
 
 from __future__ import annotations
 
@@ -6,8 +7,8 @@ import numpy as np
 import pytest
 
 from tpm_viz import Params
-from tpm_viz import meshes as m
-from tpm_viz import meshes_parallel as mp
+from tpm_viz.drawing import meshes as m
+from tpm_viz.drawing import meshes_parallel as mp
 from tpm_viz.paper import parallel as par
 
 P = Params.paper()

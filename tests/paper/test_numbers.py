@@ -1,4 +1,4 @@
-"""tpm_viz.numbers.parse_number: numbers as people type them, exact round trips, one-line bounded errors."""
+"""tpm_viz.core.numbers.parse_number: numbers as people type them, exact round trips, one-line bounded errors."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tests.support.hypo import examples
-from tpm_viz.errors import InputError
-from tpm_viz.numbers import MAX_TEXT, parse_number, plausibility_note
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.numbers import MAX_TEXT, parse_number, plausibility_note
 
 finite = st.floats(allow_nan=False, allow_infinity=False)
 BOUNDED = settings(max_examples=examples(300), deadline=None)

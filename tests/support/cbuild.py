@@ -14,9 +14,9 @@ import subprocess
 
 import numpy as np
 
-from tpm_viz.errors import InvalidParametersError
-from tpm_viz.exchange.c_code import c_files
-from tpm_viz.params import Params
+from tpm_viz.core.errors import InvalidParametersError
+from tpm_viz.core.params import Params
+from tpm_viz.exchange.c.code import c_files
 
 CFLAGS = ["-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-pedantic"]
 SANITIZE = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-g"]

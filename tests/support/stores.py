@@ -7,8 +7,8 @@ from pathlib import Path
 from typing import Any
 
 from tests.support.storm import page_cookie
-from tpm_viz.app.sessions import Saved
 from tpm_viz.classroom.records import Records
+from tpm_viz.classroom.sessionfile import Saved
 from tpm_viz.classroom.store import SqliteStore
 
 __all__ = ["page_cookie", "stored_lecture", "stored_tabs"]

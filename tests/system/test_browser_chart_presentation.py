@@ -20,9 +20,9 @@ import pytest
 from tests.support.protocol import wait_for
 from tests.support.stage import GROUP_OF, open_tab
 from tests.system.test_browser_charts import _check_chart, open_with_a_run
-from tpm_viz.ui.teaching.charts import FORCES, KINEMATICS
+from tpm_viz.core.words import Lang, catalogue
+from tpm_viz.ui.teaching.player.charts import FORCES, KINEMATICS
 from tpm_viz.viserkit.probe import widget_uuid
-from tpm_viz.words import Lang, catalogue
 
 pytestmark = pytest.mark.browser
 

@@ -25,9 +25,9 @@ import pytest
 from tests.support.protocol import wait_for
 from tests.support.stage import open_tab
 from tpm_viz.app.runs import Source
-from tpm_viz.ui.teaching.charts import FORCES, KINEMATICS
+from tpm_viz.core.words import Lang, say
+from tpm_viz.ui.teaching.player.charts import FORCES, KINEMATICS
 from tpm_viz.viserkit.probe import widget_uuid
-from tpm_viz.words import Lang, say
 
 pytestmark = pytest.mark.browser
 

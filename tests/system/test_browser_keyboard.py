@@ -14,7 +14,7 @@ import pytest
 
 from tests.support.protocol import wait_for
 from tpm_viz.app.demos import demo_params
-from tpm_viz.words import Lang, T, say
+from tpm_viz.core.words import Lang, T, say
 
 pytestmark = pytest.mark.browser
 

@@ -20,8 +20,8 @@ import pytest
 from tests.support.browser import CHROMIUM, CHROMIUM_ARGS
 from tests.support.protocol import wait_for
 from tests.support.stage import GROUP_OF, open_tab
+from tpm_viz.core.words import Lang, catalogue
 from tpm_viz.ui.panels import GROUPS
-from tpm_viz.words import Lang, catalogue
 
 HANGUL = re.compile("[\uac00-\ud7a3]")
 CUT = """

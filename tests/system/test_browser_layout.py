@@ -25,7 +25,7 @@ import pytest
 from tests.support.browser import launched_chromium
 from tests.support.protocol import wait_for
 from tests.support.stage import open_tab
-from tpm_viz import meshes
+from tpm_viz.drawing import meshes
 from tpm_viz.ui.app import TpmApp, build_server
 from tpm_viz.viserkit.probe import widget_uuid
 

@@ -21,8 +21,8 @@ import viser.transforms as tf
 
 from tests.support.browser import launched_chromium
 from tests.support.protocol import wait_for
-from tpm_viz import meshes
 from tpm_viz.app import transitions
+from tpm_viz.drawing import meshes
 from tpm_viz.ui.app import TpmApp, build_server
 from tpm_viz.ui.phone import TOUCH_GIZMO_PX
 from tpm_viz.ui.scene import GIZMO_Z

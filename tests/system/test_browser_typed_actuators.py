@@ -18,7 +18,7 @@ import pytest
 from tests.support.browser import text_input
 from tests.support.protocol import wait_for
 from tests.support.scene_frames import node_positions, open_recorded
-from tpm_viz.ui.typed import QUIET
+from tpm_viz.ui.widgets.typed import QUIET
 from tpm_viz.viserkit.probe import widget_uuid
 
 pytestmark = pytest.mark.browser

@@ -21,15 +21,15 @@ from tests.support.protocol import ServerProcess, wait_for
 from tests.support.proxy import TcpProxy
 from tests.support.stage import open_tab
 from tests.support.stores import page_cookie, stored_lecture
-from tpm_viz.app import sessions
 from tpm_viz.app.runs import Source, build_run
-from tpm_viz.app.sessions import Document, Saved
 from tpm_viz.app.state import AppState
+from tpm_viz.classroom import sessionfile
+from tpm_viz.classroom.runhub import sampled
+from tpm_viz.classroom.sessionfile import Document, Saved
+from tpm_viz.core.params import Params
 from tpm_viz.paper.trajectories import Trajectory
-from tpm_viz.params import Params
 from tpm_viz.ui.continuity import SAVE_SECONDS
 from tpm_viz.ui.continuity import lecture_store as Store
-from tpm_viz.ui.teaching.playing import sampled
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
@@ -177,7 +177,7 @@ def test_a_restart_finds_the_lecturers_state(tmp_path):
     path = tmp_path / "session.json"  # a JSON session file: imported once into the store beside it
     params = Params.paper(l_a=0.27)
     state = sampled(AppState.initial(params), build_run(params, _csv_source()), 0.1)  # as a lecturer left it
-    sessions.write_atomic(path, sessions.dumps(Document(Saved(state, _csv_source()), lesson_step=2)))
+    sessionfile.write_atomic(path, sessionfile.dumps(Document(Saved(state, _csv_source()), lesson_step=2)))
     original = path.read_bytes()
     store = tmp_path / "session.json.sqlite3"
     first = ServerProcess(session=path)
@@ -243,7 +243,7 @@ def _saved_l_a(store: Path) -> float:
 
 def test_fresh_starts_clean_and_leaves_the_file_as_it_is(tmp_path):
     path = tmp_path / "session.json"
-    sessions.write_atomic(path, sessions.dumps(Document(Saved(AppState.initial(Params.paper(l_a=0.27))))))
+    sessionfile.write_atomic(path, sessionfile.dumps(Document(Saved(AppState.initial(Params.paper(l_a=0.27))))))
     original = path.read_bytes()
     store = tmp_path / "session.json.sqlite3"
     server = ServerProcess(session=path, args=("--fresh",))

@@ -167,7 +167,7 @@ def test_the_scan_finds_references_and_catches_a_wrong_one():
     assert _resolves("inverse_kinematics", "tpm_viz.paper.dynamics", None)
     assert _resolves(".kinematics.inverse_kinematics", "tpm_viz.paper.dynamics", None)
     assert not _resolves(".kinematics.no_such_function", "tpm_viz.paper.dynamics", None)
-    assert _resolves(".text.num", "tpm_viz.ui.teaching.player_text", None)  # Sphinx's suffix search
+    assert _resolves(".text.num", "tpm_viz.ui.teaching.player.text", None)  # Sphinx's suffix search
     assert not _resolves(".no_such_module", "tpm_viz.ui.app", None)
     assert not _resolves("paper.no_such_module", "tpm_viz.app.state", None)
 

@@ -1,5 +1,5 @@
 """Refusals and notes reach a Korean tab in Korean (issue 13): the errors the library raises for what a user types,
-uploads or drags carry a :class:`~tpm_viz.words.Phrase`, so ``say(Lang.KO, exc)`` is Korean with the same numbers
+uploads or drags carry a :class:`~tpm_viz.core.words.Phrase`, so ``say(Lang.KO, exc)`` is Korean with the same numbers
 and quotes, while ``str(exc)`` (the command line, the logs) keeps its English words.
 
 Each case triggers a real refusal through the public functions, then checks three things independently of the
@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from tpm_viz import Params
-from tpm_viz.app import sessions, transitions
+from tpm_viz.app import transitions
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES, read_upload
 from tpm_viz.app.moves import Pose
 from tpm_viz.app.planner import Limits
@@ -23,12 +23,13 @@ from tpm_viz.app.planning import parse_waypoints
 from tpm_viz.app.readouts import evaluate
 from tpm_viz.app.runs import Source, build_run
 from tpm_viz.app.state import AppState
+from tpm_viz.classroom import sessionfile
 from tpm_viz.classroom.access import Access
-from tpm_viz.errors import TpmVizError
-from tpm_viz.numbers import unit_factor
+from tpm_viz.core.errors import TpmVizError
+from tpm_viz.core.numbers import unit_factor
+from tpm_viz.core.words import Lang, T, say
 from tpm_viz.paper.kinematics import forward_kinematics
 from tpm_viz.paper.trajectories import parse_trajectory_csv
-from tpm_viz.words import Lang, T, say
 
 P = Params.paper()
 HANGUL = re.compile("[\uac00-\ud7a3]")
@@ -83,11 +84,11 @@ CASES = {
         "the force limit must be a positive, finite number of newtons, got -5",
     ),
     "a session file of another program": (
-        lambda: sessions.loads('{"format": "other"}'),
+        lambda: sessionfile.loads('{"format": "other"}'),
         "session file: not a tpm-viz session",
     ),
     "a session file of another version": (
-        lambda: sessions.loads('{"format": "tpm-viz-session", "version": 99}'),
+        lambda: sessionfile.loads('{"format": "tpm-viz-session", "version": 99}'),
         "session file: version 99, this tpm-viz reads version 1",
     ),
     "actuators the legs cannot join": (

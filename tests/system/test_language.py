@@ -15,10 +15,10 @@ import pytest
 from tests.support.pages import Page, classroom_app, views_of
 from tests.support.protocol import ServerProcess, wait_for
 from tests.support.stores import page_cookie, stored_tabs
-from tpm_viz.app import sessions
-from tpm_viz.app.sessions import Document, Saved
 from tpm_viz.app.state import AppState
-from tpm_viz.words import Lang, catalogue, preferred
+from tpm_viz.classroom import sessionfile
+from tpm_viz.classroom.sessionfile import Document, Saved
+from tpm_viz.core.words import Lang, catalogue, preferred
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
@@ -172,13 +172,13 @@ def test_a_restart_brings_a_tab_back_in_its_language(tmp_path):
 def test_the_session_file_keeps_each_tabs_language_and_reads_older_files_as_english():
     saved = Saved(AppState.initial(), lang="ko")
     doc = Document(Saved(AppState.initial()), tabs={"c:x": [{"private": False, "saved": saved, "left_at": 1e9}]})
-    text = sessions.dumps(doc)
-    back = sessions.loads(text, now=1e9 + 1)
+    text = sessionfile.dumps(doc)
+    back = sessionfile.loads(text, now=1e9 + 1)
     assert back.tabs["c:x"][0]["saved"].lang == "ko" and back.shared.lang == "en"
     raw = json.loads(text)
     del raw["tabs"]["c:x"][0]["saved"]["lang"]  # a file written before languages
     raw["shared"]["lang"] = "tlh"  # and a language this app does not have
-    old = sessions.loads(json.dumps(raw), now=1e9 + 1)
+    old = sessionfile.loads(json.dumps(raw), now=1e9 + 1)
     assert old.tabs["c:x"][0]["saved"].lang == "en" and old.shared.lang == "en"
 
 

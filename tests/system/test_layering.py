@@ -1,23 +1,21 @@
 """Architecture rules, read from the source: folders by layer, each with one import rule; no cycles; viser behind
-one door; no module over 400 lines. The rules are per folder (a new module obeys its folder's rule automatically).
+one door; no module over 400 lines. The layer of a module is its folder under ``tpm_viz/`` (a new module obeys its
+folder's rule automatically), and each rule is one test.
 
 Layers, bottom up (a module may import its own layer and the layers its rule lists, never one above):
 
-- base (``errors``, ``params``, ``csvio``, ``csvdialect``, ``numbers``, ``words``, ``files``): the standard library and
-  numpy;
-- ``paper/``: the paper's maths, numpy only;
-- drawing (``meshes``, ``meshes_parallel``, ``figures``, ``clips``, ``videos``, ``views3d``): trimesh / matplotlib /
-  Pillow / PyAV over the paper's maths;
-- ``reports/``: documents of a run (the lab report) from the app's runs and the drawing layer;
-- ``exchange/``: model files written from the parameters (no simulator imported);
+- ``core/``: errors, parameters, numbers, words, files, CSV: the standard library and numpy;
+- ``paper/`` (with ``paper/parallel/``): the paper's maths, numpy only;
+- ``drawing/``: trimesh parts, matplotlib figures, the palette, over the paper's maths;
+- ``media/``: what leaves the room (clips, 3D frames, videos, the lab report): drawing and the app's runs;
+- ``exchange/`` (with ``exchange/c/``): model files and C written from the parameters (no simulator imported);
 - ``multibody/``: the only place that imports pinocchio;
 - ``app/``: pure app behaviour, no viser, no pinocchio;
-- ``classroom/``: the classroom's shared state (sessions, drags, snapshot, pacing, access), store, identities, saving
-  and jobs: the standard library, base, paper, drawing, app and platformdirs (no viser);
-- ``viserkit/``: the adapter, the only place that touches viser's or websockets' internals: base, app, classroom,
-  viser and websockets;
-- ``cluster`` (``tpm_viz/cluster.py``): the only place that imports Dask (the optional extra ``.[cluster]``);
-- ``ui/``: the per-tab views through viser's public API (its private names only in ``viserkit/``);
+- ``design/``: the design studio over the app's planner (the only place that imports Dask: ``design/cluster.py``);
+- ``classroom/``: the classroom's shared state, runs, store, identities, links, saving and jobs (no viser);
+- ``lti/``: the LTI 1.3 tool (an ASGI service), over the classroom;
+- ``viserkit/``: the adapter, the only place that touches viser's or websockets' internals;
+- ``ui/`` (with ``ui/widgets/`` and ``ui/teaching/``): the per-tab views through viser's public API;
 - ``cli/``: may import every layer; nothing imports it but ``__main__``.
 """
 
@@ -34,61 +32,36 @@ import pytest
 
 PACKAGE = pathlib.Path(__file__).resolve().parents[2] / "tpm_viz"
 STDLIB = set(sys.stdlib_module_names) | {"__future__"}
-
-BASE = {"errors", "params", "csvio", "csvdialect", "numbers", "words", "files"}
-DRAWING = {"meshes", "figures", "clips", "videos", "meshes_parallel", "views3d"}
+LAYERS = ("core", "paper", "drawing", "media", "exchange", "multibody", "app", "design", "classroom", "lti")
+LAYERS += ("viserkit", "ui", "cli")
 
 # layer -> (tpm_viz layers it may import, third-party packages it may import)
 RULES: dict[str, tuple[set[str], set[str]]] = {
-    "base": ({"base"}, {"numpy"}),
-    "paper": ({"base", "paper"}, {"numpy"}),
-    "drawing": ({"base", "paper", "drawing"}, {"numpy", "trimesh", "matplotlib", "PIL", "av"}),
-    "reports": ({"base", "paper", "drawing", "app", "reports"}, {"numpy"}),
-    "exchange": ({"base", "paper", "exchange"}, {"numpy"}),
-    "multibody": ({"base", "paper", "multibody"}, {"numpy", "pinocchio"}),
-    "app": ({"base", "paper", "app"}, {"numpy", "toppra", "scipy"}),
-    "classroom": ({"base", "paper", "drawing", "app", "classroom"}, {"numpy", "platformdirs"}),
-    "viserkit": ({"base", "app", "classroom", "viserkit"}, {"numpy", "viser", "websockets"}),
-    "cluster": ({"base", "paper", "app", "cluster"}, {"numpy", "distributed", "dask"}),  # tpm_viz/cluster.py
-    "ui": (
-        {"base", "paper", "drawing", "multibody", "app", "reports", "classroom", "viserkit", "ui"},
-        {"numpy", "trimesh", "viser", "platformdirs", "segno"},
-    ),
-    "cli": (
-        {
-            "base",
-            "paper",
-            "drawing",
-            "exchange",
-            "multibody",
-            "app",
-            "reports",
-            "classroom",
-            "viserkit",
-            "ui",
-            "cluster",
-            "cli",
-        },
-        {"numpy"},
-    ),
-    "api": ({"base", "paper"}, set()),  # tpm_viz/__init__.py: the public API
+    "core": ({"core"}, {"numpy"}),
+    "paper": ({"core", "paper"}, {"numpy"}),
+    "drawing": ({"core", "paper", "drawing"}, {"numpy", "trimesh", "matplotlib"}),
+    "media": ({"core", "paper", "drawing", "app", "media"}, {"numpy", "trimesh", "matplotlib", "PIL", "av"}),
+    "exchange": ({"core", "paper", "exchange"}, {"numpy"}),
+    "multibody": ({"core", "paper", "multibody"}, {"numpy", "pinocchio"}),
+    "app": ({"core", "paper", "app"}, {"numpy", "toppra", "scipy"}),
+    "design": ({"core", "paper", "app", "design"}, {"numpy", "scipy", "distributed", "dask"}),
+    "classroom": ({"core", "paper", "drawing", "app", "classroom"}, {"numpy", "platformdirs"}),
+    "lti": ({"core", "app", "classroom", "lti"}, {"jwt", "cryptography", "starlette", "uvicorn", "httpx"}),
+    "viserkit": ({"core", "app", "classroom", "viserkit"}, {"numpy", "viser", "websockets"}),
+    "ui": (set(LAYERS) - {"cli", "lti"}, {"numpy", "trimesh", "viser", "platformdirs", "segno"}),
+    "cli": (set(LAYERS), {"numpy"}),
+    "api": ({"core", "paper"}, set()),  # tpm_viz/__init__.py: the public API
     "main": ({"cli"}, set()),  # tpm_viz/__main__.py
 }
 
 
 def layer_of(module: str) -> str:
-    """The layer of a dotted module name under tpm_viz (``tpm_viz.paper.kinematics`` -> ``paper``)."""
+    """The layer of a dotted module name: its folder under tpm_viz (``tpm_viz.paper.parallel.dynamics`` ->
+    ``paper``)."""
     parts = module.split(".")[1:]
     if not parts:
         return "api"
-    head = parts[0]
-    if head in BASE:
-        return "base"
-    if head in DRAWING:
-        return "drawing"
-    if head == "__main__":
-        return "main"
-    return head
+    return "main" if parts[0] == "__main__" else parts[0]
 
 
 @functools.cache
@@ -127,29 +100,38 @@ def imports(path: pathlib.Path, module: str) -> list[tuple[str, bool]]:
 MODULES = modules()
 
 
-@pytest.mark.parametrize("module", sorted(MODULES))
-def test_each_module_imports_only_what_its_layer_allows(module):
-    layer = layer_of(module)
-    assert layer in RULES, f"{module}: folder {layer!r} has no import rule; add one to RULES"
+def test_every_folder_of_the_package_is_a_layer_with_a_rule():
+    folders = {p.parent.relative_to(PACKAGE).parts[0] for p in PACKAGE.rglob("*.py") if p.parent != PACKAGE}
+    loose = sorted(p.name for p in PACKAGE.glob("*.py"))
+    assert folders <= set(RULES), f"folders without an import rule: {sorted(folders - set(RULES))}"
+    assert loose == ["__init__.py", "__main__.py"], f"modules loose at the package root: {loose}"
+
+
+@pytest.mark.parametrize("layer", sorted(RULES))
+def test_the_layer_imports_only_what_its_rule_allows(layer):
     allowed_layers, allowed_third = RULES[layer]
-    for imported, _ in imports(MODULES[module], module):
-        root = imported.split(".")[0]
-        if root == "tpm_viz":
-            target = layer_of(imported)
-            assert target in allowed_layers, f"{module} ({layer}) imports {imported} ({target}): points up a layer"
-        elif root not in STDLIB:
-            assert root in allowed_third, f"{module} ({layer}) imports {root}: not allowed in {layer}/"
+    wrong = []
+    for module in (m for m in MODULES if layer_of(m) == layer):
+        for imported, _ in imports(MODULES[module], module):
+            root = imported.split(".")[0]
+            if root == "tpm_viz" and layer_of(imported) not in allowed_layers:
+                wrong.append(f"{module} imports {imported} ({layer_of(imported)}): points up a layer")
+            elif root not in STDLIB and root != "tpm_viz" and root not in allowed_third:
+                wrong.append(f"{module} imports {root}: not allowed in {layer}/")
+    assert wrong == []
 
 
-@pytest.mark.parametrize("module", sorted(MODULES))
-def test_no_import_inside_functions_except_the_cli_deferring_heavy_layers(module):
+def test_no_import_inside_functions_except_the_cli_deferring_heavy_layers():
     """Lazy imports hide cycles and cost; the command line alone defers the heavy modules (pinocchio, viser,
     matplotlib, toppra) to the subcommand that needs them, so ``tpm-viz kinematics`` starts fast."""
-    lazy = [name for name, top in imports(MODULES[module], module) if not top]
-    if layer_of(module) == "cli":
-        assert all(n.startswith("tpm_viz") for n in lazy), lazy
-    else:
-        assert lazy == [], f"{module} imports inside a function: {lazy}"
+    wrong = []
+    for module, path in MODULES.items():
+        lazy = [name for name, top in imports(path, module) if not top]
+        if layer_of(module) == "cli":
+            wrong += [f"{module}: {n} (not tpm-viz's own)" for n in lazy if not n.startswith("tpm_viz")]
+        else:
+            wrong += [f"{module} imports {n} inside a function" for n in lazy]
+    assert wrong == []
 
 
 def test_no_import_cycle():
@@ -185,9 +167,9 @@ def test_nothing_imports_the_command_line():
             assert not any(layer_of(i) == "cli" for i, _ in imports(path, module) if i.startswith("tpm_viz")), module
 
 
-@pytest.mark.parametrize("module", sorted(MODULES))
-def test_no_module_over_400_lines(module):
-    assert len(MODULES[module].read_text().splitlines()) <= 400, f"{module}: split it by concept"
+def test_no_module_over_400_lines():
+    long = {m: n for m, p in MODULES.items() if (n := len(p.read_text().splitlines())) > 400}
+    assert long == {}, f"split these by concept: {long}"
 
 
 PRIVATE_VISER = re.compile(

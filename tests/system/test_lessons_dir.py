@@ -10,7 +10,7 @@ import pytest
 
 from tpm_viz.app.lessons import assets_dir
 from tpm_viz.cli import main as cli_main
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
 from tpm_viz.ui.app import main as serve
 
 

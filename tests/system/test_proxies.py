@@ -22,9 +22,9 @@ from websockets.sync.client import connect as connect_sync
 from tests.support.forwarding_proxy import ForwardingProxy
 from tests.support.pages import ADDRESSES, TOKEN, Page
 from tests.support.protocol import CAMERA, wait_for
-from tpm_viz.app.network import PROXIED, UNKNOWN, HostRules, Network, client_address, header_problem, host_name
+from tpm_viz.classroom.network import PROXIED, UNKNOWN, HostRules, Network, client_address, header_problem, host_name
 from tpm_viz.cli import main as cli_main
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
 from tpm_viz.ui.app import TpmApp, build_server
 from tpm_viz.ui.classroom import Classroom
 

@@ -32,7 +32,7 @@ from websockets.sync.client import connect as connect_sync
 from tests.support.pages import classroom_app
 from tests.support.protocol import CAMERA, decode_batch
 from tpm_viz.app.lessons import DEMOS
-from tpm_viz.words import Lang, Phrase, catalogue, fields_of
+from tpm_viz.core.words import Lang, Phrase, catalogue, fields_of
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 

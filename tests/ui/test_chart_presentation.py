@@ -1,7 +1,8 @@
-"""The player's charts follow a tab's presentation mode (:meth:`tpm_viz.ui.teaching.charts.Charts.set_presentation`),
-through viser's protocol: what the tab's uPlot charts are sent, measured against DejaVu Sans (the widest of the usual
-sans fonts, shipped with matplotlib) with Pillow, not with the module's own width estimate. The browser's drawing is
-checked in ``tests/system/test_browser_chart_presentation.py``.
+"""The player's charts follow a tab's presentation mode
+(:meth:`tpm_viz.ui.teaching.player.charts.Charts.set_presentation`), through viser's protocol: what the tab's uPlot
+charts are sent, measured against DejaVu Sans (the widest of the usual sans fonts, shipped with matplotlib) with Pillow,
+not with the module's own width estimate. The browser's drawing is checked in
+``tests/system/test_browser_chart_presentation.py``.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from PIL import ImageFont
 
 from tests.support.protocol import wait_for
 from tpm_viz.app.runs import Source
-from tpm_viz.ui.teaching.charts import NARROWEST_PX
+from tpm_viz.ui.teaching.player.charts import NARROWEST_PX
 
 SIZE = 18  # [px] the presentation font asked for: at least 16 px on a projector
 TICK, GAP = 10, 5  # [px] uPlot's tick length and the gap to its label, as the charts send them

@@ -8,8 +8,8 @@ import time
 
 from tests.support.fixtures import open_tab
 from tests.support.protocol import ProtocolClient, wait_for
+from tpm_viz.core.words import Lang
 from tpm_viz.ui import app as app_module
-from tpm_viz.words import Lang
 
 HANGUL = re.compile("[\uac00-\ud7a3]")
 

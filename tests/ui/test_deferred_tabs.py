@@ -12,8 +12,8 @@ import weakref
 
 from tests.support.fixtures import open_tab
 from tests.support.protocol import ProtocolClient, wait_for
-from tpm_viz.app.sessions import Saved
 from tpm_viz.classroom.later import Later
+from tpm_viz.classroom.sessionfile import Saved
 from tpm_viz.ui.teaching.tabs import LATER
 
 _ID = re.compile(r"[0-9a-f]{8}-?[0-9a-f]{4}-?[0-9a-f]{4}-?[0-9a-f]{4}-?[0-9a-f]{12}|data-tpmviz-keys=[^>]*")

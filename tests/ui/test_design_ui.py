@@ -1,5 +1,5 @@
 """The *Design* tab without a browser (a served app and a protocol client): the heat map's cells hold the indices
-:func:`tpm_viz.app.design.evaluate` gives for those designs (called here directly), infeasible cells are grey and
+:func:`tpm_viz.design.indices.evaluate` gives for those designs (called here directly), infeasible cells are grey and
 say so without a number, a click on a cell, its column and row typed, or *Load best design* load that design into
 the tab's mechanism, and the parallel mechanism is drawn where the closed-form kinematics of the issue put it."""
 
@@ -13,12 +13,12 @@ import pytest
 
 from tests.support.protocol import wait_for
 from tpm_viz import Params
-from tpm_viz.app.design import Task, evaluate
-from tpm_viz.errors import TpmVizError
+from tpm_viz.core.errors import TpmVizError
+from tpm_viz.core.words import Lang, T
+from tpm_viz.design.indices import Task, evaluate
 from tpm_viz.paper.arrangement import Arrangement
-from tpm_viz.ui.teaching import design_text as text
-from tpm_viz.ui.teaching.design_map import INFEASIBLE_COLOUR, Axis, MapSpec, best_cell, colours, prototype_at, ramp
-from tpm_viz.words import Lang, T
+from tpm_viz.ui.teaching.design import text
+from tpm_viz.ui.teaching.design.map import INFEASIBLE_COLOUR, Axis, MapSpec, best_cell, colours, prototype_at, ramp
 
 P = Params.paper()
 TASK = Task(-0.05, 0.05, -0.05, 0.05)

@@ -15,10 +15,10 @@ from tpm_viz.app.state import AppState
 from tpm_viz.classroom import snapshot
 from tpm_viz.classroom.pacing import LIVE_NUMBERS_INTERVAL
 from tpm_viz.classroom.session import Hub
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Lang
 from tpm_viz.multibody import inverse_dynamics as pinocchio_inverse_dynamics
 from tpm_viz.paper.kinematics import forward_kinematics
-from tpm_viz.params import Params
-from tpm_viz.words import Lang
 
 P = Params.paper()
 

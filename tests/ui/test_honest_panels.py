@@ -16,8 +16,8 @@ import pytest
 
 from tests.support.fixtures import open_tab
 from tests.support.protocol import wait_for
-from tpm_viz.app import sessions
 from tpm_viz.app.readouts import Load
+from tpm_viz.classroom import sessionfile
 from tpm_viz.paper.dynamics import inverse_dynamics
 from tpm_viz.ui.app import TpmApp, build_server
 from tpm_viz.ui.teaching.stage import CONTROL, front
@@ -77,7 +77,7 @@ def test_a_saved_session_after_a_control_run_reopens_at_rest(app, connect):
     _control_run(client, view)
     saved = _state(view)
     text = app.room.session_json()  # what *Save session* downloads
-    raw = sessions.json.loads(text)["shared"]
+    raw = sessionfile.json.loads(text)["shared"]
     assert raw["load"]["mode"] == "static" and raw["sample"]["kind"] == "none"  # the run's load is not saved
 
     server = build_server("127.0.0.1", 0)  # a restart: a new server opens the file

@@ -19,11 +19,11 @@ from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz.app.overlays import MAP_KINDS
 from tpm_viz.app.run_names import label_words, reference_words
 from tpm_viz.app.runs import Source, build_run
-from tpm_viz.params import Params
-from tpm_viz.reports.report import report_html
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Lang, T, catalogue, say
+from tpm_viz.media.report import report_html
 from tpm_viz.ui.language import show_text
 from tpm_viz.viserkit.probe import widget_uuid
-from tpm_viz.words import Lang, T, catalogue, say
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 

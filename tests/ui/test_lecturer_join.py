@@ -3,8 +3,8 @@ and says nothing of it when the URL is on the room's network."""
 
 from __future__ import annotations
 
+from tpm_viz.core.words import Lang, say
 from tpm_viz.ui.lecturer import LOOPBACK_ONLY, join_html
-from tpm_viz.words import Lang, say
 
 
 def test_a_loopback_only_class_is_warned_in_the_panel():

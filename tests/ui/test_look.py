@@ -13,7 +13,7 @@ import viser
 import viser.transforms as tf
 
 from tests.support.protocol import CAMERA, ProtocolClient, wait_for
-from tpm_viz import meshes
+from tpm_viz.drawing import meshes
 
 
 def _fractions(camera, points) -> np.ndarray:

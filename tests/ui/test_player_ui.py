@@ -14,7 +14,7 @@ from tests.support.protocol import wait_for
 from tpm_viz import Params
 from tpm_viz.app.lessons import DEMOS
 from tpm_viz.paper.trajectories import circle_state, line_state
-from tpm_viz.ui.teaching.charts import CHART_POINTS
+from tpm_viz.ui.teaching.player.charts import CHART_POINTS
 from tpm_viz.viserkit.probe import widget_uuid
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out

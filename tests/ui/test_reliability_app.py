@@ -33,8 +33,8 @@ from tpm_viz.app.inputs import MAX_UPLOAD_BYTES, read_choice, read_flag, read_nu
 from tpm_viz.app.moves import check, ik_branch
 from tpm_viz.app.state import AppState
 from tpm_viz.classroom.session import Hub
+from tpm_viz.core.params import PARAM_INFO
 from tpm_viz.paper.status import PoseStatus
-from tpm_viz.params import PARAM_INFO
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 

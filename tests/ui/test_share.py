@@ -16,16 +16,16 @@ from websockets.http11 import Response
 
 from tests.support.pages import Page, views_of
 from tests.support.protocol import wait_for
-from tpm_viz.app.links import LINK_VERSION, PendingLinks, encode_link
 from tpm_viz.app.runs import Source
-from tpm_viz.app.sessions import Saved
+from tpm_viz.classroom.links import LINK_VERSION, PendingLinks, encode_link
+from tpm_viz.classroom.sessionfile import Saved
+from tpm_viz.core.words import Lang, Phrase, say
 from tpm_viz.paper.trajectories import Trajectory
 from tpm_viz.ui.app import TpmApp, build_server
 from tpm_viz.ui.classroom import SHARE_COOKIE, Handshakes, shared_token
 from tpm_viz.ui.continuity import lecture_store
 from tpm_viz.ui.share import origin_of
 from tpm_viz.viserkit.probe import widget_uuid
-from tpm_viz.words import Lang, Phrase, say
 
 RUN_SECONDS = 120.0  # a run is computed in the worker: generous under a loaded machine (no timed assert)
 

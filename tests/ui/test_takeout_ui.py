@@ -16,16 +16,16 @@ import scipy.ndimage
 from PIL import Image
 
 from tests.support.protocol import CAMERA, wait_for
-from tpm_viz.app.palette import PALETTE
-from tpm_viz.meshes import PLATFORM_Z
-from tpm_viz.ui.teaching.recording import APP_FRAMES, SCENE_COLOURS, SLOTS, frames_of
-from tpm_viz.ui.teaching.takeout import tab_camera
-from tpm_viz.views3d import Camera, View3dRenderer
-from tpm_viz.words import Lang, say
+from tpm_viz.core.words import Lang, say
+from tpm_viz.drawing.meshes import PLATFORM_Z
+from tpm_viz.drawing.palette import PALETTE
+from tpm_viz.media.views3d import Camera, View3dRenderer
+from tpm_viz.ui.teaching.takeout.buttons import tab_camera
+from tpm_viz.ui.teaching.takeout.recording import APP_FRAMES, SCENE_COLOURS, SLOTS, frames_of
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
-BLUE, RED = (31, 119, 180), (214, 39, 40)  # the bars of τ1 and τ2 (tpm_viz.clips.BAR_COLOURS)
+BLUE, RED = (31, 119, 180), (214, 39, 40)  # the bars of τ1 and τ2 (tpm_viz.media.clips.BAR_COLOURS)
 
 
 def _catch(view) -> list[tuple[str, bytes]]:

@@ -10,7 +10,7 @@ import pytest
 
 from tests.support.protocol import wait_for
 from tpm_viz.classroom.text import LEGEND
-from tpm_viz.words import Lang, catalogue
+from tpm_viz.core.words import Lang, catalogue
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 

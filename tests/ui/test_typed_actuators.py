@@ -16,9 +16,9 @@ import pytest
 from tests.support.protocol import wait_for
 from tpm_viz import Params
 from tpm_viz.app import transitions
-from tpm_viz.ui.typed import QUIET
+from tpm_viz.core.words import Lang, catalogue
+from tpm_viz.ui.widgets.typed import QUIET
 from tpm_viz.viserkit.probe import widget_uuid
-from tpm_viz.words import Lang, catalogue
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 

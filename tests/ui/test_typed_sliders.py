@@ -22,7 +22,7 @@ from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz import Params
 from tpm_viz.app.paths import path_for
 from tpm_viz.app.planner import Limits, plan_cycle
-from tpm_viz.ui.typed import QUIET
+from tpm_viz.ui.widgets.typed import QUIET
 from tpm_viz.viserkit.probe import widget_uuid
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out

@@ -17,7 +17,7 @@ import pytest
 
 from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz import Params
-from tpm_viz.ui.typed import QUIET
+from tpm_viz.ui.widgets.typed import QUIET
 from tpm_viz.viserkit.probe import arrive, widget_uuid
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out

@@ -20,10 +20,10 @@ import pytest
 
 from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES
+from tpm_viz.core.words import Lang
 from tpm_viz.ui.app import build_server
 from tpm_viz.viserkit.probe import widget_uuid
 from tpm_viz.viserkit.transport import harden
-from tpm_viz.words import Lang
 
 HANGUL = re.compile("[\uac00-\ud7a3]")
 

@@ -21,9 +21,9 @@ from websockets.sync.client import connect as connect_sync
 
 from tests.support.protocol import CAMERA, ProtocolClient, wait_for
 from tpm_viz.app.readouts import LOAD_MODES
+from tpm_viz.core.words import Lang
 from tpm_viz.ui.worded import TabGui
 from tpm_viz.viserkit.probe import arrive, outgoing_replaced, widget_uuid
-from tpm_viz.words import Lang
 
 KO = tomllib.loads((Path(__file__).resolve().parents[2] / "assets" / "words" / "ko.toml").read_text("utf-8"))
 """The Korean catalogue, read from its file."""

@@ -1,8 +1,10 @@
-"""Pure app behaviour, no browser: the app's state, its transitions, input readers, interactive moves, special
-poses, readouts, trajectory runs, lessons, floor overlays, the equations panel, who a connection
-comes from (:mod:`.network`), share links (:mod:`.links`), and the design studio (:mod:`.design`, :mod:`.atlas`,
-:mod:`.compare`).
+"""Pure app behaviour, no browser: the app's state (:mod:`.state`), its transitions (:mod:`.transitions`), input
+readers (:mod:`.inputs`), interactive moves (:mod:`.moves`), special poses (:mod:`.poses`), readouts
+(:mod:`.readouts`), trajectory runs (:mod:`.runs`), lessons (:mod:`.lessons`), floor overlays (:mod:`.overlays`), the
+equations panel (:mod:`.equations`), the planner's paths and timing (:mod:`.paths`, :mod:`.planner`,
+:mod:`.planning`) and motor sizing (:mod:`.sizing`).
 
 Import rule (checked by ``tests/system/test_layering.py``): no viser and no pinocchio; the Pinocchio reference forces
-come in as a callable (:data:`tpm_viz.app.readouts.Reference`). May import the base modules and :mod:`tpm_viz.paper`.
+come in as a callable (:data:`tpm_viz.app.readouts.Reference`). May import :mod:`tpm_viz.core` and
+:mod:`tpm_viz.paper`.
 """

@@ -14,10 +14,10 @@ import numpy as np
 
 from tpm_viz.app.moves import Pose
 from tpm_viz.app.runs import Source
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.params import Params
 from tpm_viz.paper.kinematics import forward_kinematics
 from tpm_viz.paper.trajectories import Trajectory
-from tpm_viz.params import Params
 
 __all__ = ["CHECK_NAMES", "LANGUAGES", "Camera", "Check", "Demo", "Motion", "demo_params", "demo_pose", "demo_source"]
 

@@ -3,7 +3,7 @@
 viser's Markdown does not render LaTeX; MathML inside an HTML block does render in the browser. Every
 number comes from :func:`tpm_viz.inverse_dynamics_detail` and :func:`tpm_viz.paper.jacobians`; this module only
 formats (mm, mm/s, mm/s², N, N/m) and never computes physics of its own. Non-finite numbers are shown as
-"—" so that nothing like NaN or inf reaches the screen. The words are phrases (:mod:`tpm_viz.words`), rendered in
+"—" so that nothing like NaN or inf reaches the screen. The words are phrases (:mod:`tpm_viz.core.words`), rendered in
 the language asked for (the app's tab, ``tpm-viz report --lang``); the formulas are the same in every language.
 """
 
@@ -17,10 +17,10 @@ from typing import SupportsFloat
 import numpy as np
 from numpy.typing import ArrayLike
 
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Lang, Phrase, T, say
 from tpm_viz.paper.dynamics import DynamicsResult
 from tpm_viz.paper.jacobians import Jacobians
-from tpm_viz.params import Params
-from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["ERRATA_HTML", "errata_html", "procedure_html"]
 

@@ -12,8 +12,8 @@ every GUI message before a callback runs (``viserkit/transport.py``): a number f
 text of at most :data:`MAX_TEXT` characters, a tuple of the widget's length (its answer is a log line, in English:
 a browser never sends such a value, so no user reads it).
 
-Every refusal carries a :class:`~tpm_viz.words.Phrase` (``str(exc)``: the English line; ``say(lang, exc)``: the line
-in a tab's language). A widget's ``name`` in a message may be a phrase (``T("time t")``), shown in the tab's
+Every refusal carries a :class:`~tpm_viz.core.words.Phrase` (``str(exc)``: the English line; ``say(lang, exc)``: the
+line in a tab's language). A widget's ``name`` in a message may be a phrase (``T("time t")``), shown in the tab's
 language, or a plain name (``"d1"``, ``"f_ext"``), shown as it is.
 """
 
@@ -25,10 +25,10 @@ from collections.abc import Iterable, Mapping
 import numpy as np
 
 from tpm_viz.app.readouts import reason
-from tpm_viz.errors import InputError, TpmVizError
+from tpm_viz.core.errors import InputError, TpmVizError
+from tpm_viz.core.params import PARAM_INFO, Params
+from tpm_viz.core.words import Phrase, T
 from tpm_viz.paper.trajectories import Trajectory, parse_trajectory_csv
-from tpm_viz.params import PARAM_INFO, Params
-from tpm_viz.words import Phrase, T
 
 __all__ = [
     "MAX_TEXT",

@@ -20,17 +20,17 @@ import re
 
 import numpy as np
 
-from tpm_viz import files
 from tpm_viz.app.demos import CHECK_NAMES, LANGUAGES, Camera, Check, Demo, Motion, demo_params, demo_pose, demo_source
 from tpm_viz.app.lesson_toml import MAX_FILE_BYTES, LessonError, Problem, Reader, line_of, parse
 from tpm_viz.app.moves import check, why_not
 from tpm_viz.app.overlays import MAP_KINDS
 from tpm_viz.app.readouts import reason
 from tpm_viz.app.runs import check_path
-from tpm_viz.errors import FileRefusedError, InputError, TpmVizError
+from tpm_viz.core import files
+from tpm_viz.core.errors import FileRefusedError, InputError, TpmVizError
+from tpm_viz.core.params import PARAM_INFO, Params
+from tpm_viz.core.words import Phrase, T
 from tpm_viz.paper.trajectories import parse_trajectory_csv
-from tpm_viz.params import PARAM_INFO, Params
-from tpm_viz.words import Phrase, T
 
 __all__ = ["MAX_FILE_BYTES", "LessonError", "assets_dir", "load_lesson", "load_lessons", "load_preset"]
 
@@ -167,7 +167,7 @@ def _key_of(path: pathlib.Path) -> str:
 
 def load_lesson(path: str | os.PathLike[str], root: str | os.PathLike[str] | None = None) -> Demo:
     """One lesson file (raises :class:`LessonError`; its ``line`` says where). It and the CSV file it names must be
-    regular files inside ``root`` (default: the lesson's own folder), read by :mod:`tpm_viz.files`."""
+    regular files inside ``root`` (default: the lesson's own folder), read by :mod:`tpm_viz.core.files`."""
     path = pathlib.Path(path)
     root = path.parent if root is None else pathlib.Path(root)
     text, data = parse(path, root)

@@ -1,6 +1,6 @@
 """Lesson and preset files as TOML with line numbers: where a key is written (:func:`line_of`), typed access that
 refuses a value at the line of its key (:class:`Reader`), and the file read and parsed (:func:`parse`). The words
-of a refusal are a :class:`~tpm_viz.words.Phrase` (shown in a tab's language; ``str()``: English).
+of a refusal are a :class:`~tpm_viz.core.words.Phrase` (shown in a tab's language; ``str()``: English).
 """
 
 from __future__ import annotations
@@ -11,9 +11,9 @@ import re
 import tomllib
 from typing import NoReturn
 
-from tpm_viz import files
-from tpm_viz.errors import FileRefusedError, InputError
-from tpm_viz.words import Phrase
+from tpm_viz.core import files
+from tpm_viz.core.errors import FileRefusedError, InputError
+from tpm_viz.core.words import Phrase
 
 __all__ = ["MAX_FILE_BYTES", "LessonError", "Problem", "Reader", "line_of", "parse"]
 
@@ -25,7 +25,7 @@ MAX_DEPTH = 8
 
 class Problem(str):
     """One refused file as a line of English (``file:line: what is wrong``: the command line, the log) that keeps its
-    words as a :class:`~tpm_viz.words.Phrase` in ``phrase`` (a tab shows them in its language)."""
+    words as a :class:`~tpm_viz.core.words.Phrase` in ``phrase`` (a tab shows them in its language)."""
 
     phrase: Phrase
 
@@ -170,7 +170,7 @@ def _name(table: str, key: str) -> str:
 
 def parse(path: pathlib.Path, root: pathlib.Path | None = None) -> tuple[str, dict]:
     """The text and the TOML data of ``path`` (:class:`LessonError` with the line on any problem), read with
-    :mod:`tpm_viz.files`' rules (a regular file inside ``root`` if given, at most :data:`MAX_FILE_BYTES`, nested
+    :mod:`tpm_viz.core.files`' rules (a regular file inside ``root`` if given, at most :data:`MAX_FILE_BYTES`, nested
     at most :data:`MAX_DEPTH` levels); a refusal never quotes the file."""
     try:
         raw = files.read_bytes(path, MAX_FILE_BYTES, root)

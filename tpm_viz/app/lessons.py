@@ -22,14 +22,14 @@ from tpm_viz.app.moves import Pose
 from tpm_viz.app.overlays import cached_map
 from tpm_viz.app.readouts import Reference
 from tpm_viz.app.runs import Run, build_run
-from tpm_viz.errors import InputError
-from tpm_viz.numbers import fixed
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.numbers import fixed
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase
 from tpm_viz.paper.ellipses import ManipulabilityEllipses, manipulability_ellipses
 from tpm_viz.paper.jacobians import Jacobians, condition_number, jacobians
 from tpm_viz.paper.kinematics import forward_kinematics_both
 from tpm_viz.paper.workspace import workspace_area
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase
 
 __all__ = [
     "CHECKS",

@@ -28,12 +28,12 @@ from typing import Literal, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tpm_viz.errors import InputError
-from tpm_viz.numbers import fixed
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.numbers import fixed
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase
 from tpm_viz.paper.kinematics import forward_kinematics_both, inverse_kinematics
 from tpm_viz.paper.status import MOVE_LIMITS, PoseStatus, SingularityThresholds
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase
 
 __all__ = [
     "Move",
@@ -94,7 +94,7 @@ class Pose:
 
 class Move(NamedTuple):
     """Result of a move: the new pose, whether it stopped short of the request, and why (one line: a
-    :class:`~tpm_viz.words.Phrase`, rendered in the tab's language; ``""`` when there is nothing to say)."""
+    :class:`~tpm_viz.core.words.Phrase`, rendered in the tab's language; ``""`` when there is nothing to say)."""
 
     pose: Pose
     clamped: bool = False

@@ -7,7 +7,7 @@
   exist (unreachable: NaN in the map) are fully transparent, so no NaN ever leaves this module; reachable cells
   outside the stroke are drawn faint.
 - :func:`colour_scale`: the legend of each kind (colour stops with their values and units; its words are
-  :class:`~tpm_viz.words.Phrase` s, rendered in a tab's language where the legend is shown).
+  :class:`~tpm_viz.core.words.Phrase` s, rendered in a tab's language where the legend is shown).
 - :func:`ellipse_polylines`: the velocity and force manipulability ellipses (:mod:`tpm_viz.paper.ellipses`) at a
   platform position, scaled for drawing, or None at a singular pose.
 - :func:`arrow_length`, :func:`arrow_vector`: how long the force arrows of the 3D view are drawn. Near a
@@ -26,11 +26,11 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from tpm_viz.errors import InputError, TpmVizError
+from tpm_viz.core.errors import InputError, TpmVizError
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase, T
 from tpm_viz.paper.ellipses import ellipse_outline, manipulability_ellipses
 from tpm_viz.paper.workspace import WorkspaceMap, workspace_map
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase, T
 
 __all__ = [
     "ARROW_FORCE",

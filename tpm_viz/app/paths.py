@@ -12,7 +12,7 @@ tangent) and ``p''(s)`` (curvature times the inward normal) are exact; the plann
 
 Every path is checked against the valid region: reachable (eq. 4), in stroke (``0 <= d_i <= Δd``) and away from
 both singularities (eqs. 11-12, :data:`~tpm_viz.paper.status.MOVE_LIMITS`); :func:`check_path` raises an
-:class:`~tpm_viz.errors.InputError` naming the first offending point.
+:class:`~tpm_viz.core.errors.InputError` naming the first offending point.
 """
 
 from __future__ import annotations
@@ -25,12 +25,12 @@ from enum import Enum
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tpm_viz.errors import InputError
-from tpm_viz.numbers import fixed
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.numbers import fixed
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase
 from tpm_viz.paper.arrangement import Arrangement, classify
 from tpm_viz.paper.status import MOVE_LIMITS, STATUS_WORDS, PoseStatus, SingularityThresholds
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase
 
 __all__ = [
     "CHECK_STEP",

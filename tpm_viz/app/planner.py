@@ -37,10 +37,10 @@ from toppra.constraint import DiscretizationType, LinearConstraint
 from toppra.interpolator import AbstractGeometricPath
 
 from tpm_viz.app.paths import GeometricPath, check_path
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase, T
 from tpm_viz.paper.arrangement import Arrangement, actuator_velocity, inverse_dynamics
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase, T
 
 __all__ = ["CHECK_RATE", "DEFAULT_GRID", "Limits", "Plan", "PlanSamples", "plan_cycle", "plan_path"]
 

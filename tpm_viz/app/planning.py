@@ -24,11 +24,11 @@ import numpy as np
 from tpm_viz.app.paths import GeometricPath, path_for
 from tpm_viz.app.planner import Limits, Plan, PlanSamples, plan_cycle, plan_path
 from tpm_viz.app.sizing import Sizing, size_motion, size_trajectory
-from tpm_viz.errors import InputError
-from tpm_viz.numbers import shorten
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.numbers import shorten
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase
 from tpm_viz.paper.dynamics import inverse_dynamics
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase
 
 __all__ = [
     "INDUSTRY",

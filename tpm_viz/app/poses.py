@@ -13,11 +13,11 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from tpm_viz.app.moves import Move, Pose, check, ik_branch, pose_codes, why_not
-from tpm_viz.errors import InputError, InvalidParametersError
-from tpm_viz.numbers import fixed
+from tpm_viz.core.errors import InputError, InvalidParametersError
+from tpm_viz.core.numbers import fixed
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase
 from tpm_viz.paper.status import MOVE_LIMITS, WARN, PoseStatus, SingularityThresholds
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase
 
 __all__ = ["DEMO_KINDS", "go_home", "home_pose", "preset_pose", "settle"]
 

@@ -24,14 +24,14 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from tpm_viz.app.moves import Pose
-from tpm_viz.errors import InputError, TpmVizError
-from tpm_viz.numbers import fixed
+from tpm_viz.core.errors import InputError, TpmVizError
+from tpm_viz.core.numbers import fixed
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase, T
 from tpm_viz.paper.dynamics import inverse_dynamics
 from tpm_viz.paper.jacobians import jacobians
 from tpm_viz.paper.kinematics import forward_kinematics_both
 from tpm_viz.paper.status import WARN, SingularityThresholds
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase, T
 
 __all__ = ["LOAD_MODES", "Alert", "Forces", "Load", "Readout", "Reference", "evaluate", "joined", "reason"]
 __all__ += ["with_reference"]

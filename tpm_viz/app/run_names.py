@@ -1,4 +1,4 @@
-"""The names of runs and references in words (:mod:`tpm_viz.words`): the paper's line and circle are named as the
+"""The names of runs and references in words (:mod:`tpm_viz.core.words`): the paper's line and circle are named as the
 *Trajectory* and *Reference* dropdowns name them (``line (Fig. 4)``, in the reader's language); any other name (an
 uploaded file's) is shown as it is. The player's summary, the control lab's texts and the lab report share these."""
 
@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import re
 
-from tpm_viz.words import Phrase, T
+from tpm_viz.core.words import Phrase, T
 
 __all__ = ["PAPER_NAMES", "label_words", "reference_words"]
 

@@ -23,14 +23,14 @@ from numpy.typing import ArrayLike
 
 from tpm_viz.app.moves import ik_branch, pose_codes, why_not
 from tpm_viz.app.readouts import Reference, reason
-from tpm_viz.errors import InputError, TpmVizError
-from tpm_viz.numbers import fixed
+from tpm_viz.core.errors import InputError, TpmVizError
+from tpm_viz.core.numbers import fixed
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase, T
 from tpm_viz.paper.dynamics import inverse_dynamics_detail
 from tpm_viz.paper.spline import CubicSpline
 from tpm_viz.paper.status import MOVE_LIMITS, PoseStatus, SingularityThresholds
 from tpm_viz.paper.trajectories import DEFAULT_DURATIONS, Trajectory, circle_state, line_state
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase, T
 
 __all__ = ["RUN_SAMPLES", "Run", "Source", "build_run", "check_path", "peak_force"]
 

@@ -29,11 +29,11 @@ from typing import SupportsFloat
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase, T
 from tpm_viz.paper.dynamics import inverse_dynamics
 from tpm_viz.paper.jacobians import actuator_velocity
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase, T
 
 __all__ = ["SIZING_COLUMNS", "Sizing", "format_sizing", "size_motion", "size_trajectory", "sizing_columns"]
 
@@ -215,7 +215,7 @@ def format_sizing(sizing: Sizing) -> str:
 
 
 def sizing_columns(sizing: Sizing) -> dict[str, list]:
-    """The table as columns :data:`SIZING_COLUMNS` (for :func:`tpm_viz.csvio.write_columns`)."""
+    """The table as columns :data:`SIZING_COLUMNS` (for :func:`tpm_viz.core.csvio.write_columns`)."""
     rows = sizing.rows()
     return {name: [r[k] for r in rows] for k, name in enumerate(SIZING_COLUMNS)}
 

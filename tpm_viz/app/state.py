@@ -13,8 +13,8 @@ from typing import TypedDict, Unpack
 from tpm_viz.app.moves import Pose
 from tpm_viz.app.poses import home_pose
 from tpm_viz.app.readouts import Load
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase
 
 __all__ = ["AppState", "Changes", "TrajectorySample", "run_note"]
 

@@ -21,8 +21,8 @@ from tpm_viz.app.moves import Move, drag_to, drive_to, switch_mode
 from tpm_viz.app.poses import DEMO_KINDS, go_home, preset_pose, settle
 from tpm_viz.app.readouts import LOAD_MODES, Load
 from tpm_viz.app.state import AppState
-from tpm_viz.params import Params
-from tpm_viz.words import T
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import T
 
 __all__ = [
     "MAX_ACCEL",

@@ -20,6 +20,10 @@
 - :mod:`.jobs`: the fair queue of every tab's heavy jobs (runs, maps, control lab, planner): one pending job per tab
   and kind (latest wins), light tabs before flooders, bounded per tab and in total, a small thread pool.
 
-Layer rule (tests/system/test_layering.py): the standard library, the base layer, ``paper``, the drawing layer and
-``app`` only.
+- :mod:`.runhub`: each session's trajectory runs (loading in the background, playback, pause and seek).
+- :mod:`.sessionfile`: the saved session's versioned JSON format; :mod:`.links`: share links; :mod:`.network`: who a
+  connection really comes from and which ``Host`` names this server answers to.
+
+Layer rule (tests/system/test_layering.py): the standard library, :mod:`tpm_viz.core`, ``paper``, the drawing layer
+and ``app`` only.
 """

@@ -27,8 +27,8 @@ import weakref
 from collections.abc import Callable
 from typing import Protocol
 
-from tpm_viz.errors import InputError
-from tpm_viz.words import Phrase
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.words import Phrase
 
 __all__ = ["LOCKOUT_SECONDS", "MAX_FAILURES", "MAX_FAILURES_SERVER", "MAX_LOCKOUT_SECONDS", "Access", "AccessDenied"]
 

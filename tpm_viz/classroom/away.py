@@ -3,7 +3,7 @@
 viser gives every websocket connection a new client id and its page sends nothing that identifies the tab when it
 reconnects; what survives is the browser's cookie (:mod:`.identity`). A tab is recognised by its browser, and when
 the browser has several tabs, by the camera it sends first (a reconnecting page keeps its camera). Each tab that
-left is kept for :data:`~tpm_viz.app.sessions.KEEP_SECONDS`.
+left is kept for :data:`~tpm_viz.classroom.sessionfile.KEEP_SECONDS`.
 
 Bounds: :data:`MAX_PER_BROWSER` tabs per browser, :data:`MAX_PER_ADDRESS` browsers per source address and
 :data:`MAX_AWAY` browsers in all. A new browser of an address that has its share pushes out that address's own
@@ -23,7 +23,7 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from tpm_viz.app.sessions import KEEP_SECONDS, Saved
+from tpm_viz.classroom.sessionfile import KEEP_SECONDS, Saved
 
 __all__ = ["MAX_AWAY", "MAX_PER_ADDRESS", "MAX_PER_BROWSER", "PRESENTER_SECONDS", "Away"]
 

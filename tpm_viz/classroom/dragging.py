@@ -22,7 +22,7 @@ import numpy.typing as npt
 from tpm_viz.classroom.drags import PendingDrag, Take
 from tpm_viz.classroom.guard import guarded
 from tpm_viz.classroom.session import Session, View
-from tpm_viz.errors import TpmVizError
+from tpm_viz.core.errors import TpmVizError
 
 __all__ = ["SHARED_DRAG_INTERVAL", "Dragging", "GizmoEvent"]
 

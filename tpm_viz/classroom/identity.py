@@ -19,8 +19,8 @@ import re
 import secrets
 from pathlib import Path
 
-from tpm_viz.errors import InputError
-from tpm_viz.files import read_bytes
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.files import read_bytes
 
 __all__ = ["SECRET_FILE", "Keys", "hashed"]
 

@@ -11,7 +11,7 @@ map, a control-lab simulation, a plan), each 20-200 ms of computation. The rules
   by how long they have waited (round robin). With every flooder holding one pending job, a round of theirs is
   10 jobs; a tab that asks now and then skips it and waits for the jobs already running only.
 - **Bounded**: ``per_tab`` pending jobs per tab and ``total`` in all; a job over a bound is refused: its ``done``
-  gets :class:`~tpm_viz.errors.BusyError` (one line for the tab), it never runs.
+  gets :class:`~tpm_viz.core.errors.BusyError` (one line for the tab), it never runs.
 - **A tab that leaves** (:meth:`FairJobs.leave`) has its pending jobs dropped.
 - **Faults stay with their tab**: a job that raises hands the exception to its own ``done`` (a bug is also
   reported with its traceback) and the pool carries on.
@@ -31,8 +31,8 @@ from collections import OrderedDict, deque
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass
 
-from tpm_viz.errors import BusyError, TpmVizError
-from tpm_viz.words import T
+from tpm_viz.core.errors import BusyError, TpmVizError
+from tpm_viz.core.words import T
 
 __all__ = ["BURST", "FLOODER", "TAU", "Demand", "Done", "FairJobs", "Job"]
 
@@ -105,7 +105,7 @@ class FairJobs:
     """The queue and its pool (see the module docstring).
 
     ``threads``: pool size; ``per_tab``, ``total``: bounds on pending jobs; ``report(exc, what)``: where a job's
-    bug (an exception that is not a :class:`~tpm_viz.errors.TpmVizError`) is logged."""
+    bug (an exception that is not a :class:`~tpm_viz.core.errors.TpmVizError`) is logged."""
 
     def __init__(
         self,
@@ -144,7 +144,7 @@ class FairJobs:
         dropped: Callable[[], None] | None = None,
     ) -> bool:
         """Queue ``fn`` as ``tab``'s job of ``kind``, replacing a pending one (latest wins). False: refused (a
-        bound), and ``done`` will get :class:`~tpm_viz.errors.BusyError`."""
+        bound), and ``done`` will get :class:`~tpm_viz.core.errors.BusyError`."""
         job = Job(fn, done, dropped)
         with self._cond:
             self.demand.add(tab)

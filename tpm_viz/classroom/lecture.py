@@ -19,13 +19,13 @@ from typing import Any
 
 import platformdirs
 
-from tpm_viz.app.sessions import MAX_DOCUMENT_BYTES, Document
 from tpm_viz.classroom.identity import Keys
 from tpm_viz.classroom.records import Records, import_json
 from tpm_viz.classroom.saver import Saver
+from tpm_viz.classroom.sessionfile import MAX_DOCUMENT_BYTES, Document
 from tpm_viz.classroom.store import Limits, SqliteStore, is_sqlite, open_store
-from tpm_viz.errors import TpmVizError
-from tpm_viz.files import read_bytes
+from tpm_viz.core.errors import TpmVizError
+from tpm_viz.core.files import read_bytes
 
 __all__ = ["LectureStore", "default_path"]
 

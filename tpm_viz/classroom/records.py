@@ -1,8 +1,8 @@
 """The store's record bodies: the lecture, a browser's tabs, and the one-time import of an old JSON session file.
 
-A mechanism is the JSON form of :func:`tpm_viz.app.sessions.encode_saved`, except that an uploaded trajectory's
+A mechanism is the JSON form of :func:`tpm_viz.classroom.sessionfile.encode_saved`, except that an uploaded trajectory's
 samples are a blob of the store (``{"kind": "csv", "blob": <sha256>, ...}``): nine students with the same 540 kB
-CSV keep it once. Reading goes through :func:`tpm_viz.app.sessions.decode_saved` (the library's own checks); a
+CSV keep it once. Reading goes through :func:`tpm_viz.classroom.sessionfile.decode_saved` (the library's own checks); a
 record that fails is skipped by the caller, a missing blob only drops that trajectory.
 
 :class:`Records` is the codec of one store (it remembers which trajectories it has put, so that a save does not
@@ -20,12 +20,12 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from tpm_viz.app import sessions
 from tpm_viz.app.runs import Source
-from tpm_viz.app.sessions import Document, Saved
+from tpm_viz.classroom import sessionfile
+from tpm_viz.classroom.sessionfile import Document, Saved
 from tpm_viz.classroom.store import Copy, Store
-from tpm_viz.errors import InputError, TpmVizError
-from tpm_viz.files import loads_json, read_bytes
+from tpm_viz.core.errors import InputError, TpmVizError
+from tpm_viz.core.files import loads_json, read_bytes
 
 __all__ = ["Records", "import_json"]
 
@@ -54,7 +54,7 @@ class Records:
 
     def saved(self, saved: Saved) -> dict[str, Any]:
         """The JSON form of one mechanism, an uploaded trajectory's samples put in a blob."""
-        body = sessions.encode_saved(saved)
+        body = sessionfile.encode_saved(saved)
         trajectory = body.get("trajectory")
         if saved.source is not None and isinstance(trajectory, dict) and "t" in trajectory:
             samples = {"t": trajectory.pop("t"), "p": trajectory.pop("p", [])}
@@ -93,7 +93,7 @@ class Records:
                 raw = dict(raw, trajectory=trajectory)
             else:
                 raw = dict(raw, trajectory=None)  # the samples are gone: the mechanism without its trajectory
-        return sessions.decode_saved(raw)
+        return sessionfile.decode_saved(raw)
 
     def read_lecture(self, body: Any, steps: int | None = None) -> tuple[Saved, int]:
         """The shared mechanism and the lesson step of a lecture record (raises a one-line InputError)."""
@@ -104,7 +104,7 @@ class Records:
         return self._mechanism(body.get("shared")), step if ok else 0
 
     def read_copies(self, copies: Mapping[str, Copy], now: float) -> tuple[dict[str, list[dict[str, Any]]], int]:
-        """The tabs of every readable browser record still within :data:`~tpm_viz.app.sessions.KEEP_SECONDS`,
+        """The tabs of every readable browser record still within :data:`~tpm_viz.classroom.sessionfile.KEEP_SECONDS`,
         and the number of records skipped."""
         tabs: dict[str, list[dict[str, Any]]] = {}
         skipped = 0
@@ -113,7 +113,7 @@ class Records:
                 kept = []
                 for r in copy.body["tabs"]:
                     left_at = float(r["left_at"])
-                    if not now - sessions.KEEP_SECONDS <= left_at <= now + 60:
+                    if not now - sessionfile.KEEP_SECONDS <= left_at <= now + 60:
                         continue
                     saved = None if r.get("saved") is None else self._mechanism(r["saved"])
                     record = {"private": r.get("private") is True, "saved": saved, "left_at": left_at}
@@ -138,14 +138,14 @@ def import_json(store: Store, path: Path, records: Records) -> str | None:
     store's. Returns a one-line notice (imported, or why not), or None when there was nothing to do. ``path`` is
     never written."""
     try:
-        data = read_bytes(path, sessions.MAX_DOCUMENT_BYTES)
+        data = read_bytes(path, sessionfile.MAX_DOCUMENT_BYTES)
     except InputError as exc:
         return f"session file not imported: {exc}"
     digest = hashlib.sha256(data).hexdigest()
     if store.imported(digest):
         return None
     try:
-        doc = sessions.loads(data)
+        doc = sessionfile.loads(data)
     except InputError as exc:
         store.mark_imported(digest, str(path))  # said once; the file is left as it is
         return f"{path} not imported ({exc}); it is left as it is"

@@ -14,9 +14,9 @@ import sqlite3
 import threading
 from collections.abc import Callable
 
-from tpm_viz.app.sessions import Document
 from tpm_viz.classroom.records import Records
-from tpm_viz.errors import TpmVizError
+from tpm_viz.classroom.sessionfile import Document
+from tpm_viz.core.errors import TpmVizError
 
 __all__ = ["MAX_BACKOFF_SECONDS", "SAVE_SECONDS", "Saver"]
 

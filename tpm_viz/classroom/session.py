@@ -34,8 +34,8 @@ from tpm_viz.classroom.drags import DragQueue
 from tpm_viz.classroom.guard import report
 from tpm_viz.classroom.pacing import BUSY_NUMBERS_INTERVAL, LIVE_NUMBERS_INTERVAL, Pacer
 from tpm_viz.classroom.snapshot import Snapshot
-from tpm_viz.errors import InputError
-from tpm_viz.words import Lang, Phrase
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.words import Lang, Phrase
 
 __all__ = ["AppState", "Hub", "Session", "View", "read_number", "read_vec2"]
 
@@ -54,7 +54,7 @@ class View(Protocol):
     closed: bool
     hub: Hub
     lang: Lang
-    """The tab's language: render its words with ``say(view.lang, phrase)`` (:mod:`tpm_viz.words`)."""
+    """The tab's language: render its words with ``say(view.lang, phrase)`` (:mod:`tpm_viz.core.words`)."""
 
     def __hash__(self) -> int: ...  # views are dictionary keys (drag queues, presenter sets)
 

@@ -13,16 +13,16 @@ from functools import cached_property
 
 import numpy as np
 
-from tpm_viz import meshes
 from tpm_viz.app.equations import errata_html, procedure_html
 from tpm_viz.app.readouts import Readout
 from tpm_viz.app.state import AppState
 from tpm_viz.classroom.text import dashboard_html
-from tpm_viz.errors import TpmVizError
+from tpm_viz.core.errors import TpmVizError
+from tpm_viz.core.words import Lang, say
+from tpm_viz.drawing import meshes
 from tpm_viz.paper.dynamics import inverse_dynamics_detail
 from tpm_viz.paper.jacobians import jacobians
 from tpm_viz.paper.kinematics import MechanismPose, mechanism_pose
-from tpm_viz.words import Lang, say
 
 __all__ = ["Snapshot"]
 

@@ -28,8 +28,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
 
-from tpm_viz.errors import InputError
-from tpm_viz.files import DEFAULT_DEPTH, loads_json
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.files import DEFAULT_DEPTH, loads_json
 
 __all__ = [
     "SCHEMA",

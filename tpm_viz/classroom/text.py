@@ -13,10 +13,10 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from tpm_viz.app.palette import hex_colour
 from tpm_viz.app.readouts import Readout
 from tpm_viz.app.state import AppState
-from tpm_viz.words import Lang, Phrase, T, say
+from tpm_viz.core.words import Lang, Phrase, T, say
+from tpm_viz.drawing.palette import hex_colour
 
 __all__ = ["COLORS_CSS", "banner_level", "dashboard_html", "force_scale", "legend_html", "num"]
 

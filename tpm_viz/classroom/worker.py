@@ -29,7 +29,7 @@ def _report(exc: Exception, what: str) -> None:
 
 class Worker:
     """Run ``fn()`` in the pool, then ``done(result, error)`` (``error`` a :class:`TpmVizError`, a bug, or
-    :class:`~tpm_viz.errors.BusyError` when the queue refused the job)."""
+    :class:`~tpm_viz.core.errors.BusyError` when the queue refused the job)."""
 
     def __init__(self, name: str = "tpm-viz-worker", threads: int | None = None) -> None:
         self.jobs = FairJobs(THREADS if threads is None else threads, name=name, report=_report)

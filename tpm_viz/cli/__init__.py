@@ -22,7 +22,7 @@ import sys
 
 from tpm_viz.cli import control, design, export, multibody, outputs, paper, plan, serve
 from tpm_viz.cli.common import Parser, common_parent, one_line, params_from_args
-from tpm_viz.errors import TpmVizError
+from tpm_viz.core.errors import TpmVizError
 
 __all__ = ["build_parser", "main", "params_from_args"]
 

@@ -13,10 +13,10 @@ from typing import overload
 
 import numpy as np
 
-from tpm_viz.csvio import write_columns
-from tpm_viz.errors import InputError
-from tpm_viz.numbers import parse_number
-from tpm_viz.params import PARAM_INFO, Params
+from tpm_viz.core.csvio import write_columns
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.numbers import parse_number
+from tpm_viz.core.params import PARAM_INFO, Params
 
 __all__ = [
     "MAX_COUNT",
@@ -89,7 +89,7 @@ def positive(value: None, name: str) -> None: ...
 @overload
 def positive(value: float | None, name: str) -> float | None: ...
 def positive(value: float | None, name: str) -> float | None:
-    """``value`` if None or positive and finite; else :class:`~tpm_viz.errors.InputError` naming ``name``."""
+    """``value`` if None or positive and finite; else :class:`~tpm_viz.core.errors.InputError` naming ``name``."""
     if value is not None and (not math.isfinite(value) or value <= 0):
         raise InputError(f"{name} must be a positive, finite number, got {value:g}")
     return value
@@ -97,7 +97,8 @@ def positive(value: float | None, name: str) -> float | None:
 
 def within(value: float, name: str, low: float, high: float, unit: str = "") -> float:
     """``value`` if it is a finite number from ``low`` to ``high``; else a one-line
-    :class:`~tpm_viz.errors.InputError` naming ``name`` and the range (a 309-digit value is never printed whole)."""
+    :class:`~tpm_viz.core.errors.InputError` naming ``name`` and the range (a 309-digit value is never printed
+    whole)."""
     ok = isinstance(value, (int, float)) and not isinstance(value, bool)
     try:
         ok = ok and math.isfinite(value) and low <= value <= high
@@ -111,7 +112,7 @@ def within(value: float, name: str, low: float, high: float, unit: str = "") -> 
 
 def positive_float(text: str) -> float:
     """argparse type: a number of seconds from :data:`MIN_SECONDS` to :data:`MAX_SECONDS` (numbers as typed:
-    ``2e-1``, ``0,2``; :func:`tpm_viz.numbers.parse_number`)."""
+    ``2e-1``, ``0,2``; :func:`tpm_viz.core.numbers.parse_number`)."""
     try:
         value = parse_number(text, "value", "s")
     except InputError as exc:
@@ -158,7 +159,7 @@ def check_output(output: str | None, input_path: str | None) -> None:
 
 
 def write_output(path: str | None, columns: Mapping[str, np.ndarray]) -> None:
-    """:func:`tpm_viz.csvio.write_columns` (atomic replacement of ``path``), and a quiet exit with status 141
+    """:func:`tpm_viz.core.csvio.write_columns` (atomic replacement of ``path``), and a quiet exit with status 141
     when the reader of stdout goes away (``tpm-viz ... | head``), as other Unix tools do."""
     if path not in (None, "-"):
         write_columns(path, columns)

@@ -3,7 +3,7 @@
 :func:`register` adds the subcommand to the ``tpm-viz`` parser (:mod:`tpm_viz.cli`). The simulation
 (Pinocchio plant) is imported by the handler, so that ``import tpm_viz.cli`` stays free of Pinocchio.
 The run goes to ``--output`` (or stdout) as CSV with columns :data:`CONTROL_COLUMNS` (SI units) and
-a one-line summary goes to stderr. Bad input raises :class:`~tpm_viz.errors.TpmVizError` (``cli.main``
+a one-line summary goes to stderr. Bad input raises :class:`~tpm_viz.core.errors.TpmVizError` (``cli.main``
 prints one line and exits with 2).
 """
 
@@ -14,8 +14,8 @@ import math
 import sys
 
 from tpm_viz.cli.common import check_output, params_from_args, positive, within
-from tpm_viz.csvio import read_text, write_columns
-from tpm_viz.errors import InputError
+from tpm_viz.core.csvio import read_text, write_columns
+from tpm_viz.core.errors import InputError
 from tpm_viz.paper.control import Gains
 from tpm_viz.paper.trajectories import parse_trajectory_csv
 

@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from tpm_viz.cli.common import params_from_args, write_output
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
 
 __all__ = ["register"]
 
@@ -23,7 +23,7 @@ ARRANGEMENTS = ("perpendicular", "parallel")
 
 
 def _settings(args):
-    from tpm_viz.app.design import Settings  # toppra (matplotlib): only for these commands
+    from tpm_viz.design.indices import Settings  # toppra (matplotlib): only for these commands
 
     force = args.force_limit
     if not (math.isfinite(force) and 1e-6 <= force <= 1e9):
@@ -51,8 +51,8 @@ def _table(rows: list[dict], columns: list[str]) -> dict[str, np.ndarray]:
 
 
 def _cmd_design(args) -> int:
-    from tpm_viz.app.atlas import PARAMETER_COLUMNS, design_row, values_of
-    from tpm_viz.app.design import INDEX_COLUMNS, Task
+    from tpm_viz.design.atlas import PARAMETER_COLUMNS, design_row, values_of
+    from tpm_viz.design.indices import INDEX_COLUMNS, Task
 
     task = Task.parse(args.task)
     params = params_from_args(args)
@@ -64,8 +64,8 @@ def _cmd_design(args) -> int:
 
 
 def _cmd_compare(args) -> int:
-    from tpm_viz.app.compare import COMPARE_COLUMNS, Hold, compare
-    from tpm_viz.app.design import Task
+    from tpm_viz.design.compare import COMPARE_COLUMNS, Hold, compare
+    from tpm_viz.design.indices import Task
 
     task = Task.parse(args.task)
     rows = compare(params_from_args(args), task, Hold.parse(args.hold), _settings(args), args.evaluations)
@@ -105,11 +105,11 @@ def _footprint_limit(text: str | None) -> tuple[float | None, float | None]:
 
 
 def _cmd_atlas(args) -> int:
-    from tpm_viz.app.atlas import Limits, Vary, best, columns_for, design_row, designs, optimise, pareto, sweep
-    from tpm_viz.app.atlas import values_of as values
-    from tpm_viz.app.design import Task
+    from tpm_viz.core.params import Params
+    from tpm_viz.design.atlas import Limits, Vary, best, columns_for, design_row, designs, optimise, pareto, sweep
+    from tpm_viz.design.atlas import values_of as values
+    from tpm_viz.design.indices import Task
     from tpm_viz.paper.arrangement import Arrangement
-    from tpm_viz.params import Params
 
     task = Task.parse(args.task)
     settings = _settings(args)
@@ -123,7 +123,7 @@ def _cmd_atlas(args) -> int:
     progress = _Progress(len(grid))
     if args.scheduler:
         try:
-            from tpm_viz.cluster import sweep_on_cluster  # Dask: the optional extra .[cluster]
+            from tpm_viz.design.cluster import sweep_on_cluster  # Dask: the optional extra .[cluster]
         except ImportError:
             raise InputError("--scheduler needs Dask: pip install 'tpm-viz[cluster]'") from None
         rows = sweep_on_cluster(args.scheduler, arrangement, base, grid, task, settings, progress)

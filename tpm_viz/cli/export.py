@@ -3,9 +3,9 @@
 :func:`register` adds the subcommand to the ``tpm-viz`` parser (:mod:`tpm_viz.cli`). The text comes from
 :mod:`tpm_viz.exchange` (no MuJoCo or Pinocchio needed to write it). The file is written atomically: a
 temporary file in the same directory, then ``os.replace``, so a reader never sees half a model. ``--output -``
-prints to stdout. ``--format c`` writes ``tpm_2ppa.h`` and ``tpm_2ppa.c`` (:mod:`tpm_viz.exchange.c_code`) into
+prints to stdout. ``--format c`` writes ``tpm_2ppa.h`` and ``tpm_2ppa.c`` (:mod:`tpm_viz.exchange.c.code`) into
 the directory ``--output`` (created if missing), each file atomically. The handler returns the exit status and
-raises :class:`~tpm_viz.errors.TpmVizError` for bad input (``cli.main`` prints one line and exits with 2).
+raises :class:`~tpm_viz.core.errors.TpmVizError` for bad input (``cli.main`` prints one line and exits with 2).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import sys
 import tempfile
 
 from tpm_viz.cli.common import params_from_args, positive
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
 
 __all__ = ["FORMATS", "register", "write_atomically"]
 
@@ -63,7 +63,7 @@ def write_atomically(path: str, data: str | bytes) -> None:
 
 
 def _write_c(params, directory: str) -> None:
-    from tpm_viz.exchange.c_code import c_files
+    from tpm_viz.exchange.c.code import c_files
 
     if directory == "-":
         raise InputError("--format c writes two files: give a directory as --output, not '-'")

@@ -2,7 +2,7 @@
 
 :func:`register` adds the subcommands to the ``tpm-viz`` parser (:mod:`tpm_viz.cli`). The heavy layers
 (Pinocchio, matplotlib) are imported by the handler that runs, so that the file commands start fast
-(``tests/test_layering.py``). Handlers return the exit status and raise :class:`~tpm_viz.errors.TpmVizError` for
+(``tests/test_layering.py``). Handlers return the exit status and raise :class:`~tpm_viz.core.errors.TpmVizError` for
 bad input (``cli.main`` prints one line and exits with 2). Durations and steps: 1e-9 to 1e6 s; the CSV output is
 replaced atomically (:func:`tpm_viz.cli.common.write_output`).
 """
@@ -14,7 +14,7 @@ import pathlib
 import sys
 
 from tpm_viz.cli.common import MAX_COUNT, params_from_args, positive, positive_float, within, write_output
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
 
 __all__ = ["REPLAY_COLUMNS", "register"]
 
@@ -60,7 +60,7 @@ def _cmd_crosscheck(args) -> int:
 
 
 def _cmd_figures(args) -> int:
-    from tpm_viz.figures import FILE_NAMES, plot_forces  # matplotlib
+    from tpm_viz.drawing.figures import FILE_NAMES, plot_forces  # matplotlib
     from tpm_viz.multibody.crosscheck import compare_forces  # the Pinocchio model
 
     params = params_from_args(args)

@@ -3,7 +3,7 @@
 :func:`register` adds the subcommands to the ``tpm-viz`` parser (:mod:`tpm_viz.cli`). The run is the app's
 (:func:`tpm_viz.app.runs.build_run`: the paper's line or circle, or a CSV ``t,p1,p2`` followed through its spline,
 checked sample by sample); matplotlib, PyAV and Pinocchio are imported by the handler that runs. Files are replaced
-atomically; bad input raises :class:`~tpm_viz.errors.TpmVizError` (``cli.main`` prints one line, exits with 2).
+atomically; bad input raises :class:`~tpm_viz.core.errors.TpmVizError` (``cli.main`` prints one line, exits with 2).
 """
 
 from __future__ import annotations
@@ -17,8 +17,8 @@ import sys
 from tpm_viz.app.runs import MAX_DURATION, RUN_SAMPLES, Run, Source, build_run
 from tpm_viz.cli.common import check_output, params_from_args
 from tpm_viz.cli.export import write_atomically
-from tpm_viz.csvio import read_text
-from tpm_viz.errors import InputError
+from tpm_viz.core.csvio import read_text
+from tpm_viz.core.errors import InputError
 from tpm_viz.paper.trajectories import parse_trajectory_csv
 
 __all__ = ["MAX_SAMPLES", "register", "run_from_args", "write_bytes"]
@@ -59,8 +59,8 @@ def _suffix(path: str, allowed: tuple[str, ...]) -> str:
 
 
 def _cmd_clip(args) -> int:
-    from tpm_viz.clips import ClipRenderer, check_fps, parse_size  # matplotlib
-    from tpm_viz.videos import encode_clip  # Pillow, PyAV
+    from tpm_viz.media.clips import ClipRenderer, check_fps, parse_size  # matplotlib
+    from tpm_viz.media.videos import encode_clip  # Pillow, PyAV
 
     fmt = _suffix(args.output, ("gif", "mp4"))
     fps = check_fps(args.fps)
@@ -104,8 +104,8 @@ def _report_date(text: str | None) -> datetime.date:
 
 
 def _cmd_report(args) -> int:
+    from tpm_viz.media.report import report_html
     from tpm_viz.multibody import inverse_dynamics  # the Pinocchio model, the closed form's cross-check
-    from tpm_viz.reports.report import report_html
 
     _suffix(args.output, ("html", "htm"))
     run = run_from_args(args, reference=inverse_dynamics)

@@ -8,15 +8,15 @@ import sys
 import numpy as np
 
 from tpm_viz.cli.common import check_output, params_from_args, positive_float, write_output
-from tpm_viz.csvio import read_columns, time_unit_note
-from tpm_viz.errors import InputError
-from tpm_viz.numbers import parse_number, plausibility_note, shorten
+from tpm_viz.core.csvio import read_columns, time_unit_note
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.numbers import parse_number, plausibility_note, shorten
+from tpm_viz.core.params import Params
 from tpm_viz.paper.dynamics import inverse_dynamics_detail
 from tpm_viz.paper.jacobians import classify, condition_number, jacobians
 from tpm_viz.paper.kinematics import inverse_kinematics, leg_angles, reachable
 from tpm_viz.paper.status import STATUS_LABELS
 from tpm_viz.paper.trajectories import MAX_CSV_ROWS, paper_trajectory, trajectory_from_samples
-from tpm_viz.params import Params
 
 __all__ = ["DYN_IN", "register"]
 

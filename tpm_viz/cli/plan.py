@@ -2,7 +2,7 @@
 
 :func:`register` adds the subcommands to the ``tpm-viz`` parser (:mod:`tpm_viz.cli`). The planner (toppra, which
 loads matplotlib) is imported by the handler that runs. Handlers return the exit status and raise
-:class:`~tpm_viz.errors.TpmVizError` for bad input (``cli.main`` prints one line and exits with 2).
+:class:`~tpm_viz.core.errors.TpmVizError` for bad input (``cli.main`` prints one line and exits with 2).
 """
 
 from __future__ import annotations
@@ -15,8 +15,8 @@ import numpy as np
 from tpm_viz.app import paths
 from tpm_viz.app.sizing import format_sizing, size_trajectory, sizing_columns
 from tpm_viz.cli.common import MAX_SECONDS, check_output, params_from_args, positive, within
-from tpm_viz.csvio import parse_columns, read_columns, read_text, write_columns
-from tpm_viz.errors import InputError
+from tpm_viz.core.csvio import parse_columns, read_columns, read_text, write_columns
+from tpm_viz.core.errors import InputError
 from tpm_viz.paper.trajectories import trajectory_from_samples
 
 __all__ = ["MAX_WAYPOINTS", "PLAN_COLUMNS", "SIZE_INPUTS", "register"]

@@ -18,8 +18,8 @@ import threading
 from pathlib import Path
 
 from tpm_viz.cli.common import port_number
-from tpm_viz.errors import InputError
-from tpm_viz.numbers import shorten
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.numbers import shorten
 
 __all__ = ["RESOLVE_SECONDS", "check_bind", "register"]
 

@@ -5,7 +5,7 @@
 - :mod:`.mjcf`: MJCF with the loop closures as ``<equality><connect>`` and stiff solver settings;
 - :mod:`.urdf`: URDF (a tree: the parallelogram's inner loops as mimic joints, the leg closure in a comment).
 
-Import rule: the standard library, numpy, :mod:`tpm_viz.params`, :mod:`tpm_viz.errors` and
+Import rule: the standard library, numpy, :mod:`tpm_viz.core.params`, :mod:`tpm_viz.core.errors` and
 :mod:`tpm_viz.paper` only; neither MuJoCo nor Pinocchio (the files are text; the tests load them).
 Conventions: ``docs/conventions.md`` (SI units, frame OXY with Z up, the mechanism in the plane ``z = 0``).
 """

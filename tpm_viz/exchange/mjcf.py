@@ -29,9 +29,9 @@ import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.params import PARAM_INFO, Params
 from tpm_viz.exchange.topology import Body, Topology, joint_positions, topology
-from tpm_viz.params import PARAM_INFO, Params
 
 __all__ = ["DEFAULT_SETTINGS", "MUJOCO_DEFAULTS", "MjcfSettings", "mjcf_text"]
 

@@ -34,9 +34,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.params import Params
 from tpm_viz.paper.kinematics import as_xy, inverse_kinematics, leg_components
-from tpm_viz.params import Params
 
 __all__ = [
     "BASE_INERTIAL",

@@ -22,9 +22,9 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.params import PARAM_INFO, Params
 from tpm_viz.exchange.topology import Body, topology
-from tpm_viz.params import PARAM_INFO, Params
 
 __all__ = ["MIMIC", "urdf_text"]
 

@@ -16,11 +16,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from tpm_viz.errors import InputError, SingularConfigurationError, UnreachablePoseError
+from tpm_viz.core.errors import InputError, SingularConfigurationError, UnreachablePoseError
+from tpm_viz.core.numbers import fixed
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase
 from tpm_viz.multibody.locking import locked
-from tpm_viz.numbers import fixed
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase
 
 __all__ = ["DOF", "NEWTON_FLOOR", "NEWTON_MAX_ITER", "NEWTON_TOL", "ClosedLoopAssembly", "ThreeArrays"]
 

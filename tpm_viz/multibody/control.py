@@ -28,13 +28,13 @@ from typing import SupportsFloat
 
 import numpy as np
 
-from tpm_viz.errors import InputError, TpmVizError
+from tpm_viz.core.errors import InputError, TpmVizError
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase, T
 from tpm_viz.multibody.forward import PlatformPlant
 from tpm_viz.multibody.model import model_for
 from tpm_viz.paper.control import ControlLaw, ControllerKind, Gains, model_with_errors, reference_state
 from tpm_viz.paper.trajectories import Trajectory, paper_duration, positive_seconds
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase, T
 
 __all__ = ["COLUMNS", "DEFAULT_RATE", "MAX_PLANT_STEP", "MAX_SAMPLES", "ControlRun", "ControlSetup", "simulate"]
 
@@ -190,7 +190,7 @@ def simulate(
 
     ``reference``: ``"line"`` / ``"circle"`` (path duration ``duration`` [s], default 0.2 / 0.5 s) or a
     :class:`~tpm_viz.paper.trajectories.Trajectory`; the run lasts ``horizon`` [s] (default: the path's
-    duration; the reference rests at its end afterwards). Raises :class:`~tpm_viz.errors.TpmVizError`
+    duration; the reference rests at its end afterwards). Raises :class:`~tpm_viz.core.errors.TpmVizError`
     with one line for bad input or when the platform leaves the workspace (unstable loop).
     """
     if not isinstance(params, Params):

@@ -14,13 +14,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.params import Params
 from tpm_viz.multibody.model import inverse_dynamics as pinocchio_inverse_dynamics
 from tpm_viz.multibody.replay import replay
 from tpm_viz.paper.dynamics import inverse_dynamics
 from tpm_viz.paper.jacobians import classify
 from tpm_viz.paper.trajectories import paper_duration, paper_trajectory
-from tpm_viz.params import Params
 
 __all__ = [
     "CrosscheckRow",

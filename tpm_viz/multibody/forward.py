@@ -24,12 +24,12 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from tpm_viz.errors import SingularConfigurationError, UnreachablePoseError
+from tpm_viz.core.errors import SingularConfigurationError, UnreachablePoseError
+from tpm_viz.core.numbers import fixed
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase
 from tpm_viz.multibody.assembly import DOF, NEWTON_FLOOR, NEWTON_MAX_ITER, NEWTON_TOL
 from tpm_viz.multibody.rank import RankedSvd, ranked_svd
-from tpm_viz.numbers import fixed
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase
 
 __all__ = ["ClosedLoopModel", "PlatformPlant", "forward_dynamics", "project"]
 

@@ -52,15 +52,15 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from tpm_viz.errors import InputError, SingularConfigurationError
+from tpm_viz.core.errors import InputError, SingularConfigurationError
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase
 from tpm_viz.multibody import forward
 from tpm_viz.multibody.assembly import DOF, ClosedLoopAssembly, ThreeArrays
 from tpm_viz.multibody.locking import locked
 from tpm_viz.multibody.rank import RankedSvd, ranked_svd
 from tpm_viz.multibody.tree import Built, closed_tree, point_mass, rod, se3
 from tpm_viz.paper.kinematics import as_xy
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase
 
 __all__ = ["PART_NAMES", "MultibodyModel", "inverse_dynamics", "model_for"]
 
@@ -94,7 +94,7 @@ class MultibodyModel(ClosedLoopAssembly):
     """The closed-loop Pinocchio model of one parameter set (see the module docstring).
 
     Public methods take platform quantities as ``(2,)`` (or ``(..., 2)`` where stated) arrays in SI
-    units and raise :mod:`tpm_viz.errors` exceptions with one-line messages. Methods are serialised
+    units and raise :mod:`tpm_viz.core.errors` exceptions with one-line messages. Methods are serialised
     by a lock (Pinocchio's ``Data`` is shared scratch memory).
     """
 

@@ -14,7 +14,7 @@ Each link's x axis runs along the link: ``φ_1k = θ_1`` and, in slider 2's turn
 (``θ_i`` measured from the rail inwards, ``docs/parallel.md``); ``φ_p = -θ_1`` keeps the platform translating.
 Closures: the tips of link1_1, link2_0 and link2_1 to ``B_1 + s e_2``, ``B_2 = B_1 + 2b e_1`` and
 ``B_2 + s e_2`` on the platform (``CONTACT_3D``, ``LOCAL_WORLD_ALIGNED``; 9 rows of rank 5 as in the
-perpendicular model). Independent of the closed form of :mod:`tpm_viz.paper.parallel_dynamics`.
+perpendicular model). Independent of the closed form of :mod:`tpm_viz.paper.parallel.dynamics`.
 """
 
 from __future__ import annotations
@@ -26,14 +26,14 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from tpm_viz.errors import InputError, SingularConfigurationError, UnreachablePoseError
+from tpm_viz.core.errors import InputError, SingularConfigurationError, UnreachablePoseError
+from tpm_viz.core.numbers import fixed
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase
 from tpm_viz.multibody.locking import locked
 from tpm_viz.multibody.model import MultibodyModel
 from tpm_viz.multibody.tree import Built, closed_tree, point_mass, rod, se3
-from tpm_viz.numbers import fixed
 from tpm_viz.paper import parallel as par
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase
 
 __all__ = ["ParallelMultibodyModel", "inverse_dynamics", "parallel_model_for"]
 

@@ -22,12 +22,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase, T
 from tpm_viz.multibody.model import model_for
 from tpm_viz.paper.dynamics import inverse_dynamics
 from tpm_viz.paper.trajectories import circle_state, line_state, paper_duration, positive_seconds
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase, T
 
 __all__ = ["DEFAULT_DT", "MAX_STEPS", "MIN_STEPS", "ReplayResult", "replay"]
 
@@ -94,7 +94,7 @@ def replay(
     ``min(DEFAULT_DT, duration / MIN_STEPS)``) is rounded down so that whole RK4 steps span the
     duration. ``force_params`` (default ``params``) are the parameters the closed-form forces are
     computed with: a mismatch shows as a tracking error.
-    Raises :mod:`tpm_viz.errors` exceptions for bad input, an unreachable path or a singular
+    Raises :mod:`tpm_viz.core.errors` exceptions for bad input, an unreachable path or a singular
     configuration on it.
     """
     if not isinstance(params, Params) or not isinstance(force_params, Params | None):

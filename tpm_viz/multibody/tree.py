@@ -14,7 +14,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from tpm_viz.params import Params
+from tpm_viz.core.params import Params
 
 __all__ = ["Built", "TreeRow", "closed_tree", "point_mass", "rod", "se3"]
 

@@ -14,7 +14,9 @@ from types import ModuleType, SimpleNamespace
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.params import Params, geometry_problem
+from tpm_viz.core.words import Phrase
 from tpm_viz.paper import dynamics as _perp_dyn
 from tpm_viz.paper import jacobians as _perp_jac
 from tpm_viz.paper import kinematics as _perp_kin
@@ -22,8 +24,6 @@ from tpm_viz.paper import parallel as _par
 from tpm_viz.paper.jacobians import Jacobians
 from tpm_viz.paper.kinematics import FkSolutions, MechanismPose
 from tpm_viz.paper.status import WARN, SingularityThresholds
-from tpm_viz.params import Params, geometry_problem
-from tpm_viz.words import Phrase
 
 __all__ = [
     "Arrangement",

@@ -33,8 +33,10 @@ from typing import Protocol, SupportsFloat, TypeVar
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tpm_viz.errors import InputError, SingularConfigurationError, UnreachablePoseError
-from tpm_viz.numbers import fixed
+from tpm_viz.core.errors import InputError, SingularConfigurationError, UnreachablePoseError
+from tpm_viz.core.numbers import fixed
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase
 
 # _procedure: the scalar steps (b)-(e) of eqs. (9)-(31); the public single-state inverse_dynamics adds numpy
 # checks that cost ~25 µs per call, too slow for a 1 kHz loop in Python (the checks are done here in floats).
@@ -42,8 +44,6 @@ from tpm_viz.paper.dynamics import SINGULAR_TOL, _procedure, inverse_dynamics
 from tpm_viz.paper.jacobians import actuator_velocity
 from tpm_viz.paper.kinematics import inverse_kinematics
 from tpm_viz.paper.trajectories import State, Trajectory, circle_state, line_state, paper_duration
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase
 
 __all__ = [
     "CTC_DIRECT_TOL",
@@ -228,7 +228,7 @@ _N = TypeVar("_N", bound=Arithmetic)
 CTC_DIRECT_TOL = 1e-9
 """The computed-torque law refuses a measured pose with ``|c_1 c_2 - p_1 p_2| < CTC_DIRECT_TOL l_a²``, i.e.
 ``|cos(θ1 + θ2)|`` below it (eq. 12); at the inverse singularity it refuses where the closed form does
-(``SINGULAR_TOL``, eq. 11). The generated C (:mod:`tpm_viz.exchange.c_code`) reads both from here."""
+(``SINGULAR_TOL``, eq. 11). The generated C (:mod:`tpm_viz.exchange.c.code`) reads both from here."""
 
 
 def task_space_command(p_ref: _N, dp_ref: _N, ddp_ref: _N, p: _N, dp: _N, kp: _N, kd: _N) -> _N:
@@ -277,7 +277,7 @@ class ControlLaw:
         """``f(row, p1, p2, ṗ1, ṗ2) -> (τ1, τ2, τ_ff1, τ_ff2)`` [N] for one sample (floats, no arrays).
 
         ``row`` is one entry of :meth:`ReferenceSamples.rows`; ``p, ṗ`` [m, m/s] the measured platform
-        state. Raises :class:`~tpm_viz.errors.TpmVizError` if the measured pose is unreachable or singular.
+        state. Raises :class:`~tpm_viz.core.errors.TpmVizError` if the measured pose is unreachable or singular.
         """
         prm, kp, kd = self.params, self.gains.kp, self.gains.kd
         la, k = prm.l_a, prm.a - prm.b

@@ -28,18 +28,18 @@ from typing import cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from tpm_viz.errors import SingularConfigurationError
+from tpm_viz.core.errors import SingularConfigurationError
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase, T
 from tpm_viz.paper.jacobians import actuator_velocity
 from tpm_viz.paper.kinematics import as_xy, finite_result, inverse_kinematics, leg_components
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase, T
 
 __all__ = ["SINGULAR_TOL", "DynamicsResult", "inverse_dynamics", "inverse_dynamics_detail", "kinetic_energy"]
 
 
 Component = float | NDArray[np.float64]
 """One component of a state [SI]: a float, or an array of them (all of one shape). The C generator
-(:mod:`tpm_viz.exchange.c_code`) traces :func:`_procedure` with its own symbols instead."""
+(:mod:`tpm_viz.exchange.c.code`) traces :func:`_procedure` with its own symbols instead."""
 
 
 @dataclass(frozen=True)
@@ -115,7 +115,7 @@ def _procedure(
     are those printed below eqs. (29) and (31) (:func:`_v_leg`, :func:`_w_leg`) regrouped with
     ``t_i = tan θ_i = p_j / c_i`` (eq. 23), ``ω_i = θ̇_i = ṗ_j / c_i`` (eq. 24) and ``q_i = t_i ω_i`` so that
     each appears once (~110 operations instead of ~190; ``tests/paper/test_dynamics_factored.py`` checks the
-    regrouping against the printed forms). The generated C (:mod:`tpm_viz.exchange.c_code`) is traced from here.
+    regrouping against the printed forms). The generated C (:mod:`tpm_viz.exchange.c.code`) is traced from here.
     """
     u1, u2 = 1.0 / c1, 1.0 / c2
     t1, t2 = p2 * u1, p1 * u2  # tan θ_i

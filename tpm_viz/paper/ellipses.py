@@ -17,10 +17,10 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tpm_viz.errors import SingularConfigurationError
+from tpm_viz.core.errors import SingularConfigurationError
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase
 from tpm_viz.paper.jacobians import jacobians
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase
 
 __all__ = ["Ellipse", "ManipulabilityEllipses", "ellipse_outline", "manipulability_ellipses"]
 

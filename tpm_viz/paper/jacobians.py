@@ -20,11 +20,11 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from tpm_viz.errors import SingularConfigurationError
+from tpm_viz.core.errors import SingularConfigurationError
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase, T
 from tpm_viz.paper.kinematics import as_xy, finite_result, in_stroke, inverse_kinematics, leg_components, reachable
 from tpm_viz.paper.status import STATUS_LABELS, WARN, PoseStatus, SingularityThresholds
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase, T
 
 __all__ = [
     "STATUS_LABELS",

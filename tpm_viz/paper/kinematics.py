@@ -18,11 +18,11 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tpm_viz.errors import InputError, SingularConfigurationError, UnreachablePoseError
-from tpm_viz.numbers import fixed
+from tpm_viz.core.errors import InputError, SingularConfigurationError, UnreachablePoseError
+from tpm_viz.core.numbers import fixed
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase
 from tpm_viz.paper.status import FK_STATUS, FkStatus
-from tpm_viz.params import Params
-from tpm_viz.words import Phrase
 
 __all__ = [
     "FK_STATUS",

@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tpm_viz.errors import InputError
-from tpm_viz.words import Phrase
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.words import Phrase
 
 __all__ = ["CubicSpline"]
 

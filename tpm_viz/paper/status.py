@@ -13,7 +13,7 @@ from __future__ import annotations
 from enum import IntEnum
 from typing import NamedTuple
 
-from tpm_viz.words import Phrase, T
+from tpm_viz.core.words import Phrase, T
 
 __all__ = [
     "FK_STATUS",

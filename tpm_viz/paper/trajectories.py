@@ -21,10 +21,10 @@ from typing import SupportsFloat
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from tpm_viz.csvio import parse_columns
-from tpm_viz.errors import InputError
+from tpm_viz.core.csvio import parse_columns
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.words import Phrase, T
 from tpm_viz.paper.spline import CubicSpline
-from tpm_viz.words import Phrase, T
 
 __all__ = [
     "DEFAULT_DURATIONS",
@@ -167,6 +167,6 @@ def trajectory_from_samples(t: ArrayLike, p: ArrayLike, name: str = "custom") ->
 
 def parse_trajectory_csv(text: str, name: str = "custom", max_rows: int = MAX_CSV_ROWS) -> Trajectory:
     """A trajectory from CSV text with columns ``t,p1,p2`` (s, m, m unless the header gives units, ``t [ms]``);
-    the dialects and limits of :mod:`tpm_viz.csvio` (``docs/csv.md``); one-line errors."""
+    the dialects and limits of :mod:`tpm_viz.core.csvio` (``docs/csv.md``); one-line errors."""
     cols = parse_columns(text, ["t", "p1", "p2"], source=T("the trajectory CSV"), max_rows=max_rows)
     return trajectory_from_samples(cols["t"], np.stack([cols["p1"], cols["p2"]], -1), name)

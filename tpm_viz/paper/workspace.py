@@ -20,10 +20,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tpm_viz.errors import InputError
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.params import Params
 from tpm_viz.paper.jacobians import condition_number, jacobians
 from tpm_viz.paper.kinematics import in_stroke, inverse_kinematics, reachable
-from tpm_viz.params import Params
 
 __all__ = [
     "WorkspaceMap",

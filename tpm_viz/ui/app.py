@@ -29,16 +29,17 @@ import viser
 
 from tpm_viz import multibody
 from tpm_viz.app.lessons import Demo, load_lessons
-from tpm_viz.app.network import HostRules, Network
 from tpm_viz.app.readouts import Reference
 from tpm_viz.app.state import AppState
 from tpm_viz.classroom.access import Access
 from tpm_viz.classroom.guard import guarded, log, log_fault, report
 from tpm_viz.classroom.identity import Keys
+from tpm_viz.classroom.network import HostRules, Network
 from tpm_viz.classroom.runtime import tune_for_serving
 from tpm_viz.classroom.session import Hub
-from tpm_viz.errors import InputError, TpmVizError
-from tpm_viz.params import Params
+from tpm_viz.core.errors import InputError, TpmVizError
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Lang, Phrase, say
 from tpm_viz.ui.classroom import Classroom, Handshakes, local_addresses, qr_text, student_urls
 from tpm_viz.ui.client import ClientView
 from tpm_viz.ui.continuity import LectureStore, lecture_store
@@ -55,7 +56,6 @@ from tpm_viz.viserkit.adapter import install, new_server
 from tpm_viz.viserkit.core import connection_request
 from tpm_viz.viserkit.limits import DEFAULT_MAX_CONNECTIONS, set_max_connections
 from tpm_viz.viserkit.transport import harden
-from tpm_viz.words import Lang, Phrase, say
 
 __all__ = ["TpmApp", "build_server", "main"]
 
@@ -308,7 +308,7 @@ def main(
     tests inject theirs). ``lessons``: a folder of lesson files (or one file) for the *Demos* tab instead of the
     packaged ones; a refused file is one warning line, and no lesson at all is an error. ``trusted_proxies``: the
     reverse proxies whose X-Forwarded-For / Forwarded name the client; ``allowed_hosts``: more ``Host`` names to
-    answer to (:mod:`tpm_viz.app.network`)."""
+    answer to (:mod:`tpm_viz.classroom.network`)."""
     access = Access(presenter_token)  # validates the token before anything starts
     network = Network.of(trusted_proxies, allowed_hosts)
     tour = None if lessons is None else load_lessons(lessons)

@@ -12,8 +12,8 @@
   ``tpmviz_id`` cookie the server minted and signed (:mod:`tpm_viz.classroom.identity`; one it did not sign is
   replaced), which the browser sends back with every websocket handshake, reconnections included: it is
   how a tab that comes back after a wifi blip or a restart is recognised (:func:`identity`). A page asked with
-  ``?share=TOKEN`` (a share link, :mod:`tpm_viz.app.links`) gets a short-lived ``tpmviz_share`` cookie naming where
-  its token waits (:data:`PENDING`); that page's websocket brings it back and :func:`shared_token` hands the token
+  ``?share=TOKEN`` (a share link, :mod:`tpm_viz.classroom.links`) gets a short-lived ``tpmviz_share`` cookie naming
+  where its token waits (:data:`PENDING`); that page's websocket brings it back and :func:`shared_token` hands the token
   over once (:mod:`.share` opens it on the tab's own copy).
 """
 
@@ -35,9 +35,9 @@ from urllib.parse import urlsplit
 
 import segno
 
-from tpm_viz.app.links import PENDING_SECONDS, PendingLinks, token_of_query
-from tpm_viz.app.network import PROXIED, HostRules, client_address, header_problem, host_name
 from tpm_viz.classroom.identity import Keys, hashed
+from tpm_viz.classroom.links import PENDING_SECONDS, PendingLinks, token_of_query
+from tpm_viz.classroom.network import PROXIED, HostRules, client_address, header_problem, host_name
 from tpm_viz.ui.keyboard import Keyboard
 from tpm_viz.viserkit.page import with_script
 
@@ -211,7 +211,7 @@ class Handshakes:
         self.keys = keys if keys is not None else DEFAULT_KEYS
         """Mints the page's identity cookie (:mod:`tpm_viz.classroom.identity`)."""
         self.hosts = hosts if hosts is not None else HostRules()
-        """The ``Host`` names served and the trusted proxies (:mod:`tpm_viz.app.network`)."""
+        """The ``Host`` names served and the trusted proxies (:mod:`tpm_viz.classroom.network`)."""
         self._warned_proxy = False
         self._logged = 0.0
         self.keyboard = Keyboard()

@@ -18,17 +18,18 @@ from typing import cast
 import numpy as np
 import viser
 
-from tpm_viz import meshes
 from tpm_viz.app import transitions
 from tpm_viz.app.poses import DEMO_KINDS
-from tpm_viz.app.sessions import Saved
 from tpm_viz.app.state import AppState
 from tpm_viz.classroom.dragging import Dragging
 from tpm_viz.classroom.guard import guarded
 from tpm_viz.classroom.pacing import watch_phase, watch_slot
 from tpm_viz.classroom.session import Hub, Session
+from tpm_viz.classroom.sessionfile import Saved
 from tpm_viz.classroom.snapshot import Snapshot
-from tpm_viz.params import Params
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase, say
+from tpm_viz.drawing import meshes
 from tpm_viz.ui.fields import Place, Typing, control
 from tpm_viz.ui.language import TabWords, first_language
 from tpm_viz.ui.login import LoginPanel
@@ -40,7 +41,6 @@ from tpm_viz.ui.tabscene import TabScene
 from tpm_viz.ui.teaching.tabs import Services, Teaching
 from tpm_viz.ui.worded import TabGui
 from tpm_viz.viserkit.core import widget_value
-from tpm_viz.words import Phrase, say
 
 __all__ = ["ClientView"]
 
@@ -75,7 +75,8 @@ class ClientView:
         the hub's lock) the shared one, so a callback that arrives meanwhile finds it, then waits for the lock."""
         self.closed = False
         self.lang = first_language(client)
-        """The language of this tab's words (:mod:`tpm_viz.words`): render a phrase with ``say(view.lang, ...)``."""
+        """The language of this tab's words (:mod:`tpm_viz.core.words`): render a phrase with ``say(view.lang,
+        ...)``."""
         self.gui = TabGui(client.gui, self.lang)
         """This tab's GUI: every element made through it shows its fixed texts in ``lang`` (:mod:`.worded`)."""
         self.login: LoginPanel | None = None

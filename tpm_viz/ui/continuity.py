@@ -12,14 +12,14 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from tpm_viz.app.sessions import Saved
 from tpm_viz.classroom.lecture import LectureStore, default_path
+from tpm_viz.classroom.runhub import RunHub, following
 from tpm_viz.classroom.saver import SAVE_SECONDS
 from tpm_viz.classroom.session import Session
+from tpm_viz.classroom.sessionfile import Saved
+from tpm_viz.core.words import Lang
 from tpm_viz.ui.classroom import DEFAULT_KEYS
-from tpm_viz.ui.teaching.playing import RunHub, following
 from tpm_viz.viserkit.core import widget_value
-from tpm_viz.words import Lang
 
 __all__ = [
     "PRESENTATION",

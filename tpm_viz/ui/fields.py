@@ -1,8 +1,8 @@
-"""Typed number fields and notes next to controls: the widget side of :mod:`tpm_viz.ui.typed`.
+"""Typed number fields and notes next to controls: the widget side of :mod:`tpm_viz.ui.widgets.typed`.
 
 viser's number inputs drop what they cannot show (``1e9`` became ``19``) and send every keystroke, and its text
 input sends every keystroke too, with no blur event. So a typed number is an ``add_text`` field read through a
-:class:`~tpm_viz.ui.typed.TypedGroup`:
+:class:`~tpm_viz.ui.widgets.typed.TypedGroup`:
 
 - :class:`TypedBox`: the text fields of one group inside a viser form, and the :class:`Note` under them: why a text
   is refused, the value in use whenever a field's text is not it, the group's refusal, plausibility notes. Enter is
@@ -35,9 +35,9 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any, Protocol, cast
 
 from tpm_viz.classroom.guard import guarded
-from tpm_viz.errors import TpmVizError
-from tpm_viz.ui.typed import TypedGroup
-from tpm_viz.words import Lang, Phrase, say
+from tpm_viz.core.errors import TpmVizError
+from tpm_viz.core.words import Lang, Phrase, say
+from tpm_viz.ui.widgets.typed import TypedGroup
 
 __all__ = ["ONE_LINE_CSS", "Note", "Place", "TypedBox", "Typing", "Waker", "as_phrase", "control", "note_html"]
 
@@ -112,7 +112,7 @@ class Note:
 
 
 class TypedBox:
-    """The text fields of one :class:`~tpm_viz.ui.typed.TypedGroup` in a form (Enter submits) and their note.
+    """The text fields of one :class:`~tpm_viz.ui.widgets.typed.TypedGroup` in a form (Enter submits) and their note.
 
     ``labels`` by key (fixed English texts, translated on the wire); ``hints`` by key (optional). The note is
     created right under the fields unless ``note=False`` (then the caller places it with :meth:`add_note`, e.g.

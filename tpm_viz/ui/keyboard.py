@@ -33,9 +33,9 @@ import viser
 from tpm_viz.app import transitions
 from tpm_viz.classroom.guard import guarded
 from tpm_viz.classroom.session import View
-from tpm_viz.errors import TpmVizError
+from tpm_viz.core.errors import TpmVizError
+from tpm_viz.core.words import T
 from tpm_viz.viserkit.page import QUEUED, key_request
-from tpm_viz.words import T
 
 __all__ = ["BIG_STEP_MM", "KEY_BURST", "KEY_RATE", "MOVES", "STEP_MM", "Keyboard", "keyboard_of"]
 

@@ -9,8 +9,8 @@ producers with ``say(view.lang, phrase)``.
 then the tab's live parts are drawn again in the new language.
 
 The language of a new tab is the first one its browser asks for (``Accept-Language`` of its websocket handshake,
-:func:`tpm_viz.words.preferred`, read by :func:`first_language`); a tab that comes back after a drop or a restart gets
-its own back (:mod:`.continuity`).
+:func:`tpm_viz.core.words.preferred`, read by :func:`first_language`); a tab that comes back after a drop or a restart
+gets its own back (:mod:`.continuity`).
 """
 
 from __future__ import annotations
@@ -20,9 +20,9 @@ from typing import Any
 import viser
 
 from tpm_viz.classroom.guard import guarded
+from tpm_viz.core.words import Lang, preferred
 from tpm_viz.ui.worded import show_text
 from tpm_viz.viserkit.core import client_request
-from tpm_viz.words import Lang, preferred
 
 __all__ = ["LABEL", "TabWords", "first_language", "show_text"]
 
@@ -34,7 +34,7 @@ its line still breaks anywhere. In the page of a tab shown in Korean only."""
 
 
 def first_language(client: viser.ClientHandle) -> Lang:
-    """The language a new tab is shown in: the first of :class:`~tpm_viz.words.Lang` its browser asks for."""
+    """The language a new tab is shown in: the first of :class:`~tpm_viz.core.words.Lang` its browser asks for."""
     request = client_request(client)
     return preferred(None if request is None else request[1].get("Accept-Language"))
 

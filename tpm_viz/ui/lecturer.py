@@ -1,5 +1,5 @@
 """The *Lecturer* folder of a presenter's tab: how students join, who may change the shared mechanism, and the
-session as a file (*Save session* / *Open session*, :mod:`tpm_viz.app.sessions`).
+session as a file (*Save session* / *Open session*, :mod:`tpm_viz.classroom.sessionfile`).
 
 Shown to a tab that may change the shared mechanism as its presenter: every tab when nobody holds the shared
 mechanism (no presenter token, not classroom mode: e.g. a lecturer preparing a class at home), else the presenter's
@@ -16,9 +16,9 @@ import viser
 
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES
 from tpm_viz.classroom.guard import guarded
+from tpm_viz.core.words import T
 from tpm_viz.ui.classroom import is_loopback_address, qr_data_uri
 from tpm_viz.ui.worded import TabGui
-from tpm_viz.words import T
 
 __all__ = ["Lecture", "LecturerPanel", "join_html"]
 

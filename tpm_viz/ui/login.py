@@ -17,10 +17,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from tpm_viz.core.words import Lang, T, say
 from tpm_viz.ui.fields import one_line
 from tpm_viz.ui.worded import TabGui
 from tpm_viz.viserkit.core import widget_uuid
-from tpm_viz.words import Lang, T, say
 
 __all__ = ["LoginPanel", "mask_css"]
 

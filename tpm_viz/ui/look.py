@@ -7,7 +7,7 @@ wide: viser's own breakpoint, where it shows the panel as a sheet along the bott
 above it (all but the sheet's handle while the sheet is collapsed), and makes every control at least :data:`TOUCH` CSS
 pixels across (wide equations scroll sideways in their own boxes).
 Either way the canvas is the free part of the screen, so the camera frames the mechanism in the whole canvas
-(:mod:`tpm_viz.ui.framing`): the server only needs the canvas's aspect ratio, which each camera message carries.
+(:mod:`tpm_viz.ui.widgets.framing`): the server only needs the canvas's aspect ratio, which each camera message carries.
 The camera is framed again when that ratio changes (a rotated phone, a resized window, a collapsed panel), not
 when the viewer orbits or zooms.
 
@@ -18,10 +18,10 @@ brings it back for the lecturer. A box of live numbers floats over the bottom of
 its warnings at :data:`BANNER_PX`, p, d, τ₁ and τ₂ with their bars at :data:`READOUT_PX` CSS pixels. With the panel
 open, its readout is the same compact one (:data:`~.panels.FOLDED` left out) in large, dark type, the panel wider
 (:data:`PRESENTATION_WIDTH`); thicker lines and larger labels in 3D (:mod:`.tabscene`), the player's charts with 18 px
-dark axes (:data:`~.teaching.charts.LARGE`). All of it is this tab's own: the style sheet is an HTML element of the
-tab's GUI, and every tab's GUI is its own.
+dark axes (:data:`~.teaching.player.charts.LARGE`). All of it is this tab's own: the style sheet is an HTML element of
+the tab's GUI, and every tab's GUI is its own.
 
-Nothing here computes; the style sheets are constants, and the messages are words of :mod:`tpm_viz.words`.
+Nothing here computes; the style sheets are constants, and the messages are words of :mod:`tpm_viz.core.words`.
 """
 
 from __future__ import annotations
@@ -33,15 +33,15 @@ from typing import Any
 import numpy as np
 import viser
 
-from tpm_viz import meshes
 from tpm_viz.classroom.guard import guarded
-from tpm_viz.params import Params
-from tpm_viz.ui.framing import LIVE_BAND, frame_box
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Lang, T
+from tpm_viz.drawing import meshes
 from tpm_viz.ui.language import KEEP_ALL
 from tpm_viz.ui.panels import FOLDED
 from tpm_viz.ui.scene import camera_pose
+from tpm_viz.ui.widgets.framing import LIVE_BAND, frame_box
 from tpm_viz.viserkit.core import point_camera
-from tpm_viz.words import Lang, T
 
 __all__ = [
     "BUTTON_TOUCH",
@@ -86,7 +86,7 @@ LIVE_GAP = 12
 """Gap between that box and the canvas's left and bottom edges [CSS px]."""
 LIVE_CHROME = 64
 """Height of that box's frame [CSS px]: its grip, its tab and :data:`LIVE_GAP`; the box, frame included, stays
-within the bottom :data:`~tpm_viz.ui.framing.LIVE_BAND` of the window that the framing keeps free."""
+within the bottom :data:`~tpm_viz.ui.widgets.framing.LIVE_BAND` of the window that the framing keeps free."""
 LIVE_LABEL = T("Warnings and forces")
 """Tab name of the box of banner and forces (presentation mode; shown in the tab's language by its handle)."""
 

@@ -25,8 +25,8 @@ from tpm_viz.app.readouts import Load, evaluate
 from tpm_viz.app.runs import Run
 from tpm_viz.app.state import AppState
 from tpm_viz.classroom.snapshot import Snapshot
-from tpm_viz.errors import InputError
-from tpm_viz.params import Params
+from tpm_viz.core.errors import InputError
+from tpm_viz.core.params import Params
 from tpm_viz.ui.scene import MechanismScene, camera_pose
 from tpm_viz.viserkit.core import check_viser, disable_share_url
 

@@ -4,11 +4,11 @@ No maths here: the numbers come from a :class:`~tpm_viz.app.readouts.Readout`, f
 Units in labels: mm, N, kg, s, degrees (SI inside; the scale factors come from ``PARAM_INFO``).
 
 Typed numbers (the platform and actuator positions, the load vectors, the parameters) are text fields read through
-:mod:`tpm_viz.ui.typed` (:class:`~.fields.TypedBox`: scientific notation and decimal commas, applied on Enter, by
-*Apply* or after a quiet time, never per keystroke; the value in use always shown). Their groups hold values in
-the units of their labels (mm, N, m/s, m/s², kg), as the transitions take them. Refusals and notes are shown next
-to the control that caused them (:class:`~.fields.Note`); the line at the top of the panel is for the others
-(drags, the classroom).
+:mod:`tpm_viz.ui.widgets.typed` (:class:`~.fields.TypedBox`: scientific notation and decimal commas, applied on Enter,
+by *Apply* or after a quiet time, never per keystroke; the value in use always shown). Their groups hold values in the
+units of their labels (mm, N, m/s, m/s², kg), as the transitions take them. Refusals and notes are shown next to the
+control that caused them (:class:`~.fields.Note`); the line at the top of the panel is for the others (drags, the
+classroom).
 
 The actuators have both: a slider each, to drive by dragging (a phone's thumb), without viser's number box beside it
 (that box drops the ``e`` of ``1.5e2`` and applies per keystroke: hidden by :func:`slider_css`), and the typed box
@@ -29,12 +29,12 @@ from tpm_viz.app.transitions import MAX_ACCEL, MAX_FORCE, MAX_POSITION, MAX_SPEE
 from tpm_viz.classroom.pacing import LIVE_NUMBERS_INTERVAL
 from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.classroom.text import legend_html
-from tpm_viz.params import PARAM_INFO, Params
+from tpm_viz.core.params import PARAM_INFO, Params
+from tpm_viz.core.words import Lang
 from tpm_viz.ui.fields import Note, TypedBox
-from tpm_viz.ui.typed import QUIET, Quantity, TypedField, TypedGroup, force_note
+from tpm_viz.ui.widgets.typed import QUIET, Quantity, TypedField, TypedGroup, force_note
 from tpm_viz.ui.worded import TabGui, Tabs, Worded
 from tpm_viz.viserkit.core import widget_uuid
-from tpm_viz.words import Lang
 
 __all__ = ["ACTUATOR_HINT", "ACTUATOR_LABELS", "GROUPS", "GUIDE_HTML", "PARAM_LABELS", "Panel", "slider_css"]
 

@@ -14,16 +14,16 @@ import weakref
 from collections.abc import Callable
 from typing import Any, TypeVar
 
-from tpm_viz.app import sessions
-from tpm_viz.app.sessions import Document, Saved
+from tpm_viz.classroom import sessionfile
 from tpm_viz.classroom.away import Away
 from tpm_viz.classroom.guard import guarded, log
-from tpm_viz.errors import TpmVizError
+from tpm_viz.classroom.sessionfile import Document, Saved
+from tpm_viz.core.errors import TpmVizError
+from tpm_viz.core.words import Lang, T, say
 from tpm_viz.ui.classroom import Classroom, identity, student_urls
 from tpm_viz.ui.continuity import LectureStore, lecture_store, reload, restore, saved_of
 from tpm_viz.ui.lecturer import LecturerPanel
 from tpm_viz.viserkit.core import connection_request
-from tpm_viz.words import Lang, T, say
 
 __all__ = ["BACK", "KEPT", "LOGGED_OUT", "Room"]
 
@@ -264,7 +264,7 @@ class Room:
     def session_json(self) -> str:
         """The session for *Save session*: the shared mechanism and the lesson step (no students' copies)."""
         doc = self.document()
-        return sessions.dumps(Document(doc.shared, doc.lesson_step))
+        return sessionfile.dumps(Document(doc.shared, doc.lesson_step))
 
     def open_session(self, view: Any, data: bytes) -> None:
         """*Open session*: the shared mechanism becomes the file's (refused with one line to this tab only)."""
@@ -273,7 +273,7 @@ class Room:
             try:
                 hub.authorize(view, hub.shared)
                 choice = getattr(getattr(view.teaching, "demos", None), "choice", None)
-                doc = sessions.loads(data, steps=None if choice is None else len(choice.options))
+                doc = sessionfile.loads(data, steps=None if choice is None else len(choice.options))
                 self._apply_shared(doc, origin=view)
             except TpmVizError as exc:
                 view.refuse(exc, resync=False)

@@ -15,14 +15,14 @@ from __future__ import annotations
 import numpy as np
 import viser
 
-from tpm_viz import meshes
 from tpm_viz.app.overlays import arrow_length, arrow_vector
-from tpm_viz.app.palette import PALETTE
 from tpm_viz.app.readouts import Readout
 from tpm_viz.app.state import AppState
 from tpm_viz.classroom.snapshot import Snapshot
-from tpm_viz.params import Params
-from tpm_viz.ui.scene_shapes import circle, floor, made, part
+from tpm_viz.core.params import Params
+from tpm_viz.drawing import meshes
+from tpm_viz.drawing.palette import PALETTE
+from tpm_viz.ui.widgets.scene_shapes import circle, floor, made, part
 
 __all__ = [
     "ARROW_SHORTEST",
@@ -37,7 +37,7 @@ __all__ = [
 ]
 
 COLORS = PALETTE
-"""RGB colours of the parts, the warning colours and the force arrows (:mod:`tpm_viz.app.palette`)."""
+"""RGB colours of the parts, the warning colours and the force arrows (:mod:`tpm_viz.drawing.palette`)."""
 
 ARROW_SHORTEST = 1e-3
 """[m] A force arrow shorter than this is hidden. Lengths: :func:`tpm_viz.app.overlays.arrow_length` (linear for small

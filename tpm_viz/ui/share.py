@@ -1,6 +1,6 @@
 """Share links in the app: *Copy share link* (a tab's own state as a link and its QR code) and opening one.
 
-- :class:`ShareDesk` (one per app): :meth:`ShareDesk.link` is the link (:mod:`tpm_viz.app.links`) of what a tab
+- :class:`ShareDesk` (one per app): :meth:`ShareDesk.link` is the link (:mod:`tpm_viz.classroom.links`) of what a tab
   shows (:func:`~.continuity.saved_of`: parameters, pose, load, trajectory, player time, view options; an upload too
   large for a link is kept in this server's store by content hash) on the origin its page came from (a page opened
   on this computer in classroom mode: the students' URL, so that the QR code works on their phones).
@@ -23,17 +23,17 @@ from urllib.parse import urlsplit
 import segno
 import viser
 
-from tpm_viz.app.links import decode_link, encode_link, share_url
 from tpm_viz.app.readouts import reason
-from tpm_viz.app.sessions import Saved
 from tpm_viz.classroom.guard import guarded, log
+from tpm_viz.classroom.links import decode_link, encode_link, share_url
 from tpm_viz.classroom.session import Hub
-from tpm_viz.errors import TpmVizError
+from tpm_viz.classroom.sessionfile import Saved
+from tpm_viz.core.errors import TpmVizError
+from tpm_viz.core.words import Phrase, T
 from tpm_viz.ui.classroom import PENDING, is_loopback_address, qr_data_uri, shared_token
 from tpm_viz.ui.continuity import restore, saved_of
 from tpm_viz.ui.fields import Note
 from tpm_viz.ui.worded import TabGui
-from tpm_viz.words import Phrase, T
 
 __all__ = ["ShareBox", "ShareDesk", "describe", "origin_of"]
 

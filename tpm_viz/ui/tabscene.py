@@ -26,7 +26,7 @@ import numpy as np
 import viser
 
 from tpm_viz.classroom.snapshot import Snapshot
-from tpm_viz.params import Params
+from tpm_viz.core.params import Params
 from tpm_viz.ui.phone import TOUCH_CSS, TOUCH_GIZMO_PX, drag_gain
 from tpm_viz.ui.scene import FAMILIES, GIZMO_Z, LABEL_SCALE, LINE_SCALE, MechanismScene, line_width
 from tpm_viz.viserkit.core import drop_gizmo_echo

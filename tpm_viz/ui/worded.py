@@ -2,8 +2,8 @@
 
 The code writes its fixed texts in English (labels, hints, dropdown and button-group options, tab names, markdown,
 HTML, chart titles, series and axis labels). :class:`TabGui` creates each element with those texts as the tab shows
-them (:func:`show_text`: a whole text of the catalogue with :func:`tpm_viz.words.shown`; each text between two tags
-of HTML with :func:`tpm_viz.words.shown_html`) and returns a :class:`Worded` handle over viser's own:
+them (:func:`show_text`: a whole text of the catalogue with :func:`tpm_viz.core.words.shown`; each text between two tags
+of HTML with :func:`tpm_viz.core.words.shown_html`) and returns a :class:`Worded` handle over viser's own:
 
 - setting a text (``handle.content = "<b>Forces</b>"``, ``label``, ``hint``, ``options``, ``title``, ``series``,
   ``axes``) keeps the English and writes the shown text to viser's handle; reading it gives the English back;
@@ -29,8 +29,8 @@ from typing import Any, ClassVar, TypeVar
 
 import viser
 
+from tpm_viz.core.words import Lang, shown, shown_html
 from tpm_viz.viserkit.core import relabel_tab, removed
-from tpm_viz.words import Lang, shown, shown_html
 
 __all__ = ["TEXTS", "Choice", "Tab", "TabGui", "Tabs", "Worded", "show_text"]
 

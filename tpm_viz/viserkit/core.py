@@ -39,7 +39,7 @@ from viser import _messages
 from viser.infra import _infra
 from viser.infra._async_message_buffer import AsyncMessageBuffer
 
-from tpm_viz.errors import TpmVizError
+from tpm_viz.core.errors import TpmVizError
 from tpm_viz.viserkit import casts, wire
 from tpm_viz.viserkit.patches import skipped
 from tpm_viz.viserkit.wire import Malformed

@@ -49,9 +49,9 @@ import viser
 
 from tpm_viz.app.inputs import MAX_TEXT, MAX_UPLOAD_BYTES, TOO_LARGE, value_problem
 from tpm_viz.classroom.guard import log_fault
+from tpm_viz.core.words import Lang, Phrase, T, say
 from tpm_viz.viserkit.core import ClientDoor, Malformed, widget_value
 from tpm_viz.viserkit.patches import skipped
-from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["MAX_UPLOADS", "UPLOAD_TIMEOUT", "harden", "message_problem", "update_problem"]
 

@@ -22,17 +22,17 @@ from collections import OrderedDict
 import numpy as np
 import viser
 
-from tpm_viz import meshes
 from tpm_viz.app.overlays import MAP_KINDS, cached_map, colour_scale, ellipse_polylines, map_rgba
 from tpm_viz.app.readouts import reason
 from tpm_viz.classroom.guard import guarded
 from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.classroom.text import num
 from tpm_viz.classroom.worker import Worker
-from tpm_viz.errors import BusyError
-from tpm_viz.params import Params
+from tpm_viz.core.errors import BusyError
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Lang, Phrase, T, say
+from tpm_viz.drawing import meshes
 from tpm_viz.ui.worded import TabGui
-from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["ELLIPSE_COLOURS", "ELLIPSE_SCALE", "ExplorerView", "MapService"]
 

@@ -25,15 +25,15 @@ from tpm_viz.app.lessons import DEMOS, PROBLEMS, Demo, demo_params, demo_pose, d
 from tpm_viz.app.readouts import Load
 from tpm_viz.app.state import TrajectorySample
 from tpm_viz.classroom.guard import guarded
+from tpm_viz.classroom.runhub import RunHub
 from tpm_viz.classroom.session import View
 from tpm_viz.classroom.snapshot import Snapshot
-from tpm_viz.errors import TpmVizError
+from tpm_viz.core.errors import TpmVizError
+from tpm_viz.core.words import Lang, Phrase, T, say
 from tpm_viz.ui.scene import camera_pose
 from tpm_viz.ui.teaching.explorer import ExplorerView
-from tpm_viz.ui.teaching.playing import RunHub
 from tpm_viz.ui.worded import TabGui
 from tpm_viz.viserkit.core import point_camera
-from tpm_viz.words import Lang, Phrase, T, say
 
 __all__ = ["DemosView"]
 

@@ -1,12 +1,12 @@
 """What the *Control* and *Planner* tabs share: a per-tab player that plays a timed platform motion on the tab's
 session, and a uPlot time chart with a time marker.
 
-:class:`MotionPlayer` works like :class:`~.playing.RunHub` but for one tab's own motion (a control run, a plan):
-a thread steps ``t`` at ``speed`` x real time (~30 frames/s) and commits the sampled state through
+:class:`MotionPlayer` works like :class:`~tpm_viz.classroom.runhub.RunHub` but for one tab's own motion (a control run,
+a plan): a thread steps ``t`` at ``speed`` x real time (~30 frames/s) and commits the sampled state through
 ``Hub.commit`` under the hub's lock (intermediate frames with ``dragging=True``, the last one in full). The state
 carries ``TrajectorySample(kind, T, t)``, so a view knows which motion and time a frame shows (its ghost, its force
-bars, its chart marker). Any other input to the session bumps ``session.play_token``, which stops it; so does a
-new motion. Refusals (presenter mode, a pose that cannot be drawn) raise :class:`~tpm_viz.TpmVizError`.
+bars, its chart marker). Any other input to the session bumps ``session.play_token``, which stops it; so does a new
+motion. Refusals (presenter mode, a pose that cannot be drawn) raise :class:`~tpm_viz.TpmVizError`.
 """
 
 from __future__ import annotations
@@ -23,11 +23,11 @@ from tpm_viz.app.moves import place
 from tpm_viz.app.readouts import Load
 from tpm_viz.app.state import AppState, TrajectorySample, run_note
 from tpm_viz.classroom.guard import report
-from tpm_viz.errors import InputError, TpmVizError
-from tpm_viz.params import Params
-from tpm_viz.ui.teaching.charts import LARGE, NORMAL, TICK_PX, AxisLook, marker
+from tpm_viz.core.errors import InputError, TpmVizError
+from tpm_viz.core.params import Params
+from tpm_viz.core.words import Phrase, T
+from tpm_viz.ui.teaching.player.charts import LARGE, NORMAL, TICK_PX, AxisLook, marker
 from tpm_viz.ui.worded import TabGui
-from tpm_viz.words import Phrase, T
 
 __all__ = ["FPS", "Motion", "MotionPlayer", "TimeChart"]
 

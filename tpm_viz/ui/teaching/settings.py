@@ -1,14 +1,14 @@
-"""The typed sliders of the *Control* and *Planner* tabs (:class:`~tpm_viz.ui.typed_sliders.TypedSlider`): label,
-the typed field's quantity (its name in messages, UI unit, accepted range = the slider's), step and first value.
+"""The typed sliders of the *Control* and *Planner* tabs (:class:`~tpm_viz.ui.widgets.typed_sliders.TypedSlider`):
+label, the typed field's quantity (its name in messages, UI unit, accepted range = the slider's), step and first value.
 
-Units as the tabs read them (:func:`.control_run.lab_setup`: ω_n in Hz, payload in kg, mass error in %, force
+Units as the tabs read them (:func:`.control.run.lab_setup`: ω_n in Hz, payload in kg, mass error in %, force
 limit in N with 0 for none, rate in Hz, noise in µm; the planner: F_max in N, speed limit in m/s with 0 for none).
 """
 
 from __future__ import annotations
 
-from tpm_viz.ui.typed import Quantity
-from tpm_viz.ui.typed_sliders import Setting
+from tpm_viz.ui.widgets.typed import Quantity
+from tpm_viz.ui.widgets.typed_sliders import Setting
 
 __all__ = ["CONTROL_SETTINGS", "PLANNER_SETTINGS"]
 

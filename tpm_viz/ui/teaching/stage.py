@@ -15,9 +15,9 @@ from typing import Any
 import numpy as np
 import viser
 
-from tpm_viz import meshes
-from tpm_viz.params import Params
-from tpm_viz.ui.teaching.trace import TRACE_Z, segments
+from tpm_viz.core.params import Params
+from tpm_viz.drawing import meshes
+from tpm_viz.ui.teaching.player.trace import TRACE_Z, segments
 
 __all__ = ["CONTROL", "PLAN", "PLAYER", "ControlNodes", "bring", "front"]
 

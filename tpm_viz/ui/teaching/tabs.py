@@ -25,17 +25,17 @@ import viser
 
 from tpm_viz.app.lessons import DEMOS, PROBLEMS, Demo
 from tpm_viz.classroom.later import Later
+from tpm_viz.classroom.runhub import RunHub
 from tpm_viz.classroom.session import Hub, Session, View
 from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.classroom.worker import Worker
-from tpm_viz.ui.teaching.control import ControlView
-from tpm_viz.ui.teaching.design import DesignView
+from tpm_viz.ui.teaching.control.tab import ControlView
+from tpm_viz.ui.teaching.design.tab import DesignView
 from tpm_viz.ui.teaching.explorer import ExplorerView, MapService
 from tpm_viz.ui.teaching.lessons import DemosView
-from tpm_viz.ui.teaching.planner import PlannerView
-from tpm_viz.ui.teaching.player import PlayerView
-from tpm_viz.ui.teaching.playing import RunHub
-from tpm_viz.ui.teaching.takeout import TakeOut, takeout_for
+from tpm_viz.ui.teaching.planner.tab import PlannerView
+from tpm_viz.ui.teaching.player.tab import PlayerView
+from tpm_viz.ui.teaching.takeout.buttons import TakeOut, takeout_for
 from tpm_viz.ui.worded import Tabs
 
 
@@ -95,7 +95,7 @@ class Teaching:
         )
         self._control = ControlView(view, self.services.worker, self.services.runs)
         self._planner = PlannerView(view, self.services.plans)
-        self._design = DesignView(view, self.services.worker)  # the Design studio (ui/teaching/design.py)
+        self._design = DesignView(view, self.services.worker)  # the Design studio (ui/teaching/design/tab.py)
         self._takeouts: list[TakeOut] = []  # Record clip and Download report of the player, control and planner
         self._tabs: dict[str, Tabs] = {}  # the tab groups of LATER's groups, to build them in
         self.waiting: set[str] = set()

@@ -1,0 +1,1 @@
+"""The *Planner* tab: the tab (:mod:`.tab`) and its words (:mod:`.text`)."""
