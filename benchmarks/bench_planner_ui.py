@@ -13,7 +13,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository r
 from timing import p95
 
 from tests.support.protocol import wait_for
-from tests.ui.test_planner_ui import TimedClient, _measure, _planned
+from tests.ui.teaching.test_planner import TimedClient, _measure, _planned
 from tpm_viz.ui.app import TpmApp, build_server
 
 ROUNDS = 5

@@ -10,7 +10,7 @@ box ticked and the copy's 3D drawing under ``/own`` together), so that frame als
 *Equations* and *Lab* tabs follow once no tab has arrived for a moment (:mod:`tpm_viz.ui.teaching.tabs`) and are
 not timed. Median, p95, max, how many came back, and the server's CPU time over the storm. Target (issue 23):
 median <= 3 s, max <= 5 s at N = 100 on an otherwise idle 2-core machine. The test
-(tests/system/test_store_faults.py) checks only that every copy comes back.
+(tests/e2e/test_store_faults.py) checks only that every copy comes back.
 
 Run: ``python benchmarks/bench_reconnect.py`` (``--tabs 100``, ``--repeat 1``). Bounded: a time limit per storm;
 the server stops by its own pid.

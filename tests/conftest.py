@@ -1,7 +1,11 @@
-"""Root of the tests, grouped by layer: ``paper/``, ``multibody/``, ``app/``, ``ui/``, ``cli/``, ``system/``.
+"""Root of the tests, which mirror the package: ``tests/<folder>/test_<module>.py`` tests
+``tpm_viz/<folder>/<module>.py`` (``core/``, ``paper/``, ``drawing/``, ``media/``, ``exchange/``, ``multibody/``,
+``app/``, ``design/``, ``classroom/``, ``viserkit/``, ``ui/``, ``cli/``), plus ``e2e/`` (a served app with its browsers
+and attackers, as a class meets it) and ``system/`` (the rules of the repository: layering, cross-references, README,
+lock).
 
-Shared helpers live in ``tests/support/``; only ``ui/`` and ``system/`` load the server and browser fixtures, so
-the maths tests run without websockets or Chromium.
+Shared helpers live in ``tests/support/``; only ``classroom/``, ``viserkit/``, ``ui/`` and ``e2e/`` load the server
+and browser fixtures, so the maths tests run without websockets or Chromium.
 
 Profiles: ``python -m pytest -m "not slow" -n 2`` is the one-minute loop (Hypothesis's small ``dev`` profile, no
 Chromium, no long server runs); ``CI=true python -m pytest`` runs everything with the full example counts

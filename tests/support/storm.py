@@ -1,5 +1,5 @@
 """A reconnect storm: N browser tabs on their own copies drop at once and come back at once (the wifi blip of a
-lecture hall). Shared by tests/system/test_store_faults.py and benchmarks/bench_reconnect.py.
+lecture hall). Shared by tests/e2e/test_store_faults.py and benchmarks/bench_reconnect.py.
 
 Each :class:`StormTab` gets its cookie the way a browser does (``GET /``: the page response's ``Set-Cookie``), then
 opens the websocket with that cookie and an ``Origin``; it knows it has its own copy when the server says the

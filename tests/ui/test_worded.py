@@ -197,7 +197,7 @@ def test_an_element_made_outside_the_list_is_refused(plain_gui):
 def test_a_choice_that_arrives_during_a_language_switch_is_not_written_over(app):
     """The page's choice is stored by viser before its callback runs; the switch's redraw of the panel must not
     write the state's value over it (it did: the callback then read the old value as an echo and the choice was
-    lost, seen on a loaded machine in tests/system/test_language.py)."""
+    lost, seen on a loaded machine in tests/ui/test_language.py)."""
     tab, view = _open(app, "en")
     try:
         with view.hub.lock:  # the callback waits for the lock while the switch runs, as it would

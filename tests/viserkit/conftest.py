@@ -6,8 +6,11 @@ import contextlib
 
 import pytest
 
+from tests.support.fixtures import app, connect, whole_steps
 from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz.viserkit.adapter import Installed, install, new_server
+
+__all__ = ["app", "connect", "serve", "tab", "whole_steps"]
 
 
 @pytest.fixture

@@ -4,7 +4,7 @@ gettext's model, small: the **English template is the key**. Code that writes wo
 :class:`Phrase` (a template with ``str.format`` fields and the values to put in them) instead of an f-string; the
 UI renders it in the tab's language with :func:`say`; ``str(phrase)`` is the English text (command line, logs).
 The Korean templates live in ``assets/words/ko.toml`` (``"English template" = "Korean template"``); the same
-fields must appear in both, which ``tests/system/test_words.py`` checks, together with "no template used in the
+fields must appear in both, which ``tests/core/test_words.py`` checks, together with "no template used in the
 code is missing from the Korean catalogue" (it reads every ``Phrase("...")``, ``say(..., "...")`` and ``T("...")``
 literal from the source, as ``xgettext`` does).
 

@@ -3,7 +3,7 @@
 viser's number inputs drop what they cannot show (``1e9`` became ``19``) and send every keystroke, so typed numbers
 are text fields read with :func:`tpm_viz.core.numbers.parse_number` (scientific notation, decimal commas, the Unicode
 minus, the field's unit after the number). This module is their logic, as plain objects driven with explicit
-times, so that it is tested without a browser (``tests/app/test_typed_fields.py``):
+times, so that it is tested without a browser (``tests/ui/widgets/test_typed.py``):
 
 - :class:`Quantity`: what one field holds (name, UI unit, SI scale, accepted range): text -> SI value, or one line
   saying what to change; SI value -> a short text that reads back to it. A length field in mm also reads a length

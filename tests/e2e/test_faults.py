@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from tests.support.protocol import ProtocolClient, wait_for
-from tests.ui.test_reliability_app import assert_valid
+from tests.ui.test_client_reliability import assert_valid
 from tpm_viz import Params
 from tpm_viz.app import transitions
 from tpm_viz.classroom.guard import ACTIVITY, guarded

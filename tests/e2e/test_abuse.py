@@ -27,8 +27,8 @@ from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect as connect_sync
 
 import tpm_viz.viserkit.transport as transport
+from tests.e2e.test_security import _get
 from tests.support.protocol import CAMERA, ProtocolClient, ServerProcess, Tab, decode_batch, wait_for
-from tests.system.test_security import _get
 from tpm_viz.app.inputs import MAX_TEXT
 from tpm_viz.classroom.guard import ACTIVITY, Faults
 from tpm_viz.ui.app import TpmApp, build_server

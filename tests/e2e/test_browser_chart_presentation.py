@@ -5,7 +5,7 @@ uPlot's usual 12 px grey when presentation mode is turned off.
 uPlot draws its axes on a canvas, so what is measured is what the page's uPlot instances are configured with (viser's
 test point): the font size of the tick labels and of the axis titles (uPlot keeps ``[font, size in device px]``),
 the colour of the axis text (its ``stroke``), and, with the page's own text measurement in those fonts, everything
-:func:`tests.system.test_browser_charts._check_chart` checks (labels apart and inside the canvas, y labels within
+:func:`tests.e2e.test_browser_charts._check_chart` checks (labels apart and inside the canvas, y labels within
 the y axis, the rotated y title within the plot in both languages). The screenshots (English and Korean, the
 Player tab) are kept in a temporary folder named in the test's output; they were looked at when this was written.
 """
@@ -17,9 +17,9 @@ import tempfile
 
 import pytest
 
+from tests.e2e.test_browser_charts import _check_chart, open_with_a_run
 from tests.support.protocol import wait_for
 from tests.support.stage import GROUP_OF, open_tab
-from tests.system.test_browser_charts import _check_chart, open_with_a_run
 from tpm_viz.core.words import Lang, catalogue
 from tpm_viz.ui.teaching.player.charts import FORCES, KINEMATICS
 from tpm_viz.viserkit.probe import widget_uuid
@@ -77,7 +77,7 @@ def _fonts(page, charts, least: float | None, most: float | None) -> list[dict]:
 
 
 def _check_all(page, charts, where: str) -> None:
-    """Every chart whole as the page draws it (:func:`tests.system.test_browser_charts._check_chart`)."""
+    """Every chart whole as the page draws it (:func:`tests.e2e.test_browser_charts._check_chart`)."""
     y_labels = [FORCES[1], *(label for _attr, _title, label, _scale in KINEMATICS)]
     for k, (handle, y_label) in enumerate(zip(charts.handles, y_labels, strict=True)):
         _check_chart(handle, page, y_label, f"{where}, chart {k}")

@@ -16,9 +16,9 @@ import tempfile
 
 import pytest
 
+from tests.e2e.test_browser_layout import _in_view, chromium, served  # noqa: F401  (fixtures)
 from tests.support.protocol import wait_for
 from tests.support.stage import GROUP_OF, STAGE, open_tab
-from tests.system.test_browser_layout import _in_view, chromium, served  # noqa: F401  (fixtures)
 from tpm_viz.core.words import Lang, T, say, shown
 from tpm_viz.ui.look import PANEL_WIDTH
 from tpm_viz.viserkit.probe import widget_uuid

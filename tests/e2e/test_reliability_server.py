@@ -30,7 +30,7 @@ from hypothesis import strategies as st
 from tests.support.fake_viser import assert_clean
 from tests.support.hypo import examples
 from tests.support.protocol import ProtocolClient, wait_for
-from tests.ui.test_reliability_app import CSV_TEXT, GOOD_ROWS, NASTY_FLOAT, _timed, assert_valid
+from tests.ui.test_client_reliability import CSV_TEXT, GOOD_ROWS, NASTY_FLOAT, _timed, assert_valid
 from tpm_viz.classroom.guard import ACTIVITY
 from tpm_viz.viserkit.probe import widget_uuid
 

@@ -21,7 +21,7 @@ from pathlib import Path
 import pytest
 
 from tests.support.protocol import ProtocolClient, wait_for
-from tests.ui.test_reliability_app import assert_valid
+from tests.ui.test_client_reliability import assert_valid
 from tpm_viz.classroom.guard import ACTIVITY
 from tpm_viz.viserkit.probe import connection_states
 

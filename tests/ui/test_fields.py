@@ -291,7 +291,7 @@ def test_a_frame_drawn_while_a_slider_input_is_on_its_way_does_not_turn_it_into_
     """A student moves d2 to 250 mm right after *Work on my own copy*: viser stores the value on arrival, then a
     frame of the (unchanged) copy is drawn before the slider's callback runs. The frame must not write 130 mm back
     over it, or the callback reads the server's own value, takes it for an echo and the input is lost (seen under
-    load in tests/system/test_security.py). The state after the callback: 250 mm."""
+    load in tests/e2e/test_security.py). The state after the callback: 250 mm."""
     _client, view = connect()
     slider = view.panel.d[1]
     assert slider.value == pytest.approx(130.0)

@@ -2,7 +2,7 @@
 (:meth:`tpm_viz.ui.teaching.player.charts.Charts.set_presentation`), through viser's protocol: what the tab's uPlot
 charts are sent, measured against DejaVu Sans (the widest of the usual sans fonts, shipped with matplotlib) with Pillow,
 not with the module's own width estimate. The browser's drawing is checked in
-``tests/system/test_browser_chart_presentation.py``.
+``tests/e2e/test_browser_chart_presentation.py``.
 """
 
 from __future__ import annotations

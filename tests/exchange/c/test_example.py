@@ -16,7 +16,7 @@ from tpm_viz.core.errors import InputError
 from tpm_viz.core.params import Params
 from tpm_viz.exchange.c.code import c_files
 
-EXAMPLE = pathlib.Path(__file__).resolve().parents[2] / "examples" / "ctc_loop.c"
+EXAMPLE = pathlib.Path(__file__).resolve().parents[3] / "examples" / "ctc_loop.c"
 
 
 def run_example(directory: pathlib.Path, rate: float) -> dict[str, float]:
