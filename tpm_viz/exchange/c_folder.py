@@ -46,6 +46,7 @@ def _open_folder(directory: str) -> int:
     """A descriptor of the folder ``directory`` (created if missing), never through a symbolic link."""
     if directory == "-":
         raise InputError(T("--format c writes two files: give a directory as --output, not '-'"))
+    directory = directory.rstrip(os.sep) or os.sep  # "link/" would resolve the link even under O_NOFOLLOW
     if os.path.islink(directory):
         raise InputError(
             Phrase(
