@@ -72,6 +72,8 @@ static double seconds(void)
 
 int main(void)
 {
+    /* TPM_PARAMS_EXPORTED also sets the margin (min_cos, min_det): the app's move limits, inside which the dynamics
+     * refuse (TPM_E_SINGULAR_*) instead of returning unbounded forces; this circle stays far from it */
     const tpm_params prm = TPM_PARAMS_EXPORTED; /* the plant */
     const tpm_params model = TPM_PARAMS_EXPORTED; /* the controller's model (exact here) */
     const double w = 2.0 * 3.14159265358979323846 * 10.0, zeta = 1.0;

@@ -22,8 +22,11 @@ CFLAGS = ["-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-pedantic"]
 SANITIZE = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-g"]
 HERE = pathlib.Path(__file__).resolve().parent
 BATCH = HERE / "tpm_batch.c"
-IN_COLS, OUT_COLS = 27, 32
+IN_COLS, OUT_COLS = 29, 32
 SENTINEL = 12345.0
+NO_MARGIN = (1e-300, 1e-300)
+"""A margin (``min_cos``, ``min_det`` of ``tpm_params``) so small that only the exact guards (``TPM_SINGULAR_TOL``,
+``TPM_CTC_DIRECT_TOL``) refuse: what the tests of the traced formulas and of those guards use."""
 
 
 def cc() -> str | None:
@@ -62,9 +65,18 @@ def build_driver(directory: pathlib.Path, extra: list[str]) -> pathlib.Path:
     return compile_c([directory / "tpm_2ppa.c", BATCH], directory / "driver", directory, ["-DTPM_DRIVER", *extra])
 
 
-def run_batch(dll: ctypes.CDLL, rows: np.ndarray) -> np.ndarray:
-    """Every function on ``rows`` ``(n, IN_COLS)``; returns ``(n, OUT_COLS)`` (sentinel where nothing was written)."""
-    rows = np.ascontiguousarray(rows, dtype=np.float64)
+def with_margin(rows: np.ndarray, margin: tuple[float, float] = NO_MARGIN) -> np.ndarray:
+    """``rows`` of 27 columns (parameters to ``tau_in``) with the margin columns appended: ``(n, IN_COLS)``."""
+    rows = np.asarray(rows, dtype=np.float64)
+    if rows.shape[1] == IN_COLS:
+        return rows
+    return np.concatenate([rows, np.broadcast_to(np.asarray(margin, dtype=np.float64), (len(rows), 2))], axis=1)
+
+
+def run_batch(dll: ctypes.CDLL, rows: np.ndarray, margin: tuple[float, float] = NO_MARGIN) -> np.ndarray:
+    """Every function on ``rows`` (``(n, IN_COLS)``, or 27 columns and ``margin``); returns ``(n, OUT_COLS)``
+    (sentinel where nothing was written)."""
+    rows = np.ascontiguousarray(with_margin(rows, margin))
     out = np.full((len(rows), OUT_COLS), SENTINEL)
     dll.batch_all(len(rows), rows.ctypes.data, out.ctypes.data)
     return out

@@ -1,7 +1,8 @@
 /* Test harness for the generated tpm_2ppa.c (tests/exchange): every function on n rows of inputs.
  *
  * Row of IN_COLS inputs: prm[0:7] (a, b, l_a, m_a, m_b, m_p, stroke), p[7:9], dp[9:11], ddp[11:13], f_ext[13:15],
- * kp[15:17], kd[17:19], p_ref[19:21], dp_ref[21:23], ddp_ref[23:25], tau_in[25:27] (for the forward dynamics).
+ * kp[15:17], kd[17:19], p_ref[19:21], dp_ref[21:23], ddp_ref[23:25], tau_in[25:27] (for the forward dynamics),
+ * then the margin of tpm_params: min_cos[27], min_det[28].
  * Row of OUT_COLS outputs (the caller pre-fills them with a sentinel; a refusing function must leave it):
  * d[0:2] rc_ik[2] J[3:7] rc_jac[7] tau[8:10] rc_id[10] ddp[11:13] rc_fd[13] tau_ctc[14:16] rc_ctc[16]
  * rc_stroke[17] (tpm_check_stroke of the input p read as actuator positions); then the parallel arrangement's
@@ -12,7 +13,7 @@
 
 #include <stddef.h>
 
-#define IN_COLS 27
+#define IN_COLS 29
 #define OUT_COLS 32
 
 void batch_all(size_t n, const double *in, double *out);
@@ -31,6 +32,8 @@ void batch_all(size_t n, const double *in, double *out)
         prm.m_b = r[4];
         prm.m_p = r[5];
         prm.stroke = r[6];
+        prm.min_cos = r[27];
+        prm.min_det = r[28];
         o[2] = tpm_inverse_kinematics(&prm, r + 7, o + 0);
         o[7] = tpm_jacobian(&prm, r + 7, o + 3);
         o[10] = tpm_inverse_dynamics(&prm, r + 7, r + 9, r + 11, r + 13, o + 8);

@@ -4,8 +4,10 @@
 :mod:`tpm_viz.exchange` (no MuJoCo or Pinocchio needed to write it). The file is written atomically: a
 temporary file in the same directory, then ``os.replace``, so a reader never sees half a model. ``--output -``
 prints to stdout. ``--format c`` writes ``tpm_2ppa.h`` and ``tpm_2ppa.c`` (:mod:`tpm_viz.exchange.c.code`) into
-the directory ``--output`` (created if missing), each file atomically. The handler returns the exit status and
-raises :class:`~tpm_viz.core.errors.TpmVizError` for bad input (``cli.main`` prints one line and exits with 2).
+the directory ``--output`` (created if missing; not through a symbolic link), each file atomically, and replaces a
+file there only if it is untouched since its export, or with ``--force`` (:mod:`tpm_viz.exchange.c.folder`). The
+handler returns the exit status and raises :class:`~tpm_viz.core.errors.TpmVizError` for bad input (``cli.main`` prints
+one line and exits with 2).
 """
 
 from __future__ import annotations
@@ -62,19 +64,11 @@ def write_atomically(path: str, data: str | bytes) -> None:
         raise
 
 
-def _write_c(params, directory: str) -> None:
+def _write_c(params, directory: str, force: bool) -> None:
     from tpm_viz.exchange.c.code import c_files
+    from tpm_viz.exchange.c.folder import write_c_folder
 
-    if directory == "-":
-        raise InputError("--format c writes two files: give a directory as --output, not '-'")
-    if os.path.exists(directory) and not os.path.isdir(directory):
-        raise InputError(f"--output {directory!r} is a file: --format c needs a directory (created if missing)")
-    try:
-        os.makedirs(directory, exist_ok=True)
-    except OSError as exc:
-        raise InputError(f"cannot create the directory --output {directory!r}: {exc.strerror}") from None
-    for name, text in c_files(params).items():
-        write_atomically(os.path.join(directory, name), text)
+    write_c_folder(directory, c_files(params), force)
 
 
 def _cmd_export(args) -> int:
@@ -85,8 +79,10 @@ def _cmd_export(args) -> int:
     if args.format == "c":
         if args.timestep is not None:
             raise InputError("--timestep applies to --format mjcf only")
-        _write_c(params, args.output)
+        _write_c(params, args.output, args.force)
         return 0
+    if args.force:
+        raise InputError("--force applies to --format c only")
     if args.format == "mjcf":
         settings = DEFAULT_SETTINGS
         if args.timestep is not None:
@@ -122,6 +118,12 @@ def register(subparsers, common_parent: argparse.ArgumentParser) -> None:
         required=True,
         metavar="FILE",
         help="output file, replaced atomically ('-': stdout); for --format c a directory (created if missing)",
+    )
+    e.add_argument(
+        "--force",
+        action="store_true",
+        help="--format c only: replace tpm_2ppa.h/.c even if they were edited after their export (checked by the "
+        "content hash in their last line; a symbolic link or a non-regular file is never replaced)",
     )
     e.add_argument(
         "--timestep",

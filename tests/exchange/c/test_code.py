@@ -216,7 +216,7 @@ def test_the_sanitized_build_runs_every_function_cleanly_and_gives_the_same_numb
     bad = np.repeat(rows[:1], 20, axis=0)
     bad[np.arange(20), 7 + np.arange(20)] = math.nan
     everything = np.concatenate([rows, special, bad])
-    (tmp_path / "in.bin").write_bytes(everything.astype("<f8").tobytes())
+    (tmp_path / "in.bin").write_bytes(cbuild.with_margin(everything).astype("<f8").tobytes())
     done = subprocess.run(
         [str(driver), str(tmp_path / "in.bin"), str(tmp_path / "out.bin")], capture_output=True, text=True, timeout=600
     )

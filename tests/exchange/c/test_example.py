@@ -46,7 +46,10 @@ def test_export_format_c_writes_both_files_into_a_new_directory(tmp_path):
     assert args.func(args) == 0
     assert sorted(p.name for p in out.iterdir()) == ["tpm_2ppa.c", "tpm_2ppa.h"]
     assert (out / "tpm_2ppa.c").read_text() == c_files(Params.paper(m_p=4.42))["tpm_2ppa.c"]
-    assert "{ 0.482, 0.092, 0.26, 0.95, 0.84, 4.42, 0.3 }" in (out / "tpm_2ppa.h").read_text()
+    assert (
+        "{ 0.482, 0.092, 0.26, 0.95, 0.84, 4.42, 0.3, TPM_MIN_COS_APP, TPM_MIN_DET_APP }"
+        in (out / "tpm_2ppa.h").read_text()
+    )
     for bad in ("-", str(out / "tpm_2ppa.c")):
         args = parser_for(cli_export).parse_args(["export", "--format", "c", "--output", bad])
         with pytest.raises(InputError, match="directory"):

@@ -22,6 +22,7 @@ __all__ = [
     "IK_ARGS",
     "JACOBIAN_ARGS",
     "PRM",
+    "Cosines",
     "Legs",
     "Stages",
     "c_function",
@@ -51,6 +52,9 @@ Legs = tuple[str, str]
 """``(declaration, call)`` of the legs step, e.g. ``("double c1, c2;", "tpm_legs(prm, p, &c1, &c2)")``."""
 
 Stages = list[tuple[str, list[tuple[str, Sym]]]]
+
+Cosines = tuple[str, str]
+"""C expressions of ``cos θ_1, cos θ_2`` (e.g. ``("c1 / prm->l_a", "c2 / prm->l_a")``), as the app computes them."""
 
 _PARAM_LOCALS = {
     "l_a": "prm->l_a",
@@ -118,17 +122,31 @@ def finite_inputs(arrays: Sequence[str], optional: Sequence[str] = ()) -> str:
     return require(terms, "TPM_E_NONFINITE")
 
 
-def inverse_singular(product: str) -> str:
-    """Refuse at the inverse singularity, ``|c_1 c_2| < tol l_a^2`` (eq. 11; ``product`` is ``c_1 * c_2``)."""
-    return refuse(f"fabs({product}) < TPM_SINGULAR_TOL * (prm->l_a * prm->l_a)", "TPM_E_SINGULAR_INVERSE")
+def _below_min_cos(cosines: Cosines) -> str:
+    """``|cos θ_1| < min_cos || |cos θ_2| < min_cos``: the margin's inverse rule (``tpm_viz.app.moves.margins``)."""
+    return " || ".join(f"fabs({k}) < prm->min_cos" for k in cosines)
 
 
-def regular(signature: str, product: str, direct: str, direct_tol: str) -> str:
-    """A static check of both singularities: ``|product| < tol l_a^2`` inverse, ``|direct| < direct_tol l_a^2``."""
+def inverse_singular(product: str, cosines: Cosines) -> str:
+    """Refuse at the inverse singularity, ``|c_1 c_2| < tol l_a^2`` (eq. 11; ``product`` is ``c_1 * c_2``), and
+    inside the margin ``min_i |cos θ_i| < min_cos`` of ``tpm_params``."""
+    exact = refuse(f"fabs({product}) < TPM_SINGULAR_TOL * (prm->l_a * prm->l_a)", "TPM_E_SINGULAR_INVERSE")
+    return exact + refuse(_below_min_cos(cosines), "TPM_E_SINGULAR_INVERSE")
+
+
+def regular(signature: str, product: str, direct: str, direct_tol: str, cosines: Cosines, det: str) -> str:
+    """A static check of both singularities and the margin of ``tpm_params``, in the app's order (inverse first):
+    ``|product| < tol l_a^2``, ``min_i |cos θ_i| < min_cos`` (eq. 11), then ``|direct| < direct_tol l_a^2``,
+    ``|det| < min_det`` (eq. 12). ``cosines`` are ``cos θ_i`` (C expressions, declared as ``k1``, ``k2``), ``det``
+    the direct measure ``det J_x`` written with them, as :func:`tpm_viz.app.moves.margins` computes it."""
     return (
         f"static int {signature}\n{{\n    const double la2 = prm->l_a * prm->l_a;\n"
+        + "".join(f"    const double k{i + 1} = {k}; /* cos th_{i + 1} */\n" for i, k in enumerate(cosines))
+        + f"    const double det = {det}; /* det J_x */\n"
         + refuse(f"fabs({product}) < TPM_SINGULAR_TOL * la2", "TPM_E_SINGULAR_INVERSE")
+        + refuse(_below_min_cos(("k1", "k2")), "TPM_E_SINGULAR_INVERSE")
         + refuse(f"fabs({direct}) < {direct_tol} * la2", "TPM_E_SINGULAR_DIRECT")
+        + refuse("fabs(det) < prm->min_det", "TPM_E_SINGULAR_DIRECT")
         + "    return TPM_OK;\n}\n"
     )
 
@@ -214,10 +232,18 @@ FD_ARGS = (
 )
 
 
-def jacobian(name: str, legs: Legs, product: str, body: str, finite: Sequence[str], before: Sequence[str] = ()) -> str:
-    """``J = dd/dp`` row-major into ``J[4]``; refuses at the inverse singularity (``product`` = ``c_1 c_2``)."""
+def jacobian(
+    name: str,
+    legs: Legs,
+    singular: tuple[str, Cosines],
+    body: str,
+    finite: Sequence[str],
+    before: Sequence[str] = (),
+) -> str:
+    """``J = dd/dp`` row-major into ``J[4]``; refuses at the inverse singularity and inside the margin's inverse rule
+    (``singular``: ``c_1 c_2`` and the cosines, :func:`inverse_singular`). ``J`` stays finite at the direct one."""
     block = result_block(body, "J", ("J11", "J12", "J21", "J22"), before=before, finite=finite)
-    return c_function(prototype(name, JACOBIAN_ARGS), legs, [inverse_singular(product)], block)
+    return c_function(prototype(name, JACOBIAN_ARGS), legs, [inverse_singular(*singular)], block)
 
 
 def inverse_dynamics(

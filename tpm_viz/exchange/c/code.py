@@ -13,8 +13,10 @@ prints what they compute, operation by operation:
 
 The checks are a short C skeleton per function (:mod:`.text`, the shape they share in :mod:`.blocks`) with
 the Python's own thresholds (:data:`tpm_viz.paper.dynamics.SINGULAR_TOL`, :data:`tpm_viz.paper.control.CTC_DIRECT_TOL`,
-the default tolerance of :func:`tpm_viz.paper.kinematics.in_stroke`). C99, ``libm`` only, no allocation, no global
-state; a function that refuses returns a non-zero code and leaves its outputs untouched. The parallel
+the default tolerance of :func:`tpm_viz.paper.kinematics.in_stroke`) and a margin in ``tpm_params`` (``min_cos``,
+``min_det``: the rules of :func:`tpm_viz.app.moves.margins`, by default the app's move limits
+:data:`tpm_viz.paper.status.MOVE_LIMITS`) inside which the dynamics refuse. C99, ``libm`` only, no allocation, no
+global state; a function that refuses returns a non-zero code and leaves its outputs untouched. The parallel
 arrangement's functions (``tpm_par_*``) come from :mod:`.parallel` the same way.
 """
 
@@ -30,10 +32,12 @@ from tpm_viz.core.params import Params
 from tpm_viz.exchange.c.blocks import Stages, traced_block
 from tpm_viz.exchange.c.expr import Graph
 from tpm_viz.exchange.c.parallel import parallel_fields
+from tpm_viz.exchange.c.stamp import stamped
 from tpm_viz.exchange.c.text import HEADER, SOURCE
 from tpm_viz.paper.control import CTC_DIRECT_TOL, task_space_command
 from tpm_viz.paper.dynamics import SINGULAR_TOL, _procedure
 from tpm_viz.paper.kinematics import _ik_unchecked, in_stroke
+from tpm_viz.paper.status import MOVE_LIMITS
 
 __all__ = ["FILES", "c_files"]
 
@@ -149,17 +153,20 @@ def _ctc_body() -> str:
 
 def _params_initializer(params: Params) -> str:
     values = (params.a, params.b, params.l_a, params.m_a, params.m_b, params.m_p, params.stroke)
-    return "{ " + ", ".join(repr(float(v)) for v in values) + " }"
+    return "{ " + ", ".join(repr(float(v)) for v in values) + ", TPM_MIN_COS_APP, TPM_MIN_DET_APP }"
 
 
 def c_files(params: Params | None = None) -> dict[str, str]:
-    """``{file name: text}`` of the generated C; ``params`` fills ``TPM_PARAMS_EXPORTED`` (default: the paper's)."""
+    """``{file name: text}`` of the generated C; ``params`` fills ``TPM_PARAMS_EXPORTED`` (default: the paper's).
+    Each text ends with its content hash (:func:`.stamp.stamped`)."""
     params = Params.paper() if params is None else params
     stroke_tol = inspect.signature(in_stroke).parameters["tol"].default
     fields = {
         "singular_tol": repr(SINGULAR_TOL),
         "ctc_direct_tol": repr(CTC_DIRECT_TOL),
         "stroke_tol": repr(float(stroke_tol)),
+        "min_cos": repr(MOVE_LIMITS.inverse),
+        "min_det": repr(MOVE_LIMITS.direct),
         "exported": _params_initializer(params),
         "ik_body": _ik_body(),
         "jacobian_body": _jacobian_body(),
@@ -168,4 +175,4 @@ def c_files(params: Params | None = None) -> dict[str, str]:
         "ctc_body": _ctc_body(),
         **parallel_fields(),
     }
-    return {"tpm_2ppa.h": HEADER.substitute(fields), "tpm_2ppa.c": SOURCE.substitute(fields)}
+    return {"tpm_2ppa.h": stamped(HEADER.substitute(fields)), "tpm_2ppa.c": stamped(SOURCE.substitute(fields))}

@@ -19,6 +19,7 @@ from tpm_viz.exchange.c.blocks import (
     ID_ARGS,
     IK_ARGS,
     JACOBIAN_ARGS,
+    Cosines,
     Legs,
     c_function,
     copy_out,
@@ -120,6 +121,7 @@ DECLS = """
 _LEGS: Legs = ("double d[2], c[2];", "tpm_par_legs(prm, p, d, c)")
 _REGULAR_CALL = "tpm_par_regular(prm, p, c)"
 _C = unpack("c", "c")
+_COSINES: Cosines = ("c[0] / prm->l_a", "c[1] / prm->l_a")  # cos th_i = c_i / l_a (eq. P2)
 
 _HELPERS = (
     """
@@ -135,13 +137,16 @@ static int tpm_par_legs(const tpm_params *prm, const double p[2], double d[2], d
     return TPM_OK;
 }
 
-/* cos th1 cos th2 = c_1 c_2 / l_a^2; sin(th1 + th2) = p_2 (c_1 + c_2) / l_a^2 (eq. P6) */
+/* cos th1 cos th2 = c_1 c_2 / l_a^2; sin(th1 + th2) = p_2 (c_1 + c_2) / l_a^2 (eq. P6); then the margin on
+ * cos th_i = c_i / l_a and det J_x = cos th1 sin th2 + sin th1 cos th2, as tpm_viz.paper.parallel.kinematics. */
 """
     + regular(
         "tpm_par_regular(const tpm_params *prm, const double p[2], const double c[2])",
         "c[0] * c[1]",
         "p[1] * (c[0] + c[1])",
         "TPM_SINGULAR_TOL",
+        _COSINES,
+        "k1 * (p[1] / prm->l_a) + (p[1] / prm->l_a) * k2",
     )
 )
 
@@ -152,7 +157,7 @@ _FUNCTIONS = [
         [],
         refuse("!tpm_finite2(dd)", "TPM_E_OVERFLOW") + copy_out("d", ("dd[0]", "dd[1]"), depth=1),
     ),
-    jacobian(_PAR[1], _LEGS, "c[0] * c[1]", "$jacobian_body", finite=("J12", "J22"), before=_C),
+    jacobian(_PAR[1], _LEGS, ("c[0] * c[1]", _COSINES), "$jacobian_body", finite=("J12", "J22"), before=_C),
     inverse_dynamics(_PAR[2], _LEGS, _REGULAR_CALL, "$id_body", before=_C),
     forward_dynamics(_PAR[3], _LEGS, _REGULAR_CALL, "$fd_body", before=_C),
 ]

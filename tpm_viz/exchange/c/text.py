@@ -16,6 +16,7 @@ from tpm_viz.exchange.c.blocks import (
     IK_ARGS,
     JACOBIAN_ARGS,
     PRM,
+    Cosines,
     Legs,
     c_function,
     finite_inputs,
@@ -35,6 +36,7 @@ from tpm_viz.exchange.c.blocks import (
 __all__ = ["HEADER", "SOURCE"]
 
 _LEGS: Legs = ("double c1, c2;", "tpm_legs(prm, p, &c1, &c2)")
+_COSINES: Cosines = ("c1 / prm->l_a", "c2 / prm->l_a")  # cos th_i = c_i / l_a (eq. 23)
 _REGULAR_CALL = "tpm_regular(prm, p, c1, c2, TPM_SINGULAR_TOL)"
 _VOID_F = ("(void)f1;", "(void)f2;")  # the trace may not read f1, f2 (an unused local is an error under -Werror)
 _IK = prototype("tpm_inverse_kinematics", IK_ARGS)
@@ -73,21 +75,36 @@ extern "C" {
 #define TPM_OK 0
 #define TPM_E_NONFINITE 1         /* an input is NaN or inf */
 #define TPM_E_UNREACHABLE 2       /* |p_j| >= l_a for a leg: eq. (4) has no real solution */
-#define TPM_E_SINGULAR_INVERSE 3  /* |cos th1 cos th2| < TPM_SINGULAR_TOL (eq. 11): a leg is normal to its rail */
-#define TPM_E_SINGULAR_DIRECT 4   /* |cos(th1 + th2)| below the function's threshold (eq. 12): the legs are parallel */
+#define TPM_E_SINGULAR_INVERSE 3  /* a leg (nearly) normal to its rail (eq. 11): |cos th1 cos th2| < TPM_SINGULAR_TOL,
+                                   * or inside the margin: some |cos th_i| < prm->min_cos */
+#define TPM_E_SINGULAR_DIRECT 4   /* the legs (nearly) parallel (eq. 12): |cos(th1 + th2)| below the function's
+                                   * threshold, or inside the margin: |det J_x| < prm->min_det */
 #define TPM_E_STROKE 5            /* an actuator outside 0 <= d_i <= stroke (tpm_check_stroke) */
 #define TPM_E_OVERFLOW 6          /* the result is not finite: inputs too large for double */
-#define TPM_E_PARAMS 7            /* a parameter is not finite and positive, or a gain kp <= 0 or kd < 0 */
+#define TPM_E_PARAMS 7            /* a parameter is not finite and positive, a margin not in (0, 1), or a gain
+                                   * kp <= 0 or kd < 0 */
 
 #define TPM_SINGULAR_TOL $singular_tol    /* eqs. (11)-(12), as tpm_viz.paper.dynamics.SINGULAR_TOL */
 #define TPM_CTC_DIRECT_TOL $ctc_direct_tol  /* eq. (12) for tpm_computed_torque, as tpm_viz.paper.control */
 #define TPM_STROKE_TOL $stroke_tol    /* [m], as tpm_viz.paper.kinematics.in_stroke */
+#define TPM_MIN_COS_APP $min_cos  /* the app's move limit on min_i |cos th_i| (eq. 11), as tpm_viz.paper.status */
+#define TPM_MIN_DET_APP $min_det  /* the app's move limit on |det J_x| = |cos(th1 + th2)| (eq. 12), MOVE_LIMITS */
 
 /* The mechanism [m, kg]: a total size, b platform offset, l_a link length (Table 1); m_a one slider with its
  * coupler, m_b both links of one parallelogram, m_p the platform (Table 2); stroke = Delta d. Mass model of
- * tpm-viz (docs/conventions.md): sliders and platform translate, the links are uniform slender rods. */
+ * tpm-viz (docs/conventions.md): sliders and platform translate, the links are uniform slender rods.
+ *
+ * The margin [-], min_cos and min_det: near a singularity the closed form stays exact but its forces grow without
+ * bound (1e11-1e14 N a hair from one), so the dynamics, the computed torque and (the inverse rule only) the Jacobian
+ * refuse a pose with min_i |cos th_i| < min_cos (TPM_E_SINGULAR_INVERSE, eq. 11) or |det J_x| < min_det
+ * (TPM_E_SINGULAR_DIRECT, eq. 12; det J_x = cos(th1 + th2), in the parallel arrangement sin(th1 + th2)), the rules
+ * of the app's moves. Both must be in (0, 1): a struct that leaves them 0 is refused (TPM_E_PARAMS).
+ * TPM_PARAMS_EXPORTED sets the app's move limits (TPM_MIN_COS_APP, TPM_MIN_DET_APP: where its drags and trajectories
+ * stop); a smaller margin lets the controller go nearer, a larger one keeps it further away (the app warns at 0.2).
+ * tpm_inverse_kinematics and tpm_check_stroke do not apply it (but refuse an invalid one, as every function). */
 typedef struct {
     double a, b, l_a, m_a, m_b, m_p, stroke;
+    double min_cos, min_det;
 } tpm_params;
 
 /* The parameters this file was exported with: `tpm_params prm = TPM_PARAMS_EXPORTED;` */
@@ -104,22 +121,24 @@ _DECLARATIONS = (
 /* TPM_OK if 0 - TPM_STROKE_TOL <= d_i <= stroke + TPM_STROKE_TOL for both actuators, else TPM_E_STROKE. */
 {_STROKE};
 
-/* Row-major J = dd/dp (eq. 10): J[0] = 1, J[1] = tan th1, J[2] = tan th2, J[3] = 1. Refuses at eq. (11). */
+/* Row-major J = dd/dp (eq. 10): J[0] = 1, J[1] = tan th1, J[2] = tan th2, J[3] = 1. Refuses at eq. (11) and
+ * inside the margin's inverse rule (min_cos; J stays finite at the direct singularity). */
 {prototype("tpm_jacobian", JACOBIAN_ARGS)};
 
 /* Actuator forces tau [N] for the platform motion p [m], dp [m/s], ddp [m/s^2] under an external force f_ext [N]
- * applied TO the platform (NULL: none), eqs. (29)-(31) with the errata corrected (eqs. 15, 22). Refuses at
- * eq. (11) and eq. (12) (TPM_SINGULAR_TOL). */
+ * applied TO the platform (NULL: none), eqs. (29)-(31) with the actuator accelerations of eq. (14) under the
+ * corrected sign of eq. (15) (the one erratum that enters them). Refuses at eq. (11) and eq. (12)
+ * (TPM_SINGULAR_TOL) and inside the margin (tpm_params). */
 {prototype("tpm_inverse_dynamics", ID_ARGS)};
 
 /* Platform acceleration ddp [m/s^2] under actuator forces tau [N] and f_ext [N] (NULL: none): the closed form
- * solved for ddp (tau = M(p) ddp + h(p, dp, f_ext)). Same refusals as tpm_inverse_dynamics. */
+ * solved for ddp (tau = M(p) ddp + h(p, dp, f_ext)). Same refusals as tpm_inverse_dynamics (the margin too). */
 {prototype("tpm_forward_dynamics", FD_ARGS)};
 
 /* The control lab's computed-torque law in task space: tau = ID(p, dp, ddp_ref + kd (dp_ref - dp) + kp (p_ref - p))
  * with the controller's model `model`, at the measured state p [m], dp [m/s]. Gains per axis: kp = w^2 [1/s^2],
  * kd = 2 zeta w [1/s] (w = 2 pi f_n). Refuses a measured pose at eq. (11) (TPM_SINGULAR_TOL) or eq. (12)
- * (TPM_CTC_DIRECT_TOL). */
+ * (TPM_CTC_DIRECT_TOL), or inside the margin of `model`. */
 {_CTC};
 """
 )
@@ -155,7 +174,7 @@ static int tpm_params_ok(const tpm_params *prm)
             return 0;
         }
     }
-    return 1;
+    return prm->min_cos > 0.0 && prm->min_cos < 1.0 && prm->min_det > 0.0 && prm->min_det < 1.0;
 }
 
 static int tpm_finite2(const double x[2])
@@ -175,7 +194,8 @@ _LEGS_TAIL = """    la2 = prm->l_a * prm->l_a;
     return TPM_OK;
 }
 
-/* Eq. (11): c_1 c_2 = l_a^2 cos th1 cos th2; eq. (12): c_1 c_2 - p_1 p_2 = l_a^2 cos(th1 + th2). */
+/* Eq. (11): c_1 c_2 = l_a^2 cos th1 cos th2; eq. (12): c_1 c_2 - p_1 p_2 = l_a^2 cos(th1 + th2). Then the
+ * margin, on cos th_i = c_i / l_a and det J_x = cos th1 cos th2 - sin th1 sin th2, as tpm_viz.app.moves.margins. */
 """
 
 _IN_STROKE = "!(d[i] >= -TPM_STROKE_TOL && d[i] <= prm->stroke + TPM_STROKE_TOL)"
@@ -189,7 +209,7 @@ _FUNCTIONS = [
         + refuse(_IN_STROKE, "TPM_E_STROKE", depth=2)
         + "    }\n    return TPM_OK;\n}\n"
     ),
-    jacobian("tpm_jacobian", _LEGS, "c1 * c2", "$jacobian_body", finite=("J12", "J21")),
+    jacobian("tpm_jacobian", _LEGS, ("c1 * c2", _COSINES), "$jacobian_body", finite=("J12", "J21")),
     inverse_dynamics("tpm_inverse_dynamics", _LEGS, _REGULAR_CALL, "$id_body", after=_VOID_F),
     forward_dynamics("tpm_forward_dynamics", _LEGS, _REGULAR_CALL, "$fd_body", after=_VOID_F),
     c_function(
@@ -239,6 +259,8 @@ SOURCE = Template(
         "c1 * c2",
         "c1 * c2 - p[0] * p[1]",
         "direct_tol",
+        _COSINES,
+        "k1 * k2 - (p[1] / prm->l_a) * (p[0] / prm->l_a)",
     )
     + "".join("\n" + f for f in _FUNCTIONS)
     + "\n"
