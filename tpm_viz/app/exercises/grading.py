@@ -85,6 +85,7 @@ def clear_caches() -> None:
     """Forget every cached computation (simulations, reference poses, peaks): the next grade computes afresh (what
     the selftest and the benchmark time)."""
     verdict.cache_clear()
+    gains_reference.cache_clear()
     zero_pose.cache_clear()
     circle_peak.cache_clear()
 

@@ -190,7 +190,7 @@ def _unit(t: _Table, kind: Kind, task: object) -> str:
     try:
         unit_factor(unit, quantity, "unit", t.values["answer"])
     except TpmVizError as exc:
-        raise t.fail(Phrase("unit: {why}", why=reason(exc)), "unit") from None
+        raise t.fail(reason(exc), "unit") from None
     if quantity is not None and not unit:
         raise t.fail(
             Phrase("{answer} is a {quantity}: give its unit", answer=t.values["answer"], quantity=quantity), "unit"
