@@ -53,7 +53,7 @@ def test_the_tour_loads_with_at_least_eight_exercises_over_the_six_lessons():
 
 def test_the_four_exercises_of_the_issue():
     expected = {
-        "force-at-pose": (Kind.NUMBER, "N", {"p1", "p2", "ddp1", "ddp2"}),
+        "force-at-pose": (Kind.NUMBER, "N", {"p1", "p2", "ddp1", "ddp2", "m_a", "m_p"}),
         "direct-singularity-diagonal": (Kind.NUMBER, "mm", {"l_a"}),
         "zero-force-pose": (Kind.POSE, "mm", {"ddp1", "ddp2", "tol"}),
         "tune-ctc": (Kind.GAINS, "Hz", {"force_limit", "mass_error"}),

@@ -30,7 +30,7 @@ import numpy as np
 from tpm_viz.app.exercises.answers import Answer, FormatError, read_answer
 from tpm_viz.app.exercises.gains import reference as gains_reference
 from tpm_viz.app.exercises.gains import verdict
-from tpm_viz.app.exercises.model import Draw, Exercise, FileText, Grade, Kind, Texts, Variant, shown_unit
+from tpm_viz.app.exercises.model import SIGNED, Draw, Exercise, FileText, Grade, Kind, Texts, Variant, shown_unit
 from tpm_viz.app.exercises.registry import shows, task_of
 from tpm_viz.app.exercises.registry import usable as usable_for
 from tpm_viz.app.exercises.tasks import (
@@ -114,7 +114,7 @@ def shown_values(exercise: Exercise, variant: Variant) -> dict[str, str]:
         scale = shown_unit(name)[1]
         shown = value * scale
         decimals = draws[name].decimals if name in draws else _decimals(shown)
-        out[name] = fixed(shown, f".{decimals}f")
+        out[name] = fixed(shown, f"{'+' if name in SIGNED else ''}.{decimals}f")
     for name, compute in shows(task_of(exercise)).items():
         out[name] = compute(variant)
     return out

@@ -21,6 +21,7 @@ from tpm_viz.words import Lang, Phrase
 __all__ = [
     "INPUTS",
     "MAX_ANSWER",
+    "SIGNED",
     "AttemptRule",
     "Draw",
     "Exercise",
@@ -52,7 +53,9 @@ INPUTS: dict[str, tuple[str, float]] = {
 """The inputs a variant may draw besides the parameters: name -> (unit shown in a prompt, SI -> shown scale).
 Platform position ``p`` [m], platform acceleration ``p̈`` [m/s²] (``ṗ = 0`` wherever it is drawn), a force
 tolerance ``tol`` [N], the actuator ``force_limit`` [N], the controller's relative ``mass_error`` [-] on ``m_a``,
-``m_b``, ``m_p`` (shown in %), path durations ``t1``, ``t2`` [s]."""
+``m_b``, ``m_p`` (shown in %, with its sign), path durations ``t1``, ``t2`` [s]."""
+SIGNED = frozenset({"mass_error"})
+"""Inputs a prompt shows with their sign (``+20``: the model is heavier than the mechanism)."""
 
 
 def shown_unit(name: str) -> tuple[str, float]:
