@@ -12,7 +12,7 @@ The plant is the paper's closed form (:func:`tpm_viz.paper.plant.closed_form_pla
 :func:`tpm_viz.paper.tracking.track`), not Pinocchio: the app layer may not import it, and the two plants agree to
 ~1e-12 in acceleration and ~1e-9 over a run, so the verdicts agree except within that distance of the boundary
 (``tests/app/test_exercise_gains.py`` runs the lab's own Pinocchio simulation on the same variants and gains). One
-verdict is ~25-60 ms of pure Python; grading with the rad/s mistake takes two.
+verdict is 22-44 ms of pure Python (``benchmarks/bench_exercises.py``); a wrong answer takes two (the rad/s mistake).
 
 The reference (what ``--reveal`` shows) is ``ζ = 1`` and the geometric middle of the passing ``ω_n`` among
 :data:`GRID` (rounded to 1 Hz); :func:`just_outside` is the grid value just below the passing ones (too soft: the

@@ -30,7 +30,18 @@ import numpy as np
 from tpm_viz.app.exercises.answers import Answer, FormatError, read_answer
 from tpm_viz.app.exercises.gains import reference as gains_reference
 from tpm_viz.app.exercises.gains import verdict
-from tpm_viz.app.exercises.model import SIGNED, Draw, Exercise, FileText, Grade, Kind, Texts, Variant, shown_unit
+from tpm_viz.app.exercises.model import (
+    SIGNED,
+    Draw,
+    Exercise,
+    FileText,
+    Grade,
+    Kind,
+    Texts,
+    Variant,
+    decimals_of,
+    shown_unit,
+)
 from tpm_viz.app.exercises.registry import shows, task_of
 from tpm_viz.app.exercises.registry import usable as usable_for
 from tpm_viz.app.exercises.tasks import (
@@ -97,14 +108,6 @@ def tolerance(exercise: Exercise, variant: Variant) -> tuple[float, float]:
     return exercise.rtol, atol
 
 
-def _decimals(value: float) -> int:
-    """The fewest decimals (at most 6) that show ``value`` as it is."""
-    for n in range(7):
-        if abs(round(value, n) - value) <= 1e-9 * max(1.0, abs(value)):
-            return n
-    return 6
-
-
 def shown_values(exercise: Exercise, variant: Variant) -> dict[str, str]:
     """Every placeholder a prompt or a feedback line of ``exercise`` may use, as text: the parameters and the
     drawn inputs in the units a prompt shows (mm, kg, m/s², N, %, s) and the computation's shown values."""
@@ -113,7 +116,7 @@ def shown_values(exercise: Exercise, variant: Variant) -> dict[str, str]:
     for name, value in variant.values().items():
         scale = shown_unit(name)[1]
         shown = value * scale
-        decimals = draws[name].decimals if name in draws else _decimals(shown)
+        decimals = draws[name].decimals if name in draws else decimals_of(shown)
         out[name] = fixed(shown, f"{'+' if name in SIGNED else ''}.{decimals}f")
     for name, compute in shows(task_of(exercise)).items():
         out[name] = compute(variant)
@@ -128,7 +131,6 @@ def prompt(exercise: Exercise, variant: Variant) -> FileText:
 def reference(exercise: Exercise, variant: Variant) -> tuple[float, ...] | str:
     """The reference answer in the exercise's unit: ``(x,)``; a pose ``(p1, p2)`` in mm that passes; gains
     ``(ω_n [Hz], ζ)``; a choice's option key. :class:`InputError` if the computation finds none."""
-    task = task_of(exercise)
     if exercise.kind is Kind.NUMBER:
         return (to_unit(NUMBER_TASKS[exercise.answer].value(variant), exercise.unit, _quantity(exercise)),)
     if exercise.kind is Kind.POSE:
@@ -141,7 +143,6 @@ def reference(exercise: Exercise, variant: Variant) -> tuple[float, ...] | str:
         if gains is None:
             raise InputError(Phrase("exercise {id}: no gains pass for this variant", id=exercise.id))
         return gains
-    assert task is CHOICE_TASKS[exercise.answer]
     return CHOICE_TASKS[exercise.answer].value(variant)
 
 

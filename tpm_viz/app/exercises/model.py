@@ -33,6 +33,7 @@ __all__ = [
     "Result",
     "Texts",
     "Variant",
+    "decimals_of",
     "shown_unit",
 ]
 
@@ -56,6 +57,14 @@ tolerance ``tol`` [N], the actuator ``force_limit`` [N], the controller's relati
 ``m_b``, ``m_p`` (shown in %, with its sign), path durations ``t1``, ``t2`` [s]."""
 SIGNED = frozenset({"mass_error"})
 """Inputs a prompt shows with their sign (``+20``: the model is heavier than the mechanism)."""
+
+
+def decimals_of(value: float) -> int:
+    """The fewest decimals (at most 6) that show ``value`` as it is (``0.5`` -> 1, ``260.0`` -> 0)."""
+    for n in range(7):
+        if abs(round(value, n) - value) <= 1e-9 * max(1.0, abs(value)):
+            return n
+    return 6
 
 
 def shown_unit(name: str) -> tuple[str, float]:

@@ -19,7 +19,18 @@ import re
 import string
 
 from tpm_viz.app.exercises.lines import key_lines
-from tpm_viz.app.exercises.model import INPUTS, AttemptRule, Draw, Exercise, Kind, Mistake, Option, Texts, shown_unit
+from tpm_viz.app.exercises.model import (
+    INPUTS,
+    AttemptRule,
+    Draw,
+    Exercise,
+    Kind,
+    Mistake,
+    Option,
+    Texts,
+    decimals_of,
+    shown_unit,
+)
 from tpm_viz.app.exercises.registry import TASKS, shows
 from tpm_viz.app.exercises.tasks import CHOICE_TASKS, NumberTask
 from tpm_viz.app.lesson_toml import LessonError
@@ -107,13 +118,6 @@ def _number(t: _Table, value: object, lo: float, hi: float, *where: object) -> f
     return float(value)
 
 
-def _decimals(value: float) -> int:
-    for n in range(7):
-        if abs(round(value, n) - value) <= 1e-9 * max(1.0, abs(value)):
-            return n
-    return 6
-
-
 def _draw(t: _Table, name: str, spec: object, base: Params) -> Draw:
     if name not in PARAM_INFO and name not in INPUTS:
         known = ", ".join([*PARAM_INFO, *INPUTS])
@@ -142,11 +146,11 @@ def _draw(t: _Table, name: str, spec: object, base: Params) -> Draw:
                 Phrase("draw.{name}: min <= max and at most {most} steps", name=name, most=MAX_GRID), "draw", name
             )
         values = tuple(float(f"{lo + k * step:.12g}") for k in range(count))
-        decimals = max(_decimals(lo * scale), _decimals(step * scale))
+        decimals = max(decimals_of(lo * scale), decimals_of(step * scale))
         return _checked(t, Draw(name, values, decimals), base)
     else:
         values = (_number(t, spec, -1e6, 1e6, "draw", name),)
-    return _checked(t, Draw(name, values, max(_decimals(v * scale) for v in values)), base)
+    return _checked(t, Draw(name, values, max(decimals_of(v * scale) for v in values)), base)
 
 
 def _checked(t: _Table, draw: Draw, base: Params) -> Draw:
