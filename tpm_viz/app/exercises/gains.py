@@ -10,8 +10,9 @@ limit (no sample saturates).
 
 The plant is the paper's closed form (:func:`tpm_viz.paper.plant.closed_form_plant`, stepped by
 :func:`tpm_viz.paper.tracking.track`), not Pinocchio: the app layer may not import it, and the two plants agree to
-~1e-12 in acceleration and ~1e-9 over a run, so the verdicts agree except within that distance of the boundary
-(``tests/app/test_exercise_gains.py`` runs the lab's own Pinocchio simulation on the same variants and gains). One
+round-off in acceleration and within 1e-9 m over a run (``tests/paper/test_plant.py``), so the verdicts agree
+except within that distance of the boundary (``tests/app/test_exercise_references.py`` runs the lab's own
+Pinocchio simulation on the same variants and gains). One
 verdict is 22-44 ms of pure Python (``benchmarks/bench_exercises.py``); a wrong answer takes two (the rad/s mistake).
 
 The reference (what ``--reveal`` shows) is ``ζ = 1`` and the geometric middle of the passing ``ω_n`` among
