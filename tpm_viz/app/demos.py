@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tpm_viz.app.exercises.model import Exercise
 from tpm_viz.app.moves import Pose
 from tpm_viz.app.runs import Source
 from tpm_viz.core.errors import InputError
@@ -106,6 +107,7 @@ class Demo:
     texts: tuple[tuple[str, str], ...] = ()  # (language, text) for the languages other than English
     checks: tuple[Check, ...] = ()
     source: str = ""  # the file the lesson was read from
+    exercises: tuple[Exercise, ...] = ()  # its [[exercise]] tables (tpm_viz.app.exercises)
 
     def text_in(self, language: str) -> str:
         """The paragraph in ``language`` if the lesson has it, else in English."""

@@ -21,6 +21,7 @@ import re
 import numpy as np
 
 from tpm_viz.app.demos import CHECK_NAMES, LANGUAGES, Camera, Check, Demo, Motion, demo_params, demo_pose, demo_source
+from tpm_viz.app.exercises.reader import key_lines, read_exercises
 from tpm_viz.app.lesson_toml import MAX_FILE_BYTES, LessonError, Problem, Reader, line_of, parse
 from tpm_viz.app.moves import check, why_not
 from tpm_viz.app.overlays import MAP_KINDS
@@ -35,7 +36,7 @@ from tpm_viz.paper.trajectories import parse_trajectory_csv
 __all__ = ["MAX_FILE_BYTES", "LessonError", "assets_dir", "load_lesson", "load_lessons", "load_preset"]
 
 MOTION_KINDS = ("line", "circle", "segment", "csv")
-TOP_KEYS = ("key", "title", "text", "params", "pose", "motion", "camera", "view", "checks")
+TOP_KEYS = ("key", "title", "text", "params", "pose", "motion", "camera", "view", "checks", "exercise")
 CHECK_SAMPLES = 101
 """Samples at which a lesson's motion is checked when it is loaded."""
 
@@ -218,6 +219,7 @@ def load_lesson(path: str | os.PathLike[str], root: str | os.PathLike[str] | Non
         texts=tuple((lang, t) for lang, t in paragraphs.items() if lang != "en"),
         checks=_checks(r),
         source=str(path),
+        exercises=read_exercises(text, data, key, params, str(path)),
         **pose,
     )
     _check_scene(r, demo)
@@ -267,6 +269,7 @@ def load_lessons(directory: str | os.PathLike[str]) -> tuple[tuple[Demo, ...], t
         try:
             demo = load_lesson(path, root)
             for other in lessons:
+                _same_exercise(path, root, other, demo)
                 for what in ("key", "title"):
                     if getattr(other, what) == getattr(demo, what):
                         line = line_of(parse(path, root)[0], "", what)
@@ -284,6 +287,17 @@ def load_lessons(directory: str | os.PathLike[str]) -> tuple[tuple[Demo, ...], t
             continue
         lessons.append(demo)
     return tuple(lessons), tuple(problems)
+
+
+def _same_exercise(path: pathlib.Path, root: pathlib.Path, other: Demo, demo: Demo) -> None:
+    """Refuse an exercise id that an earlier lesson file already uses (ids are unique in a folder)."""
+    used = {e.id for e in other.exercises}
+    for index, exercise in enumerate(demo.exercises):
+        if exercise.id in used:
+            line = key_lines(parse(path, root)[0]).get(("exercise", index, "id"), 1)
+            raise LessonError(
+                Phrase("exercise id {id} is already used by {other}", id=repr(exercise.id), other=other.source), line
+            )
 
 
 def load_preset(path: str | os.PathLike[str]) -> Params:

@@ -15,9 +15,10 @@ and ``,`` or with several commas (``1,234.5``, ``1.234,5``, ``1,000,000``: thous
 write ``1234.5``), NaN and infinities, numbers too large for a float (``1e999``), and texts longer than
 :data:`MAX_TEXT` characters. Messages quote at most :data:`QUOTE` characters of what was typed.
 
-:data:`UNITS` and :func:`unit_factor` convert the units people write (``mm``, ``ms``, ``mm/s^2``, ``kN``, ``deg``)
-to SI; :func:`plausibility` (:func:`plausibility_note`: as text) flags results far beyond the usual size (a hint at
-an input in the wrong unit).
+:data:`UNITS` and :func:`unit_factor` convert the units people write (``mm``, ``ms``, ``mm/s^2``, ``kN``, ``deg``,
+``Hz``) to SI; :func:`parse_quantity` reads a number with any unit of the field's quantity (``0.15 m`` in a field in
+mm is 150, ``0.2 kN`` in a field in N is 200, ``30°`` in a field in rad is π/6); :func:`plausibility`
+(:func:`plausibility_note`: as text) flags results far beyond the usual size (a hint at an input in the wrong unit).
 
 Numbers as people read them: :func:`fixed` is the one formatter of a shown number (a dash for None, NaN or
 infinity; never ``-0.0``: a value that rounds to zero is written as zero, whatever its sign).
@@ -40,6 +41,7 @@ __all__ = [
     "UNITS",
     "fixed",
     "parse_number",
+    "parse_quantity",
     "plausibility",
     "plausibility_note",
     "shorten",
@@ -68,10 +70,21 @@ UNITS: dict[str, tuple[str, float, float]] = {
     "rad": ("angle", 1.0, 1.0),
     "deg": ("angle", math.pi, 180.0),
     "°": ("angle", math.pi, 180.0),
+    "hz": ("frequency", 1.0, 1.0),
+    "rad/s": ("frequency", 1.0, 2.0 * math.pi),
 }
 """Units people write (e.g. in a CSV header) -> (quantity, multiplier, divisor): SI value = value * mul / div.
-Case is ignored, ``µm``/``μm`` is ``um``, ``s²``/``s2`` is ``s^2``."""
-_SI = {"length": "m", "time": "s", "velocity": "m/s", "acceleration": "m/s^2", "force": "N", "angle": "rad"}
+Case is ignored, ``µm``/``μm`` is ``um``, ``s²``/``s2`` is ``s^2``. A frequency is in Hz; ``rad/s`` is an angular
+frequency, ``ω = 2π f`` (a natural frequency ``ω_n`` typed in rad/s)."""
+_SI = {
+    "length": "m",
+    "time": "s",
+    "velocity": "m/s",
+    "acceleration": "m/s^2",
+    "force": "N",
+    "angle": "rad",
+    "frequency": "Hz",
+}
 _QUANTITY = {
     "length": T("length"),
     "time": T("time"),
@@ -79,14 +92,18 @@ _QUANTITY = {
     "acceleration": T("acceleration"),
     "force": T("force"),
     "angle": T("angle"),
+    "frequency": T("frequency"),
 }
 """The quantities of :data:`UNITS` as words (messages)."""
-_ALT = {"m": "mm", "s": "ms", "m/s": "mm/s", "m/s^2": "mm/s^2", "N": "kN", "rad": "deg"}
+_ALT = {"m": "mm", "s": "ms", "m/s": "mm/s", "m/s^2": "mm/s^2", "N": "kN", "rad": "deg", "Hz": "rad/s"}
 """A second unit a refusal suggests besides the SI one, by SI unit."""
 _MINUS = str.maketrans({"\u2212": "-", "\uff0d": "-", "\ufe63": "-"})
 _SPACES = "\u0020\u00a0\u202f\u2009\u2007"
 _GROUPED = re.compile(rf"[+-]?\d{{1,3}}(?:[{_SPACES}]\d{{3}})+(?:[.,]\d*)?(?:[eE][+-]?\d+)?")
 _NUMBERISH = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+_WITH_UNIT = re.compile(r"(.*[0-9.,])\s*([^0-9\s.,+\-\u2212\uff0d][^\s]*)", re.S)
+"""A number followed by a unit: the longest head that ends in a digit or a separator, then a unit that starts with
+anything but a digit, a space, a separator or a sign (``1e3mm``: ``1e3`` and ``mm``; ``30°``; ``5 m/s^2``)."""
 
 
 DASH = "—"
@@ -199,6 +216,42 @@ def parse_number(text: object, name: str | Phrase = "value", unit: str = "") -> 
     return value
 
 
+def parse_quantity(text: object, name: str | Phrase = "value", unit: str = "") -> float:
+    """The number ``text`` spells, in the field's ``unit``, with any unit of the same quantity after it (the rules
+    of :func:`parse_number`; :data:`UNITS` for the units): in a field in mm, ``150``, ``150 mm``, ``15 cm`` and
+    ``0.15 m`` are all 150; in a field in N, ``0,2 kN`` is 200; in a field in Hz, ``62.83 rad/s`` is 10. A unit of
+    another quantity, an unknown unit, or any unit in a field without one (``unit`` ""), is a one-line
+    :class:`~tpm_viz.core.errors.InputError` naming the field (``name [unit]``) and the units that fit."""
+    try:
+        return parse_number(text, name, unit)
+    except InputError as exc:
+        found = _WITH_UNIT.fullmatch(text.strip()) if isinstance(text, str) and len(text) <= MAX_TEXT else None
+        if found is None or not any(ch.isdigit() for ch in found.group(1)):
+            raise exc from None
+    head, typed = found.groups()
+    label = _label(name, unit)
+    if not unit:
+        raise InputError(
+            Phrase("{label}: {unit} does not fit: type the number alone", label=label, unit=shorten(typed))
+        ) from None
+    field = _entry(unit)
+    if field is None:  # the field's own unit is not in UNITS: only that unit is understood
+        raise InputError(
+            Phrase("{label} has an unknown unit {unit} (use {si})", label=label, unit=shorten(typed), si=unit)
+        )
+    mul, div = unit_factor(typed, field[0], label, str(name))
+    value = parse_number(head, name, unit) * mul / div * field[2] / field[1]
+    if not math.isfinite(value):
+        raise InputError(Phrase("{label}: {text} is too large (beyond ±1.8e308)", label=label, text=shorten(text)))
+    return value
+
+
+def _entry(unit: str) -> tuple[str, float, float] | None:
+    """The :data:`UNITS` entry of ``unit`` as people write it (case, ``µ``, ``²``), or None."""
+    key = unit.lower().replace(" ", "").replace("µ", "u").replace("μ", "u").replace("²", "^2")
+    return UNITS.get(key[:-1] + "^2" if key.endswith("/s2") else key)
+
+
 def plausibility(
     value: float, name: str, unit: str = "", typical: float | None = None, factor: float = 1000.0
 ) -> Phrase | None:
@@ -237,8 +290,7 @@ def unit_factor(unit: str, quantity: str | None, label: str | Phrase, name: str)
     """
     if not unit:
         return 1.0, 1.0
-    key = unit.lower().replace(" ", "").replace("µ", "u").replace("μ", "u").replace("²", "^2")
-    entry = UNITS.get(key[:-1] + "^2" if key.endswith("/s2") else key)
+    entry = _entry(unit)
     si = _SI.get(quantity or "", "")
     if entry is None:
         if not si:
