@@ -17,7 +17,8 @@ tpm-viz needs these things viser's public API does not offer:
 - a tab's camera pointed in one step (:func:`point_camera`: viser's two setters compute its orientation twice and
   ask ``np.allclose`` four times, a tenth of a reconnect storm's CPU);
 - a tab's handshake headers (:func:`client_request`), a tab's label (:func:`relabel_tab`: viser's ``GuiTabHandle`` has
-  no setter) and whether a handle was removed with its container (:func:`removed`), for :mod:`tpm_viz.ui.worded`.
+  no setter) and whether a handle was removed with its container (:func:`removed`), for :mod:`tpm_viz.ui.worded`;
+- the id by which viser's page names a tab's button (:func:`tab_id`), for a style sheet of :mod:`tpm_viz.ui.panels`.
 
 :func:`check_viser` runs when the server is built: the installed viser must be the tested minor version
 (:data:`TESTED`, pinned in ``pyproject.toml``) and every internal above must exist, else the app stops at start with
@@ -27,6 +28,7 @@ one line saying what to install, instead of serving blank pages. ``tests/viserki
 from __future__ import annotations
 
 import asyncio
+import dataclasses
 import time
 import uuid
 from collections.abc import Callable
@@ -56,7 +58,8 @@ __all__ = [
     "check_viser",
 ]
 __all__ += ["client_request", "connection_request", "disable_share_url", "drop_gizmo_echo", "enable_share_url"]
-__all__ += ["point_camera", "relabel_tab", "removed", "thread_pool", "widget_uuid", "widget_value", "ws_server"]
+__all__ += ["point_camera", "relabel_tab", "removed", "tab_id", "thread_pool", "widget_uuid", "widget_value"]
+__all__ += ["ws_server"]
 
 TESTED = "1.1"
 """The viser minor version tpm-viz is tested with (``pyproject.toml`` pins ``viser>=1.1.1,<1.2``)."""
@@ -76,6 +79,7 @@ _WEBSOCK_ATTRS += ("_client_connect_cb", "_client_disconnect_cb")
 _GUI_METHODS = ("_handle_gui_updates", "_handle_file_transfer_start", "_handle_file_transfer_part")
 _MESSAGES: tuple[str, ...] = ("GuiUpdateMessage", "FileTransferStartUpload", "FileTransferPart")
 _MESSAGES += ("SetCameraPositionMessage", "SetCameraLookAtMessage")
+_TAB_FIELDS = ("_id", "_label", "_parent")  # tab_id, relabel_tab
 
 
 class IncompatibleViserError(TpmVizError):
@@ -109,6 +113,12 @@ def check_viser(version: str | None = None, websockets_version: str | None = Non
     missing += [] if hasattr(AsyncMessageBuffer, "_window_loop") else ["AsyncMessageBuffer._window_loop"]
     missing += casts.missing()
     missing += [] if hasattr(viser.CameraHandle, "_update_wxyz") else ["CameraHandle._update_wxyz"]
+    tab_fields = (
+        {f.name for f in dataclasses.fields(viser.GuiTabHandle)}
+        if dataclasses.is_dataclass(viser.GuiTabHandle)
+        else set()
+    )
+    missing += [f"GuiTabHandle.{f}" for f in _TAB_FIELDS if f not in tab_fields]
     if not hasattr(ws_server, "ServerProtocol"):
         missing.append("websockets.asyncio.server.ServerProtocol")
     if missing:
@@ -138,6 +148,16 @@ def widget_value(handle: Any) -> Any:
 def widget_uuid(handle: Any) -> str:
     """The uuid of a GUI handle (its ``label for=`` in the page: :mod:`.login` masks the token field by it)."""
     return str(handle._impl.uuid)
+
+
+def tab_id(tab: Any) -> str | None:
+    """The id of a tab of a tab group or panel (a ``viser.GuiTabHandle``, or an object that holds one as ``handle``:
+    :class:`tpm_viz.ui.worded.Tab`), which viser's page names the tab's button by (``data-dock-tab="<id>"`` on a
+    wide screen, ``id="…-tab-<id>"`` on a phone's tab strip); None for anything else (viser's public API has no name
+    for it)."""
+    handle = tab if isinstance(tab, viser.GuiTabHandle) else getattr(tab, "handle", None)
+    uuid = handle._id if isinstance(handle, viser.GuiTabHandle) else None
+    return uuid if isinstance(uuid, str) else None
 
 
 def drop_gizmo_echo(gizmo: Any) -> None:
