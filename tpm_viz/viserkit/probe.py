@@ -24,7 +24,8 @@ from viser.infra import _infra
 from viser.infra._async_message_buffer import AsyncMessageBuffer
 
 from tpm_viz.viserkit import patches, wire
-from tpm_viz.viserkit.core import ServerDoor, thread_pool, widget_uuid, widget_value
+from tpm_viz.viserkit.core import thread_pool, widget_uuid, widget_value
+from tpm_viz.viserkit.doors import ServerDoor
 
 __all__ = ["VISER_SERIALIZE", "VISER_WINDOW_LOOP", "align", "arrive", "connection_states", "lean_buffer"]
 __all__ += ["message_buffer", "messages", "shared_serialize", "tunnel_class", "upload_states", "widget_uuid"]
