@@ -14,5 +14,6 @@
 - :mod:`.probe`: small public functions for tests and benchmarks (a widget's uuid, a tab's uploads, ...);
 - :mod:`.page`: tpm-viz's own script in viser's page.
 
-See ``PATCHES.md`` beside this file for each patch, why it is there and the test that shows it.
+See ``PATCHES.md`` beside this file for each patch, why it is there, the test that shows it and the condition that
+retires it; ``upstream/`` holds the issue each would file at viser, with a script that shows it on viser alone.
 """
