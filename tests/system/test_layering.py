@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import ast
 import functools
+import importlib.util
 import pathlib
 import re
 import subprocess
@@ -191,6 +192,73 @@ def test_tests_and_benchmarks_use_no_private_viser_name():
     paths = [p for d in ("tests", "benchmarks") for p in sorted((root / d).rglob("*.py"))]
     users = [str(p.relative_to(root)) for p in paths if PRIVATE_VISER.search(p.read_text())]
     assert paths and users == [], users
+
+
+def _outside_the_adapter() -> list[pathlib.Path]:
+    """The Python files that must reach viser through the adapter: the package outside ``viserkit/``, the tests, the
+    benchmarks and the examples."""
+    root = PACKAGE.parent
+    package = [p for m, p in MODULES.items() if not m.startswith("tpm_viz.viserkit")]
+    others = [p for d in ("tests", "benchmarks", "examples") for p in sorted((root / d).rglob("*.py"))]
+    return package + others + [p for p in (root / "app.py",) if p.is_file()]
+
+
+PRIVATE_BY_NAME = re.compile(r"(?<![\w.])(?:getattr|hasattr|setattr|delattr)\(\s*[^,]+,\s*[\"']_(?!_)")
+"""A private attribute reached by its name as a string (the built-in functions; ``monkeypatch.setattr`` on tpm-viz's
+own modules is a test's business and not matched)."""
+
+
+def test_no_private_name_is_reached_by_string_outside_the_adapter():
+    """The trick that hides a private read from the name check above: ``getattr`` (or ``hasattr``, ``setattr``,
+    ``delattr``) with a literal name that starts with one underscore. Inside ``viserkit/`` it is the adapter's job."""
+    root = PACKAGE.parent
+    found = [
+        f"{p.relative_to(root)}:{n}: {line.strip()}"
+        for p in _outside_the_adapter()
+        for n, line in enumerate(p.read_text().splitlines(), 1)
+        if PRIVATE_BY_NAME.search(line)
+    ]
+    assert found == []
+
+
+def _defined_private_names(text: str) -> set[str]:
+    """Private names a file defines: ``self._x =``, ``_x =`` or ``_x:`` at a line's start, ``def _x``, ``class _X``."""
+    found = set(re.findall(r"\b(?:self|cls)\.(_[a-z]\w*)\s*(?::[^=\n]+)?=", text))
+    found |= set(re.findall(r"^\s*(_[A-Za-z]\w*)\s*[:=]", text, re.MULTILINE))
+    found |= set(re.findall(r"^\s*(?:async\s+)?(?:def|class)\s+(_[A-Za-z]\w*)", text, re.MULTILINE))
+    return found
+
+
+@functools.cache
+def _viser_only_private_names() -> frozenset[str]:
+    """The private attribute names viser's own source defines that no file of tpm-viz outside the adapter defines too
+    (a ``._x`` of such a name outside the adapter can only be viser's)."""
+    spec = importlib.util.find_spec("viser")
+    assert spec is not None and spec.submodule_search_locations, "viser is not installed"
+    viser_root = pathlib.Path(next(iter(spec.submodule_search_locations)))
+    viser_names: set[str] = set()
+    for path in viser_root.rglob("*.py"):
+        viser_names |= _defined_private_names(path.read_text(encoding="utf-8"))
+    own: set[str] = set()
+    for path in _outside_the_adapter():
+        own |= _defined_private_names(path.read_text())
+    return frozenset(viser_names - own)
+
+
+def test_no_private_attribute_of_viser_is_read_outside_the_adapter():
+    """Any attribute read outside the adapter whose private name only viser defines (an image node's encoded bytes, a
+    recorder's time): :data:`PRIVATE_VISER` lists the ones the adapter uses, this catches the next one
+    (:mod:`tpm_viz.viserkit.probe` has public functions for tests, :mod:`tpm_viz.viserkit.core` for the app)."""
+    root, names = PACKAGE.parent, _viser_only_private_names()
+    assert len(names) > 50, "viser's source was not read"
+    found = [
+        f"{p.relative_to(root)}:{n}: .{m.group(1)}"
+        for p in _outside_the_adapter()
+        for n, line in enumerate(p.read_text().splitlines(), 1)
+        for m in re.finditer(r"\.(_[a-z]\w*)\b", line)
+        if m.group(1) in names
+    ]
+    assert found == []
 
 
 def test_the_door_to_viser_refuses_an_untested_version_loudly():

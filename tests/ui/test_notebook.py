@@ -15,6 +15,7 @@ import pytest
 from tpm_viz import InputError, Params
 from tpm_viz.app.runs import Source, build_run
 from tpm_viz.ui.notebook import MAX_FRAMES, Embed
+from tpm_viz.viserkit.probe import recorded_seconds
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
@@ -45,7 +46,7 @@ def test_a_long_run_is_capped_in_frames():
     with Embed() as embed:
         run = build_run(Params.paper(), Source.paper("line", 100.0))
         serializer = embed.record(run, fps=30.0)
-        assert serializer._time == pytest.approx(run.duration * MAX_FRAMES / (MAX_FRAMES - 1))
+        assert recorded_seconds(serializer) == pytest.approx(run.duration * MAX_FRAMES / (MAX_FRAMES - 1))
 
 
 def test_the_notebook_module_is_imported_by_nothing_else_and_importing_the_library_loads_no_ipython():

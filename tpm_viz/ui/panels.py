@@ -34,7 +34,7 @@ from tpm_viz.core.words import Lang
 from tpm_viz.ui.fields import Note, TypedBox
 from tpm_viz.ui.widgets.typed import QUIET, Quantity, TypedField, TypedGroup, force_note
 from tpm_viz.ui.worded import TabGui, Tabs, Worded
-from tpm_viz.viserkit.core import widget_uuid
+from tpm_viz.viserkit.core import tab_id, widget_uuid
 
 __all__ = ["ACTUATOR_HINT", "ACTUATOR_LABELS", "GROUPS", "GUIDE_HTML", "PARAM_LABELS", "Panel", "slider_css"]
 
@@ -166,8 +166,8 @@ FOLDED = (
 
 def _tab_selector(tab) -> str:
     """A CSS selector of a tab's button, on a wide screen (viser's dock tab) and on a phone (a Mantine tab)."""
-    uuid = getattr(tab, "_id", None)
-    return f':is([data-dock-tab="{uuid}"], [id$="-tab-{uuid}"])' if isinstance(uuid, str) else ""
+    uuid = tab_id(tab)
+    return f':is([data-dock-tab="{uuid}"], [id$="-tab-{uuid}"])' if uuid is not None else ""
 
 
 def fold_css(explore, shown) -> str:

@@ -18,7 +18,8 @@ import viser
 
 from tpm_viz.classroom.guard import guard_executor, log_fault
 from tpm_viz.viserkit import patches
-from tpm_viz.viserkit.core import ServerDoor, check_viser, disable_share_url, enable_share_url, thread_pool
+from tpm_viz.viserkit.core import check_viser, disable_share_url, enable_share_url, thread_pool
+from tpm_viz.viserkit.doors import ServerDoor
 from tpm_viz.viserkit.limits import Limits, ServerGuard, harden_server
 from tpm_viz.viserkit.wire import Handshake
 

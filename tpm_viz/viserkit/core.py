@@ -6,30 +6,31 @@ tpm-viz needs these things viser's public API does not offer:
 - the server's callback thread pool (``server._thread_executor``), to guard every callback (:mod:`.guard`);
 - a tab's message handlers (``client._websock_connection``, ``gui._handle_gui_updates``,
   ``gui._handle_file_transfer_start/part``, ``gui._current_file_upload_states``, ``gui._gui_input_handle_from_uuid``),
-  to drop malformed GUI updates and oversized uploads before viser handles them and hide its toasts (:mod:`.transport`);
+  to drop malformed GUI updates and oversized uploads before viser handles them and hide its toasts (:mod:`.transport`,
+  through :class:`~.doors.ClientDoor`);
 - a GUI handle's current value without running its callbacks (``handle._impl.value``);
 - a client-scoped gizmo's cross-client echo (``gizmo._impl_aux.sync_cb``), which costs CPU and reaches nobody;
 - the share-URL tunnel, which any client can request: ``server.request_share_url`` is replaced by a no-op;
-- the websocket server under viser (:class:`ServerDoor`, for :mod:`.limits` and :mod:`.adapter`): each connection's
-  message dispatch (``_handle_incoming_message``, wrapped to drop malformed messages), its message buffers (the
-  shared one and each tab's: :mod:`.patches` puts the senders' patches on them), its outgoing backlog
+- the websocket server under viser (:class:`~.doors.ServerDoor`, for :mod:`.limits` and :mod:`.adapter`): each
+  connection's message dispatch (``_handle_incoming_message``, wrapped to drop malformed messages), its message
+  buffers (the shared one and each tab's: :mod:`.patches` puts the senders' patches on them), its outgoing backlog
   (``_client_state_from_id``), the raw connections (``_live_connections``, to refuse or drop a tab);
 - a tab's camera pointed in one step (:func:`point_camera`: viser's two setters compute its orientation twice and
   ask ``np.allclose`` four times, a tenth of a reconnect storm's CPU);
 - a tab's handshake headers (:func:`client_request`), a tab's label (:func:`relabel_tab`: viser's ``GuiTabHandle`` has
-  no setter) and whether a handle was removed with its container (:func:`removed`), for :mod:`tpm_viz.ui.worded`.
+  no setter) and whether a handle was removed with its container (:func:`removed`), for :mod:`tpm_viz.ui.worded`;
+- the id by which viser's page names a tab's button (:func:`tab_id`), for a style sheet of :mod:`tpm_viz.ui.panels`.
 
 :func:`check_viser` runs when the server is built: the installed viser must be the tested minor version
 (:data:`TESTED`, pinned in ``pyproject.toml``) and every internal above must exist, else the app stops at start with
 one line saying what to install, instead of serving blank pages. ``tests/viserkit/`` shows what each patch is for.
+The two doors live in :mod:`.doors` (re-exported here).
 """
 
 from __future__ import annotations
 
-import asyncio
+import dataclasses
 import time
-import uuid
-from collections.abc import Callable
 from typing import Any, cast
 
 import numpy as np
@@ -41,6 +42,7 @@ from viser.infra._async_message_buffer import AsyncMessageBuffer
 
 from tpm_viz.core.errors import TpmVizError
 from tpm_viz.viserkit import casts, wire
+from tpm_viz.viserkit.doors import ClientDoor, ServerDoor
 from tpm_viz.viserkit.patches import skipped
 from tpm_viz.viserkit.wire import Malformed
 
@@ -56,7 +58,8 @@ __all__ = [
     "check_viser",
 ]
 __all__ += ["client_request", "connection_request", "disable_share_url", "drop_gizmo_echo", "enable_share_url"]
-__all__ += ["point_camera", "relabel_tab", "removed", "thread_pool", "widget_uuid", "widget_value", "ws_server"]
+__all__ += ["point_camera", "relabel_tab", "removed", "tab_id", "thread_pool", "widget_uuid", "widget_value"]
+__all__ += ["ws_server"]
 
 TESTED = "1.1"
 """The viser minor version tpm-viz is tested with (``pyproject.toml`` pins ``viser>=1.1.1,<1.2``)."""
@@ -76,6 +79,7 @@ _WEBSOCK_ATTRS += ("_client_connect_cb", "_client_disconnect_cb")
 _GUI_METHODS = ("_handle_gui_updates", "_handle_file_transfer_start", "_handle_file_transfer_part")
 _MESSAGES: tuple[str, ...] = ("GuiUpdateMessage", "FileTransferStartUpload", "FileTransferPart")
 _MESSAGES += ("SetCameraPositionMessage", "SetCameraLookAtMessage")
+_TAB_FIELDS = ("_id", "_label", "_parent")  # tab_id, relabel_tab
 
 
 class IncompatibleViserError(TpmVizError):
@@ -109,6 +113,12 @@ def check_viser(version: str | None = None, websockets_version: str | None = Non
     missing += [] if hasattr(AsyncMessageBuffer, "_window_loop") else ["AsyncMessageBuffer._window_loop"]
     missing += casts.missing()
     missing += [] if hasattr(viser.CameraHandle, "_update_wxyz") else ["CameraHandle._update_wxyz"]
+    tab_fields = (
+        {f.name for f in dataclasses.fields(viser.GuiTabHandle)}
+        if dataclasses.is_dataclass(viser.GuiTabHandle)
+        else set()
+    )
+    missing += [f"GuiTabHandle.{f}" for f in _TAB_FIELDS if f not in tab_fields]
     if not hasattr(ws_server, "ServerProtocol"):
         missing.append("websockets.asyncio.server.ServerProtocol")
     if missing:
@@ -140,6 +150,16 @@ def widget_uuid(handle: Any) -> str:
     return str(handle._impl.uuid)
 
 
+def tab_id(tab: Any) -> str | None:
+    """The id of a tab of a tab group or panel (a ``viser.GuiTabHandle``, or an object that holds one as ``handle``:
+    :class:`tpm_viz.ui.worded.Tab`), which viser's page names the tab's button by (``data-dock-tab="<id>"`` on a
+    wide screen, ``id="…-tab-<id>"`` on a phone's tab strip); None for anything else (viser's public API has no name
+    for it)."""
+    handle = tab if isinstance(tab, viser.GuiTabHandle) else getattr(tab, "handle", None)
+    uuid = handle._id if isinstance(handle, viser.GuiTabHandle) else None
+    return uuid if isinstance(uuid, str) else None
+
+
 def drop_gizmo_echo(gizmo: Any) -> None:
     """Drop viser's cross-client echo of a client-scoped gizmo's drags: it queues two messages per drag event
     addressed to every client but this one, i.e. to nobody (~5 % of the server's CPU with 30 tabs dragging)."""
@@ -149,154 +169,6 @@ def drop_gizmo_echo(gizmo: Any) -> None:
     aux = getattr(gizmo, "_impl_aux", None)
     if aux is not None and hasattr(aux, "sync_cb"):
         aux.sync_cb = None
-
-
-class ClientDoor:
-    """A tab's message handling, for :mod:`.transport`: look up widgets and uploads, replace three handlers."""
-
-    def __init__(self, client: viser.ClientHandle) -> None:
-        self._conn = client._websock_connection
-        self._gui = client.gui
-        self.gui_update: wire.GuiUpdate = cast(wire.GuiUpdate, self._gui._handle_gui_updates)
-        """viser's own handler of ``GuiUpdateMessage`` (call it to let a message through)."""
-        self.upload_start: wire.Upload = cast(wire.Upload, self._gui._handle_file_transfer_start)
-        self.upload_part: wire.Upload = cast(wire.Upload, self._gui._handle_file_transfer_part)
-
-    def widget(self, uuid: str) -> Any:
-        """The GUI handle with this uuid, or None."""
-        return self._gui._gui_input_handle_from_uuid.get(uuid)
-
-    def upload_state(self, transfer_uuid: str) -> Any:
-        """viser's state of an upload in progress (``transferred_bytes``, ``total_bytes``), or None."""
-        return self._gui._current_file_upload_states.get(transfer_uuid)
-
-    def drop_upload(self, transfer_uuid: str) -> None:
-        """Forget an upload in progress (its buffered parts are freed)."""
-        self._gui._current_file_upload_states.pop(transfer_uuid, None)
-
-    def end_upload(self, button: str, transfer: str, size: int | None = None) -> None:
-        """Hide the page's upload toast (a success, whatever the app says); ``size``: free its button too."""
-        self._conn.queue_message(_messages.RemoveNotificationMessage(f"upload-{transfer}"))
-        if size is not None:
-            self._conn.queue_message(_messages.FileTransferPartAck(button, transfer, size, size))
-
-    def replace(self, gui_update: wire.GuiUpdate, upload_start: wire.Upload, upload_part: wire.Upload) -> None:
-        """Route this tab's GUI updates and upload messages to the given handlers instead of viser's."""
-        pairs: tuple[tuple[Any, Any, Any], ...] = (
-            (_messages.GuiUpdateMessage, self.gui_update, gui_update),
-            (_messages.FileTransferStartUpload, self.upload_start, upload_start),
-            (_messages.FileTransferPart, self.upload_part, upload_part),
-        )
-        for message_type, old, new in pairs:
-            self._conn.unregister_handler(message_type, old)
-            self._conn.register_handler(message_type, new)
-
-
-class ServerDoor:
-    """The websocket server under a viser server, for :mod:`.limits` (see the module docstring)."""
-
-    def __init__(self, server: viser.ViserServer) -> None:
-        self._ws: Any = server._websock_server
-        self.removers: list[Callable[[], None]] = []
-        """Undo the callbacks added by :meth:`on_connect` and :meth:`on_disconnect`."""
-
-    @property
-    def loop(self) -> asyncio.AbstractEventLoop | None:
-        """The server's event loop (None before it starts)."""
-        return cast("asyncio.AbstractEventLoop | None", self._ws._background_event_loop)
-
-    def on_connect(self, cb: Callable[[int], None], wrap: wire.Wrapper) -> None:
-        """Run ``cb(client_id)`` on the event loop for every new websocket connection, before any of its messages
-        is handled, and route that connection's messages through ``wrap(dispatch)``."""
-
-        async def connected(conn: Any) -> None:
-            conn._handle_incoming_message = wrap(conn._handle_incoming_message)
-            cb(conn.client_id)
-
-        self._ws.on_client_connect(connected)
-        self.removers.append(lambda: self._forget(self._ws._client_connect_cb, connected))
-
-    def on_disconnect(self, cb: Callable[[int], None]) -> None:
-        """Run ``cb(client_id)`` on the event loop when a websocket connection ends, after emptying its outgoing
-        buffer (what a tab that stopped reading left queued is freed now, not when its handles are collected)."""
-
-        async def disconnected(conn: Any) -> None:
-            buffer = conn._state.message_buffer
-            with buffer.buffer_lock:
-                buffer.message_from_id.clear()
-                buffer.id_from_redundancy_key.clear()
-                buffer.ids_from_entity_state_key.clear()
-            cb(conn.client_id)
-
-        self._ws.on_client_disconnect(disconnected)
-        self.removers.append(lambda: self._forget(self._ws._client_disconnect_cb, disconnected))
-
-    def wrap_server_dispatch(self, wrap: wire.Wrapper) -> None:
-        """Route the messages handled at the server level (server-scoped widgets and scene) through ``wrap``."""
-        self._ws._handle_incoming_message = wrap(self._ws._handle_incoming_message)
-
-    def unwrap_server_dispatch(self) -> None:
-        """Undo :meth:`wrap_server_dispatch` (viser's own dispatch again)."""
-        self._ws.__dict__.pop("_handle_incoming_message", None)
-
-    def shared_buffer(self) -> Any:
-        """The message buffer every tab is sent (``AsyncMessageBuffer``, persistent)."""
-        return self._ws._broadcast_buffer
-
-    def on_new_buffer(self, cb: Callable[[Any], None]) -> Callable[[], None]:
-        """Run ``cb(buffer)`` on the event loop with each new connection's own message buffer, before any other
-        connect callback (viser's included) and before its sender starts. -> a function that stops it."""
-
-        async def connected(conn: Any) -> None:
-            cb(conn._state.message_buffer)
-
-        self._ws._client_connect_cb.insert(0, connected)
-        return lambda: self._forget(self._ws._client_connect_cb, connected)
-
-    @staticmethod
-    def _forget(callbacks: list[Any], cb: Any) -> None:
-        if cb in callbacks:
-            callbacks.remove(cb)
-
-    def live(self) -> list[int]:
-        """Ids of the open websocket connections."""
-        return list(self._ws._live_connections)
-
-    def backlog(self, client_id: int, count_bytes_below: int) -> tuple[int, int]:
-        """``(messages, bytes)`` queued for this connection and not yet written to its socket; the bytes (payloads
-        of files, text, arrays) are only added up when there are fewer than ``count_bytes_below`` messages."""
-        state, connection = self._ws._client_state_from_id.get(client_id), self._ws._live_connections.get(client_id)
-        if state is None or connection is None:
-            return 0, 0
-        messages = list(state.message_buffer.message_from_id.values())
-        if len(messages) >= count_bytes_below:
-            return len(messages), -1
-        transport = connection.transport  # the frame being written (up to one window of 128 messages)
-        written = transport.get_write_buffer_size() if transport is not None else 0
-        return len(messages), written + sum(map(wire.message_bytes, messages))
-
-    def notify(self, client_id: int, title: str, body: str) -> None:
-        """Show a red notification in that tab (a connection not yet registered as a viser client included)."""
-        state = self._ws._client_state_from_id.get(client_id)
-        if state is None:
-            return
-        props = _messages.NotificationProps(
-            title=title, body=body, loading=False, with_close_button=True, auto_close_seconds=None, color="red"
-        )
-        state.message_buffer.push(_messages.NotificationShowMessage(uuid=str(uuid.uuid4()), props=props))
-        state.message_buffer.flush()
-
-    def close(self, client_id: int, code: int, reason: str) -> None:
-        """Close this connection with a closing handshake (from any thread)."""
-        connection, loop = self._ws._live_connections.get(client_id), self.loop
-        if connection is not None and loop is not None and not loop.is_closed():
-            asyncio.run_coroutine_threadsafe(connection.close(code, reason), loop)
-
-    def abort(self, client_id: int) -> None:
-        """Drop this connection at once, without a closing handshake (a tab that does not read; from any thread)."""
-        connection, loop = self._ws._live_connections.get(client_id), self.loop
-        if connection is not None and loop is not None and not loop.is_closed():
-            loop.call_soon_threadsafe(connection.transport.abort)
 
 
 def connection_request(server: viser.ViserServer, client_id: int) -> tuple[Any, Any] | None:

@@ -1,16 +1,17 @@
 """The patches of viser 1.1.x that cannot be put on one server object alone, each guarded to act for tpm-viz's own
 servers only (see ``PATCHES.md``); :mod:`.adapter` installs them.
 
-A server is *registered* (:func:`register`) with what it takes: its event loop in :data:`_LOOPS`, the server in
-:data:`_SKIPS`. Four names of viser or websockets are looked up per connection, so they are replaced for the whole
-process, by functions that do what the original does unless the object at hand belongs to a registered server:
+A server is *registered* (:func:`register`) with what it takes: its event loop in :data:`~.incoming.LOOPS`, the
+server in :data:`_SKIPS`. Four names of viser or websockets are looked up per connection, so they are replaced for
+the whole process, by functions that do what the original does unless the object at hand belongs to a registered
+server:
 
 - ``viser.infra._infra._message_producer``: a buffer that carries a tpm-viz sender (``tpm_viz_produce``, put on it
   by :func:`upgrade_buffer`) is sent with it; any other with viser's own;
 - ``viser.infra._infra._message_consumer``: on a registered loop, incoming bytes are decoded quietly
-  (:func:`decode_quietly`); elsewhere viser's own loop runs;
+  (:func:`~.incoming.decode_quietly`); elsewhere viser's own loop runs;
 - ``websockets.asyncio.server.ServerProtocol``: on a registered loop, a smaller frame limit and no HTTP 500
-  (:class:`GuardedProtocol`); elsewhere every method is the original's;
+  (:class:`~.incoming.GuardedProtocol`); elsewhere every method is the original's;
 - ``AssignablePropsBase._prop_hints``: a handle of a registered server reads its props' types from a cache per props
   class; any other handle from viser's own per-handle cache;
 - ``viser._scene_handles._set_pose_vector`` and ``AssignablePropsBase._cast_value_recursive``: for a handle of a
@@ -24,13 +25,10 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
-import dataclasses
-import errno
 import functools
-import http
 import threading
 import weakref
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from typing import Any, cast, get_type_hints
 
 import viser
@@ -38,9 +36,9 @@ from viser import _assignable_props_api, _messages, _scene_handles
 from viser.infra import _infra
 
 from tpm_viz.viserkit import casts, wire
+from tpm_viz.viserkit.incoming import BIG_MESSAGE, LOOPS, GuardedProtocol, LoopPatches, decode_quietly, message_consumer
 from tpm_viz.viserkit.wakeups import Wakeups, thread_safe_set
 from tpm_viz.viserkit.windows import Encode, Frames, Tick, encoder, producer, window_loop
-from tpm_viz.viserkit.wire import Malformed
 
 __all__ = ["BIG_MESSAGE", "GuardedProtocol", "LoopPatches", "building", "decode_quietly", "lean_encoder"]
 __all__ += ["count", "downgrade_buffer", "register", "registered", "skipped", "unregister", "upgrade_buffer"]
@@ -55,20 +53,6 @@ _ORIGINAL: dict[str, Any] = {
 }
 SERIALIZE = _messages.Message.as_serializable_dict
 """viser's own serialisation of a message (the shared one calls it once per message)."""
-BIG_MESSAGE = 64 << 10
-"""Incoming messages larger than this [bytes] must be upload parts (nothing else a browser sends is that big): a
-big map or list in any other message would hold the event loop while it is decoded."""
-
-
-@dataclasses.dataclass
-class LoopPatches:
-    """What the guarded class-level patches do on one registered server's event loop (None: that patch skipped)."""
-
-    max_frame_bytes: int | None = None
-    on_garbage: Callable[[str], object] | None = None
-
-
-_LOOPS: weakref.WeakKeyDictionary[asyncio.AbstractEventLoop, LoopPatches] = weakref.WeakKeyDictionary()
 _SKIPS: weakref.WeakKeyDictionary[viser.ViserServer, frozenset[str]] = weakref.WeakKeyDictionary()
 _HINTED: weakref.WeakSet[viser.ViserServer] = weakref.WeakSet()
 _CAST: weakref.WeakSet[viser.ViserServer] = weakref.WeakSet()
@@ -120,90 +104,9 @@ async def _message_producer(
         await produce(websocket, buffer, client_id, backlog_done_message)
 
 
-async def _message_consumer(websocket: Any, handle_message: Callable[[Any], None], message_class: type) -> None:
-    patches = _LOOPS.get(asyncio.get_running_loop())
-    on_garbage = None if patches is None else patches.on_garbage
-    if on_garbage is None:
-        await _ORIGINAL["consumer"](websocket, handle_message, message_class)
-        return
-    while True:
-        raw = await websocket.recv()
-        assert isinstance(raw, bytes)
-        handle_message(decode_quietly(message_class, raw, on_garbage))
-
-
-class _UploadPart(_infra.msgspec.Struct, forbid_unknown_fields=True):
-    """The one big message a browser sends, decoded strictly (fails at the first unexpected field)."""
-
-    type: str
-    source_component_uuid: str | None
-    transfer_uuid: str
-    part_index: int
-    content: bytes
-
-
-def decode_quietly(message_class: Any, raw: bytes, on_garbage: Callable[[str], object]) -> Any:
-    """viser's decoding of an incoming message, made forgiving: a message whose fields cannot be cast
-    (``float("a")`` in a position, a missing field) becomes a :class:`~.wire.Malformed` instead of an exception that
-    closes the connection with a traceback in the log; bytes that are not a message at all (not msgpack, no known
-    type, a big one that is not an upload part) still close the connection, quietly (``on_garbage(text)``)."""
-    if len(raw) > BIG_MESSAGE:
-        try:
-            big = _infra.msgspec.msgpack.decode(raw, type=_UploadPart)
-        except _infra.msgspec.MsgspecError:
-            big = None
-        if big is None or big.type != "FileTransferPart":
-            on_garbage(f"connection closed: a message of {len(raw)} bytes that is not an upload part")
-            raise _infra.websockets.exceptions.ConnectionClosedError(None, None)
-    try:
-        return message_class.deserialize(raw)
-    except (_infra.msgspec.DecodeError, KeyError, AttributeError) as exc:
-        on_garbage(f"connection closed: not a viser message ({type(exc).__name__})")
-        raise _infra.websockets.exceptions.ConnectionClosedError(None, None) from None
-    except (ValueError, TypeError, IndexError) as exc:
-        return Malformed(f"{type(exc).__name__}: {str(exc)[:120]}")
-
-
-class GuardedProtocol(ws_server.ServerProtocol):
-    """websockets' per-connection protocol; on a registered loop with a frame limit (:class:`LoopPatches`): that
-    smaller limit (the rest of a refused frame dropped as it arrives, not parsed), and a path the file server cannot
-    even look up (a segment too long for the file system) answered 414 or 404 instead of 500."""
-
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
-        try:
-            patches = _LOOPS.get(asyncio.get_running_loop())
-        except RuntimeError:
-            patches = None
-        limit = None if patches is None else patches.max_frame_bytes
-        self.tpm_viz_limited, self.tpm_viz_failed = limit is not None, False
-        if limit is not None:
-            size = kwargs.get("max_size")
-            kwargs["max_size"] = limit if not isinstance(size, int) else min(size, limit)
-        super().__init__(*args, **kwargs)
-
-    def fail(self, code: Any, reason: str = "") -> None:
-        super().fail(code, reason)
-        self.tpm_viz_failed = self.tpm_viz_limited
-
-    def receive_data(self, data: bytes | bytearray) -> None:
-        if self.tpm_viz_failed:
-            return
-        super().receive_data(data)
-
-    def reject(self, status: Any, text: str) -> Any:
-        exc = self.handshake_exc
-        internal = int(status) == http.HTTPStatus.INTERNAL_SERVER_ERROR
-        if self.tpm_viz_limited and internal and isinstance(exc, (OSError, ValueError)):
-            too_long = isinstance(exc, OSError) and exc.errno == errno.ENAMETOOLONG
-            status = http.HTTPStatus.REQUEST_URI_TOO_LONG if too_long else http.HTTPStatus.NOT_FOUND
-            text = "URI TOO LONG\n" if too_long else "NOT FOUND\n"
-            self.handshake_exc = None  # not a server fault: no traceback in the log
-        return super().reject(status, text)
-
-
 def _put_guards() -> None:
     _infra._message_producer = _message_producer
-    _infra._message_consumer = _message_consumer
+    _infra._message_consumer = message_consumer
     ws_server.ServerProtocol = GuardedProtocol
     _Props._prop_hints = property(_prop_hints)  # type: ignore[assignment]
     _Props._cast_value_recursive = _cast_value_recursive  # type: ignore[method-assign]
@@ -227,7 +130,7 @@ def register(
     with _LOCK:
         if not _SKIPS:
             _put_guards()
-        _LOOPS[loop] = patches
+        LOOPS[loop] = patches
         _SKIPS[server] = skip
         weakref.finalize(server, _restore_if_none)  # a server collected without unregister: originals back
         if "serialization" not in skip:
@@ -243,7 +146,7 @@ def unregister(server: viser.ViserServer, loop: asyncio.AbstractEventLoop | None
         _HINTED.discard(server)
         _CAST.discard(server)
         if loop is not None:
-            _LOOPS.pop(loop, None)
+            LOOPS.pop(loop, None)
             _WAKEUPS.pop(loop, None)
     _restore_if_none()
 

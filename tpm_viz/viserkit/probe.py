@@ -8,7 +8,8 @@ private viser or websockets name is written outside :mod:`tpm_viz.viserkit`.
   :data:`VISER_SERIALIZE`) and the shared one (:func:`shared_serialize`), its buffer alignment (:func:`align`);
 - a widget's uuid, a value arriving without its callbacks (:func:`arrive`), a tab's uploads in progress, the
   connections a server still holds, viser's tunnel class, whether a tab's sending is viser's own
-  (:func:`outgoing_replaced`).
+  (:func:`outgoing_replaced`);
+- the bytes an image node sends (:func:`image_bytes`), the length of a recording (:func:`recorded_seconds`).
 """
 
 from __future__ import annotations
@@ -23,12 +24,13 @@ from viser.infra import _infra
 from viser.infra._async_message_buffer import AsyncMessageBuffer
 
 from tpm_viz.viserkit import patches, wire
-from tpm_viz.viserkit.core import ServerDoor, thread_pool, widget_uuid, widget_value
+from tpm_viz.viserkit.core import thread_pool, widget_uuid, widget_value
+from tpm_viz.viserkit.doors import ServerDoor
 
 __all__ = ["VISER_SERIALIZE", "VISER_WINDOW_LOOP", "align", "arrive", "connection_states", "lean_buffer"]
 __all__ += ["message_buffer", "messages", "shared_serialize", "tunnel_class", "upload_states", "widget_uuid"]
 __all__ += ["event_loop", "gizmo_echoes", "share_tunnel", "shared_buffer", "thread_pool", "wake_safely"]
-__all__ += ["outgoing_replaced", "props_api", "widget_value"]
+__all__ += ["image_bytes", "outgoing_replaced", "props_api", "recorded_seconds", "widget_value"]
 
 messages = _messages
 """viser's message classes (``viser._messages``)."""
@@ -105,6 +107,16 @@ def gizmo_echoes(gizmo: Any) -> bool:
 def share_tunnel(server: viser.ViserServer) -> Any:
     """The share-URL tunnel a server opened (None: none)."""
     return server._share_tunnel
+
+
+def image_bytes(image: viser.ImageHandle) -> bytes:
+    """The encoded image (PNG or JPEG) a scene image node sends the page (viser keeps it in its ``_data`` prop)."""
+    return bytes(image._data)
+
+
+def recorded_seconds(serializer: Any) -> float:
+    """How long a recording of viser's ``StateSerializer`` lasts so far [s] (the sleeps inserted; its ``_time``)."""
+    return float(serializer._time)
 
 
 def tunnel_class() -> type:

@@ -20,7 +20,7 @@ at most :data:`MAX_TEXT` characters for a text input), finite; uploads go to upl
 :data:`~tpm_viz.app.inputs.MAX_UPLOAD_BYTES` each (refused before any byte is buffered), at most
 :data:`MAX_UPLOADS` in flight per tab, each freed after :data:`UPLOAD_TIMEOUT` seconds if unfinished. Every drop is a
 rate-limited log line (:func:`~.guard.log_fault`). What passes still goes through the callbacks' own validation
-(:mod:`tpm_viz.app.inputs`). viser's internals are reached through :class:`~tpm_viz.viserkit.core.ClientDoor`.
+(:mod:`tpm_viz.app.inputs`). viser's internals are reached through :class:`~tpm_viz.viserkit.doors.ClientDoor`.
 
 viser's page shows its own toast for every upload, "File uploaded successfully" once the last part is acknowledged,
 whatever the app then makes of the file. That toast is hidden before the last acknowledgement goes out (and the
@@ -50,7 +50,8 @@ import viser
 from tpm_viz.app.inputs import MAX_TEXT, MAX_UPLOAD_BYTES, TOO_LARGE, value_problem
 from tpm_viz.classroom.guard import log_fault
 from tpm_viz.core.words import Lang, Phrase, T, say
-from tpm_viz.viserkit.core import ClientDoor, Malformed, widget_value
+from tpm_viz.viserkit.core import Malformed, widget_value
+from tpm_viz.viserkit.doors import ClientDoor
 from tpm_viz.viserkit.patches import skipped
 
 __all__ = ["MAX_UPLOADS", "UPLOAD_TIMEOUT", "harden", "message_problem", "update_problem"]

@@ -12,6 +12,7 @@ from tests.support.protocol import wait_for
 from tpm_viz import Params
 from tpm_viz.app.overlays import MAP_KINDS
 from tpm_viz.ui.teaching import explorer as explorer_module
+from tpm_viz.viserkit.probe import image_bytes
 
 P = Params.paper()
 
@@ -41,7 +42,7 @@ def test_a_map_is_drawn_on_the_floor_and_replaces_the_plain_workspace(connect):
     client.set_value(ex.map_kind, MAP_KINDS["det_jx"])
     wait_for(lambda: _image(view) is not None, what="the map image")
     image = _image(view)
-    assert image._data[:4] == b"\x89PNG" and image.render_width == pytest.approx(2 * P.l_a * 200 / 199)
+    assert image_bytes(image)[:4] == b"\x89PNG" and image.render_width == pytest.approx(2 * P.l_a * 200 / 199)
     assert tuple(image.position) == pytest.approx((0.0, 0.0, explorer_module.MAP_Z))
     wait_for(lambda: _region_shown(view, client) is False, what="the floor hidden in this tab")
     assert _region_shown(other, other_client) is True  # only in this tab (nothing on its way to the other tab)
