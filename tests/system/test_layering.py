@@ -17,6 +17,8 @@ Layers, bottom up (a module may import its own layer and the layers its rule lis
 - ``viserkit/``: the adapter, the only place that touches viser's or websockets' internals: base, app, classroom,
   viser and websockets;
 - ``cluster`` (``tpm_viz/cluster.py``): the only place that imports Dask (the optional extra ``.[cluster]``);
+- ``lti/``: the LTI 1.3 tool (the optional extra ``.[lti]``): base, app, classroom, PyJWT, cryptography, Starlette,
+  uvicorn, httpx and python-multipart; never viser (the app applies its launches in ``ui/launched.py``);
 - ``ui/``: the per-tab views through viser's public API (its private names only in ``viserkit/``);
 - ``cli/``: may import every layer; nothing imports it but ``__main__``.
 """
@@ -50,6 +52,10 @@ RULES: dict[str, tuple[set[str], set[str]]] = {
     "classroom": ({"base", "paper", "drawing", "app", "classroom"}, {"numpy", "platformdirs"}),
     "viserkit": ({"base", "app", "classroom", "viserkit"}, {"numpy", "viser", "websockets"}),
     "cluster": ({"base", "paper", "app", "cluster"}, {"numpy", "distributed", "dask"}),  # tpm_viz/cluster.py
+    "lti": (
+        {"base", "app", "classroom", "lti"},
+        {"jwt", "cryptography", "starlette", "uvicorn", "httpx", "multipart"},
+    ),
     "ui": (
         {"base", "paper", "drawing", "multibody", "app", "reports", "classroom", "viserkit", "ui"},
         {"numpy", "trimesh", "viser", "platformdirs", "segno"},
@@ -67,6 +73,7 @@ RULES: dict[str, tuple[set[str], set[str]]] = {
             "viserkit",
             "ui",
             "cluster",
+            "lti",
             "cli",
         },
         {"numpy"},
