@@ -9,7 +9,7 @@ launch waits under a random nonce, in a short-lived cookie, for the tab's websoc
 share link's token does (:mod:`tpm_viz.app.links`). Bounded: :data:`MAX_TICKETS` tickets and
 :data:`MAX_ARRIVALS` arrivals at once (the oldest go first), each for :data:`TICKET_SECONDS`.
 
-A tab that reconnects (a wifi blip, a restart) sends no ticket: :attr:`Tickets.recall` finds the launch of the
+A tab that reconnects (a wifi blip, a restart) sends no ticket: ``Tickets.recall`` finds the launch of the
 browser it comes from (by its hashed identity cookie; the LTI layer keeps them in the store), so that the LMS user
 keeps their identity and grades; the presenter's right is never restored from it (see :mod:`tpm_viz.classroom.away`).
 """

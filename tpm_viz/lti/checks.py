@@ -87,29 +87,28 @@ class Claims:
         return value if _EXERCISE.match(value) else None
 
 
-def _refuse(why: Why, template: str, **values: object) -> Refused:
-    return Refused(why, Phrase(template, **values))
-
-
 def _verify(token: str, login: Login, keys: KeySets) -> dict[str, Any]:
     """Steps 1-3: the claims of a token whose signature holds."""
     try:
         header = jwt.get_unverified_header(token)
         unverified = jwt.decode(token, options={"verify_signature": False})
     except jwt.PyJWTError:
-        raise _refuse(Why.SIGNATURE, "the launch token is not a signed JWT (signature): launch again") from None
+        raise Refused(Why.SIGNATURE, Phrase("the launch token is not a signed JWT (signature): launch again")) from None
     if header.get("alg") != "RS256":
-        raise _refuse(
-            Why.SIGNATURE, "the launch token is not signed RS256 (signature {alg})", alg=str(header.get("alg"))[:20]
+        raise Refused(
+            Why.SIGNATURE,
+            Phrase("the launch token is not signed RS256 (signature {alg})", alg=str(header.get("alg"))[:20]),
         )
     kid = header.get("kid")
     if not isinstance(kid, str) or not kid:
-        raise _refuse(Why.KEY, "the launch token names no key (key): the platform must send a kid")
+        raise Refused(Why.KEY, Phrase("the launch token names no key (key): the platform must send a kid"))
     if unverified.get("iss") != login.platform.issuer:
-        raise _refuse(
+        raise Refused(
             Why.ISSUER,
-            "the launch comes from another platform than its login (issuer {iss}): check issuer",
-            iss=str(unverified.get("iss"))[:120],
+            Phrase(
+                "the launch comes from another platform than its login (issuer {iss}): check issuer",
+                iss=str(unverified.get("iss"))[:120],
+            ),
         )
     key = keys.key(login.platform.key_set_url, kid)
     try:
@@ -130,21 +129,22 @@ def _verify(token: str, login: Login, keys: KeySets) -> dict[str, Any]:
             )
         )
     except jwt.InvalidSignatureError:
-        raise _refuse(
-            Why.SIGNATURE, "the launch's signature does not match the platform's key (signature): check key_set_url"
+        raise Refused(
+            Why.SIGNATURE,
+            Phrase("the launch's signature does not match the platform's key (signature): check key_set_url"),
         ) from None
     except jwt.PyJWTError:
-        raise _refuse(Why.SIGNATURE, "the launch token is not a signed JWT (signature): launch again") from None
+        raise Refused(Why.SIGNATURE, Phrase("the launch token is not a signed JWT (signature): launch again")) from None
 
 
 def _times(claims: dict[str, Any], now: float) -> None:
     exp, iat = claims.get("exp"), claims.get("iat")
     if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (exp, iat)):
-        raise _refuse(Why.EXPIRED, "the launch token has no valid exp and iat times (expired): launch again")
+        raise Refused(Why.EXPIRED, Phrase("the launch token has no valid exp and iat times (expired): launch again"))
     if now > float(exp) + LEEWAY:  # type: ignore[arg-type]
-        raise _refuse(Why.EXPIRED, "the launch token has expired (expired): launch again from the course")
+        raise Refused(Why.EXPIRED, Phrase("the launch token has expired (expired): launch again from the course"))
     if float(iat) > now + LEEWAY:  # type: ignore[arg-type]
-        raise _refuse(Why.EXPIRED, "the launch token is issued in the future (expired): check both clocks")
+        raise Refused(Why.EXPIRED, Phrase("the launch token is issued in the future (expired): check both clocks"))
 
 
 def _audience(claims: dict[str, Any], client_id: str) -> None:
@@ -152,10 +152,9 @@ def _audience(claims: dict[str, Any], client_id: str) -> None:
     audiences = [aud] if isinstance(aud, str) else aud if isinstance(aud, list) else []
     wrong = client_id not in audiences or (len(audiences) > 1 and azp is None) or azp not in (None, client_id)
     if wrong:
-        raise _refuse(
+        raise Refused(
             Why.AUDIENCE,
-            "the launch is meant for another tool (audience/client {aud}): check client_id",
-            aud=str(aud)[:120],
+            Phrase("the launch is meant for another tool (audience/client {aud}): check client_id", aud=str(aud)[:120]),
         )
 
 
@@ -170,24 +169,29 @@ def check_id_token(
     """The checked claims of a launch's ``id_token`` for ``login`` (a :class:`Refused` at the first check that
     fails; order in the module docstring)."""
     if not isinstance(token, str) or not token or len(token) > 65536:
-        raise _refuse(Why.REQUEST, "the launch carries no id_token: launch again from the course")
+        raise Refused(Why.REQUEST, Phrase("the launch carries no id_token: launch again from the course"))
     claims = _verify(token, login, keys)
     platform = login.platform
     _times(claims, clock())
     _audience(claims, platform.client_id)
     nonce = claims.get("nonce")
     if not isinstance(nonce, str) or nonce != login.nonce or not logins.spend_nonce(nonce):
-        raise _refuse(Why.NONCE, "the launch's nonce is not its login's, or was used already (nonce): launch again")
+        raise Refused(
+            Why.NONCE, Phrase("the launch's nonce is not its login's, or was used already (nonce): launch again")
+        )
     version = claims.get(CLAIM + "version")
     if version != "1.3.0":
-        raise _refuse(Why.VERSION, "the launch is LTI version {v}, not 1.3.0 (version)", v=str(version)[:20])
+        raise Refused(Why.VERSION, Phrase("the launch is LTI version {v}, not 1.3.0 (version)", v=str(version)[:20]))
     kind = claims.get(CLAIM + "message_type")
     if kind not in (RESOURCE_LINK, DEEP_LINKING):
-        raise _refuse(Why.MESSAGE_TYPE, "this tool does not take the message type {t} (message type)", t=str(kind)[:60])
+        raise Refused(
+            Why.MESSAGE_TYPE, Phrase("this tool does not take the message type {t} (message type)", t=str(kind)[:60])
+        )
     deployment = _text(claims, CLAIM + "deployment_id")
     if deployment not in platform.deployment_ids:
-        raise _refuse(
-            Why.DEPLOYMENT, "unknown deployment {id} (deployment): add it to deployment_ids", id=deployment[:120]
+        raise Refused(
+            Why.DEPLOYMENT,
+            Phrase("unknown deployment {id} (deployment): add it to deployment_ids", id=deployment[:120]),
         )
     subject = _text(claims, "sub")
     if not subject or len(subject) > 255:
@@ -197,7 +201,7 @@ def check_id_token(
         raise Refused(Why.ROLE, T("the launch carries no role (role): the LMS must send the user's roles"), status=400)
     target = _text(claims, CLAIM + "target_link_uri")
     if target.rstrip("/") != login.target.rstrip("/"):
-        raise _refuse(Why.LINK, "the launch's target {url} is not its login's (link)", url=target[:120])
+        raise Refused(Why.LINK, Phrase("the launch's target {url} is not its login's (link)", url=target[:120]))
     return _claims(claims, kind, deployment, subject, roles)
 
 

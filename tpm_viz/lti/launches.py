@@ -3,7 +3,7 @@
 :func:`resource_launch` writes the records (:meth:`~tpm_viz.lti.ledger.Ledger.record_launch`: the class's course,
 the user's server-issued identity, the launch) and issues the ticket the browser takes to the app
 (:class:`~tpm_viz.classroom.launches.Tickets`); :func:`app_url` is where it goes. :func:`connect_browsers` lets
-the app find the launch of a browser that reconnects (:attr:`Tickets.recall`) through the store.
+the app find the launch of a browser that reconnects (``Tickets.recall``) through the store.
 """
 
 from __future__ import annotations
