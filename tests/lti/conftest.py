@@ -45,11 +45,13 @@ def platform() -> Iterator[TestPlatform]:
     lms.stop()
 
 
-def write_config(folder: Path, platform: TestPlatform, extra: str = "") -> Path:
-    """The tool's key (``keygen``) and a configuration naming ``platform``, in ``folder``."""
+def write_config(folder: Path, platform: TestPlatform, extra: str = "", extra_platforms: str = "") -> Path:
+    """The tool's key (``keygen``) and a configuration naming ``platform`` (and ``extra_platforms``), in
+    ``folder``."""
     keygen(folder / "keys")
     path = folder / "lti.toml"
-    path.write_text(f'[tool]\nprivate_key = "keys/tool-key.pem"\nport = 0\n{extra}\n{platform.config()}')
+    text = f'[tool]\nprivate_key = "keys/tool-key.pem"\nport = 0\n{extra}\n{platform.config()}\n{extra_platforms}'
+    path.write_text(text)
     return path
 
 
@@ -71,8 +73,10 @@ class Running:
         return httpx.Client(timeout=10, follow_redirects=False)
 
 
-def start_tool(folder: Path, platform: TestPlatform, store: Path | None = None, **options: Any) -> Running:
-    config = read_config(write_config(folder, platform))
+def start_tool(
+    folder: Path, platform: TestPlatform, store: Path | None = None, extra_platforms: str = "", **options: Any
+) -> Running:
+    config = read_config(write_config(folder, platform, extra_platforms=extra_platforms))
     key = ToolKey.read(config.private_key)
     ledger = Ledger(store or folder / "store.sqlite3")
     tickets = Tickets()
