@@ -104,6 +104,7 @@ class TestPlatform:
         self.links: dict[str, Link] = {}
         self.items: dict[str, Item] = {}
         self.tool_jwks = ""
+        self.tool_login = self.tool_launch = ""  # the tool's login and launch URLs (the course page links them)
         self.redirect_uris: list[str] = []
         self.mode = "up"  # "down": 503; "lose": apply, then answer 500 (``lose`` times); "slow": answer late
         self.lose = 0
@@ -128,6 +129,7 @@ class TestPlatform:
             Route("/lineitems/{item}", self._lineitem),
             Route("/lineitems/{item}/scores", self._scores, methods=["POST"]),
             Route("/return", self._return, methods=["POST"]),
+            Route("/course/{hint}/{link}", self._course),
         ]
         self.app = Starlette(routes=routes)
         self.server = uvicorn.Server(uvicorn.Config(self.app, log_level="warning", lifespan="off"))
@@ -330,6 +332,12 @@ class TestPlatform:
         if not newer:
             return Response("not newer", status_code=409 if self.strict else 200)
         return Response(status_code=200)
+
+    async def _course(self, request: Request) -> Response:
+        """The course page a student or a lecturer opens in the LMS: a link that starts the tool's login."""
+        hint, link = request.path_params["hint"], request.path_params["link"]
+        target = query(self.tool_login, **self.login_query(self.tool_launch, hint, link))
+        return HTMLResponse(f'<html><body><h1>Mechanisms 101</h1><a id="open" href="{html.escape(target)}">tpm-viz</a>')
 
     async def _return(self, request: Request) -> Response:
         """The deep-linking return URL (Deep Linking 2.0 §4.2): the tool's signed response, checked."""
