@@ -240,3 +240,17 @@ def test_the_outbox_is_bounded(running, monkeypatch):
 def test_scores_url_inserts_before_the_query():
     assert scores_url("https://lms.example/li/7?type=x&a=1") == "https://lms.example/li/7/scores?type=x&a=1"
     assert scores_url("https://lms.example/li/7/") == "https://lms.example/li/7/scores"
+
+
+def test_each_submission_hears_on_its_way_once_even_when_a_newer_one_joins(running, platform, sender):
+    found = _graded(running, platform)
+    first, second = [], []
+    platform.mode = "down"
+    sender.submit(found.ref, "ex1", 0.3, Rule.LATEST, tell=first.append)
+    until(lambda: first == [News.ON_ITS_WAY], "the first told")
+    sender.submit(found.ref, "ex1", 0.7, Rule.LATEST, tell=second.append)
+    until(lambda: running.ledger.outbox()[0][1] >= 2, "two tries of the newer score")
+    platform.mode = "up"
+    until(lambda: second and second[-1] is News.SENT, "sent")
+    assert first == [News.ON_ITS_WAY, News.SENT] and second == [News.ON_ITS_WAY, News.SENT]
+    assert [a["scoreGiven"] for a in platform.applied] == [7.0]

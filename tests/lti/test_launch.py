@@ -8,10 +8,10 @@ from urllib.parse import parse_qs, urlsplit
 import pytest
 
 from tests.lti.conftest import launch, login
-from tests.lti.platform import MEMBERSHIP, Person, form_fields
+from tests.lti.platform import MEMBERSHIP, Person, auth_params, form_fields
 from tpm_viz.classroom.launches import Role
 from tpm_viz.lti.checks import role_of
-from tpm_viz.lti.service import state_cookie
+from tpm_viz.lti.service import Urls, state_cookie
 
 
 def _through_platform(client, running, platform, hint: str, message: str):
@@ -137,3 +137,18 @@ def test_a_teaching_assistant_launch_presents(running, platform):
     )
     with running.client() as browser:
         assert _arrive(running, launch(browser, running, platform, "ta")).role is Role.PRESENTER
+
+
+def test_over_https_the_state_cookie_survives_a_cross_site_post_and_is_required(running, platform):
+    """Behind a TLS proxy with a path prefix (the tool's public URL is https://tpm.example/tpm)."""
+    public = Urls("https://tpm.example/tpm", "https://tpm.example/tpm/")
+    running.tool.urls = public
+    with running.client() as browser:
+        query = platform.login_query(public.launch, "student", "plain")
+        answer = browser.get(f"http://127.0.0.1:{running.server.port}/lti/login", params=query)
+    assert answer.status_code == 302
+    assert auth_params(answer.headers["location"])["redirect_uri"] == "https://tpm.example/tpm/lti/launch"
+    cookie = answer.headers["set-cookie"].lower()
+    for part in ("samesite=none", "secure", "partitioned", "httponly", "path=/tpm/lti"):
+        assert part in cookie, cookie
+    assert running.tool.must_have_cookie

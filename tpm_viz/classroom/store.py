@@ -3,6 +3,7 @@
 Records: the lecture (one row, never evicted), one row per remembered browser (its tabs that left, with the source
 address they came from) and the uploaded trajectories once each by SHA-256 of their bytes (:meth:`Store.put_blob`).
 A record's body is JSON text; one that cannot be read is skipped (:attr:`Contents.skipped`), the rest load.
+Schema 2 adds the LTI tool's tables (``lti_*``), read and written by :mod:`tpm_viz.lti.ledger` (docs/lti.md §9).
 
 :func:`open_store` never destroys what it cannot read: a file that is not a SQLite database, is damaged
 (``PRAGMA quick_check``), was written by a newer schema (``PRAGMA user_version``) or is larger than

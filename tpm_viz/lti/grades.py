@@ -104,8 +104,7 @@ class GradeSender:
         self._wake = threading.Condition()
         self._stopping = False
         self._thread: threading.Thread | None = None
-        self._told: dict[str, list[Callable[[News], None]]] = {}  # grade -> listeners still waiting
-        self._waiting_told: set[str] = set()
+        self._told: dict[str, list[list[Any]]] = {}  # grade -> [listener, told "on its way"] still waiting
         self._maxima: dict[str, float] = {}  # line item -> its scoreMaximum, read once
 
     # -- the API of the exercise UI -----------------------------------------------------------------------------------
@@ -132,8 +131,7 @@ class GradeSender:
             return News.UNCHANGED
         with self._wake:
             if tell is not None:
-                self._told.setdefault(grade, []).append(tell)
-            self._waiting_told.discard(grade)
+                self._told.setdefault(grade, []).append([tell, False])
             self._wake.notify_all()
         return News.QUEUED
 
@@ -259,14 +257,12 @@ class GradeSender:
         self._tell(row.grade, News.REFUSED, done=True)
 
     def _tell(self, grade: str, news: News, done: bool) -> None:
+        """``news`` to the listeners of ``grade``: the last news (``done``) to all, *on its way* once to each."""
         with self._wake:
-            if not done and grade in self._waiting_told:
-                return
-            listeners = self._told.pop(grade, []) if done else list(self._told.get(grade, []))
-            if not done:
-                self._waiting_told.add(grade)
-            else:
-                self._waiting_told.discard(grade)
+            waiting = self._told.pop(grade, []) if done else self._told.get(grade, [])
+            listeners = [entry[0] for entry in waiting if done or not entry[1]]
+            for entry in waiting:
+                entry[1] = True
         for listener in listeners:
             try:
                 listener(news)

@@ -29,6 +29,7 @@ import time
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass, field
 from typing import Any
+from urllib.parse import urlsplit
 
 import uvicorn
 from starlette.applications import Starlette
@@ -89,6 +90,11 @@ class Urls:
     @property
     def secure(self) -> bool:
         return self.base.startswith("https://")
+
+    @property
+    def cookie_path(self) -> str:
+        """The path of the login's cookie: ``/lti`` under the public base's path (a proxy's prefix included)."""
+        return urlsplit(self.base).path.rstrip("/") + "/lti"
 
 
 @dataclass
@@ -169,10 +175,13 @@ async def login(request: Request, tool: Tool) -> Response:
     )
     response = RedirectResponse(target, status_code=302)
     secure = urls.secure
-    response.set_cookie(
-        state_cookie(found.state), found.state, max_age=int(LOGIN_SECONDS), path="/lti", httponly=True,
-        secure=secure, samesite="none" if secure else "lax", partitioned=secure,
-    )  # fmt: skip
+    # written by hand: Starlette's set_cookie takes Partitioned only on Python 3.14+ (the state is URL-safe text)
+    site = "SameSite=None; Secure; Partitioned" if secure else "SameSite=Lax"
+    response.headers.append(
+        "set-cookie",
+        f"{state_cookie(found.state)}={found.state}; Path={urls.cookie_path}; Max-Age={int(LOGIN_SECONDS)}; "
+        f"HttpOnly; {site}",
+    )
     response.headers["Cache-Control"] = "no-store"
     return response
 
@@ -216,7 +225,7 @@ async def launch(request: Request, tool: Tool) -> Response:
         )
         response = _page(open_app_page(target, lang)) if framed else RedirectResponse(target, status_code=303)
         response.headers["Referrer-Policy"] = "no-referrer"
-    response.delete_cookie(state_cookie(found.state), path="/lti")
+    response.delete_cookie(state_cookie(found.state), path=tool.urls.cookie_path)
     return response
 
 
