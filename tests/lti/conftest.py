@@ -17,6 +17,7 @@ import pytest
 from tests.lti.platform import MEMBERSHIP, READ, SCORE, Item, Link, Person, TestPlatform, auth_params
 from tpm_viz.app.lessons import DEMOS
 from tpm_viz.classroom.launches import Tickets
+from tpm_viz.lti import refusals
 from tpm_viz.lti.config import read_config
 from tpm_viz.lti.deeplinking import Item as Offered
 from tpm_viz.lti.deeplinking import lessons_catalogue
@@ -141,3 +142,9 @@ def ref_of(answer: httpx.Response, tickets: Tickets) -> Any:
     assert answer.status_code == 303, answer.text
     ticket = parse_qs(urlsplit(answer.headers["location"]).query)["lti"][0]
     return tickets.take(tickets.arrive(ticket))[1]
+
+
+@pytest.fixture(autouse=True)
+def fresh_refusal_log() -> None:
+    """Each test starts with a fresh second of the refusal log (a flood in the test before must not silence it)."""
+    refusals._window[:] = [0.0, 0, 0]
