@@ -13,7 +13,8 @@ Layers, bottom up (a module may import its own layer and the layers its rule lis
 - ``app/``: pure app behaviour, no viser, no pinocchio;
 - ``design/``: the design studio over the app's planner (the only place that imports Dask: ``design/cluster.py``);
 - ``classroom/``: the classroom's shared state, runs, store, identities, links, saving and jobs (no viser);
-- ``lti/``: the LTI 1.3 tool (an ASGI service), over the classroom;
+- ``lti/``: the LTI 1.3 tool (the optional extra ``.[lti]``), an ASGI service over the classroom; never viser (the app
+  applies its launches in ``ui/launched.py``);
 - ``viserkit/``: the adapter, the only place that touches viser's or websockets' internals;
 - ``ui/`` (with ``ui/widgets/`` and ``ui/teaching/``): the per-tab views through viser's public API;
 - ``cli/``: may import every layer; nothing imports it but ``__main__``.
@@ -47,7 +48,7 @@ RULES: dict[str, tuple[set[str], set[str]]] = {
     "app": ({"core", "paper", "app"}, {"numpy", "toppra", "scipy"}),
     "design": ({"core", "paper", "app", "design"}, {"numpy", "scipy", "distributed", "dask"}),
     "classroom": ({"core", "paper", "drawing", "app", "classroom"}, {"numpy", "platformdirs"}),
-    "lti": ({"core", "app", "classroom", "lti"}, {"jwt", "cryptography", "starlette", "uvicorn", "httpx"}),
+    "lti": ({"core", "app", "classroom", "lti"}, {"jwt", "cryptography", "starlette", "uvicorn", "httpx", "multipart"}),
     "viserkit": ({"core", "app", "classroom", "viserkit"}, {"numpy", "viser", "websockets"}),
     "ui": (set(LAYERS) - {"cli", "lti"}, {"numpy", "trimesh", "viser", "platformdirs", "segno"}),
     "cli": (set(LAYERS), {"numpy"}),

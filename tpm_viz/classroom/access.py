@@ -13,6 +13,9 @@ does not start again) and server-wide: :data:`MAX_FAILURES` per address per :dat
 each new lockout of that address lasts twice as long (up to :data:`MAX_LOCKOUT_SECONDS`), and at most
 :data:`MAX_FAILURES_SERVER` wrong attempts per :data:`LOCKOUT_SECONDS` from everybody together.
 
+With ``serve --lti`` presenter mode is on without a token too (``Access(required=True)``): only an instructor's
+launch (:mod:`tpm_viz.ui.launched`, :meth:`Access.grant`) or the ``--presenter-token`` login makes a presenter.
+
 Classroom mode (``tpm-viz serve --classroom``): a tab opened on the serving machine itself is a presenter
 (:meth:`Access.grant`), and the presenter can hand the shared mechanism to the class and take it back
 (``Access.open_to_class``).
@@ -73,9 +76,13 @@ def check_token(token: str | None) -> str | None:
 class Access:
     """The presenter token (or None) and the set of tabs that proved it. Thread-safe."""
 
-    def __init__(self, token: str | None = None, clock: Callable[[], float] = time.monotonic) -> None:
+    def __init__(
+        self, token: str | None = None, clock: Callable[[], float] = time.monotonic, required: bool = False
+    ) -> None:
+        """``required``: presenter mode even without a token (``serve --lti``: an instructor's launch grants it)."""
         checked = None if token is None else check_token(token)
         self._token = None if checked is None else checked.encode()
+        self._required = required
         self._presenters: weakref.WeakSet = weakref.WeakSet()
         self._failures: dict[str, list[float]] = {}  # source address -> times of recent wrong attempts
         self._lockouts: dict[str, tuple[float, int]] = {}  # source address -> (locked until, lockouts so far)
@@ -87,12 +94,12 @@ class Access:
 
     @property
     def enabled(self) -> bool:
-        """Whether presenter mode is on (a token was given)."""
-        return self._token is not None
+        """Whether presenter mode is on (a token was given, or it is ``required``)."""
+        return self._token is not None or self._required
 
     def is_presenter(self, view: Tab) -> bool:
         """Whether ``view`` may change the shared mechanism (always True without presenter mode)."""
-        if self._token is None:
+        if not self.enabled:
             return True
         with self._lock:
             return view in self._presenters
@@ -100,7 +107,7 @@ class Access:
     def is_presenter_tab(self, view: Tab) -> bool:
         """Whether ``view`` logged in (or was granted): presenter mode only; False without a token."""
         with self._lock:
-            return self._token is not None and view in self._presenters
+            return self.enabled and view in self._presenters
 
     def grant(self, view: Tab) -> None:
         """Make ``view`` a presenter tab without a token (a tab opened on the serving machine, classroom mode)."""
@@ -120,7 +127,7 @@ class Access:
         """Make ``view`` a presenter tab if ``attempt`` is the token; raises after too many wrong attempts from
         ``source`` (the tab's address; default: the tab itself) or from everybody (see the module docstring)."""
         if self._token is None:
-            return True
+            return not self._required  # presenter mode without a token: no login makes a presenter
         now = self._clock()
         where = source if source is not None else f"tab-{id(view)}"
         with self._lock:

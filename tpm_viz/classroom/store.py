@@ -3,6 +3,7 @@
 Records: the lecture (one row, never evicted), one row per remembered browser (its tabs that left, with the source
 address they came from) and the uploaded trajectories once each by SHA-256 of their bytes (:meth:`Store.put_blob`).
 A record's body is JSON text; one that cannot be read is skipped (:attr:`Contents.skipped`), the rest load.
+Schema 2 adds the LTI tool's tables (``lti_*``), read and written by :mod:`tpm_viz.lti.ledger` (docs/lti.md §9).
 
 :func:`open_store` never destroys what it cannot read: a file that is not a SQLite database, is damaged
 (``PRAGMA quick_check``), was written by a newer schema (``PRAGMA user_version``) or is larger than
@@ -44,7 +45,7 @@ __all__ = [
     "open_store",
 ]
 
-SCHEMA = 1
+SCHEMA = 2
 """Schema version (``PRAGMA user_version``); a store of a higher one is moved aside, never half-read."""
 _HEADER = b"SQLite format 3\x00"
 _TABLES = (
@@ -55,8 +56,18 @@ _TABLES = (
     "used REAL NOT NULL)",
     "CREATE TABLE IF NOT EXISTS imports (digest TEXT PRIMARY KEY, source TEXT NOT NULL, at REAL NOT NULL)",
 )
+_LTI_TABLES = (  # schema 2: the LTI tool's records (tpm_viz/lti/ledger.py, docs/lti.md)
+    "CREATE TABLE IF NOT EXISTS lti_users (issuer TEXT NOT NULL, subject TEXT NOT NULL, ident TEXT NOT NULL UNIQUE, "
+    "seen REAL NOT NULL, PRIMARY KEY (issuer, subject))",
+    "CREATE TABLE IF NOT EXISTS lti_class (id INTEGER PRIMARY KEY CHECK (id = 1), body TEXT NOT NULL)",
+    "CREATE TABLE IF NOT EXISTS lti_launches (ref TEXT PRIMARY KEY, browser TEXT, body TEXT NOT NULL, "
+    "at REAL NOT NULL)",
+    "CREATE TABLE IF NOT EXISTS lti_outbox (id INTEGER PRIMARY KEY AUTOINCREMENT, grade TEXT NOT NULL, "
+    "body TEXT NOT NULL, state TEXT NOT NULL, tries INTEGER NOT NULL, due REAL NOT NULL, why TEXT NOT NULL)",
+    "CREATE TABLE IF NOT EXISTS lti_grades (grade TEXT PRIMARY KEY, best REAL NOT NULL, stamp TEXT NOT NULL)",
+)
 _HEX64 = re.compile(r"[0-9a-f]{64}")
-MIGRATIONS: dict[int, tuple[str, ...]] = {0: _TABLES}
+MIGRATIONS: dict[int, tuple[str, ...]] = {0: _TABLES, 1: _LTI_TABLES}
 """Statements that take a store of schema ``n`` to ``n + 1`` (0: a new, empty database)."""
 
 

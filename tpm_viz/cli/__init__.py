@@ -4,7 +4,8 @@ One module per family of subcommands, each with a ``register(subparsers, common)
 
 - :mod:`.paper`: ``kinematics``, ``dynamics``, ``trajectory`` (the paper's closed form);
 - :mod:`.multibody`: ``replay``, ``crosscheck``, ``figures`` (the Pinocchio model);
-- :mod:`.serve`: ``serve`` (the browser app);
+- :mod:`.serve`: ``serve`` (the browser app; ``--lti``: as an LTI 1.3 tool of an LMS);
+- :mod:`.lti`: ``lti keygen`` (the LTI tool's key);
 - :mod:`.plan`: ``plan`` (minimum-time timing within force limits) and ``size`` (the motors a motion needs);
 - :mod:`.control`: ``control`` (a controller tracking a trajectory on the Pinocchio plant);
 - :mod:`.export`: ``export`` (the model as MJCF or URDF);
@@ -21,7 +22,7 @@ from __future__ import annotations
 import csv
 import sys
 
-from tpm_viz.cli import control, design, exercise, export, multibody, outputs, paper, plan, serve
+from tpm_viz.cli import control, design, exercise, export, lti, multibody, outputs, paper, plan, serve
 from tpm_viz.cli.common import Parser, common_parent, one_line, params_from_args
 from tpm_viz.core.errors import TpmVizError
 
@@ -33,7 +34,7 @@ def build_parser() -> Parser:
     parser = Parser(prog="tpm-viz", description=(__doc__ or "").splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
     common = common_parent()
-    for family in (paper, serve, multibody, control, plan, export, outputs, design, exercise):
+    for family in (paper, serve, lti, multibody, control, plan, export, outputs, design, exercise):
         family.register(sub, common)
     return parser
 

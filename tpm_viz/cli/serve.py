@@ -18,6 +18,7 @@ import threading
 from pathlib import Path
 
 from tpm_viz.cli.common import port_number
+from tpm_viz.cli.lti import lti_plug
 from tpm_viz.core.errors import InputError
 from tpm_viz.core.numbers import shorten
 
@@ -67,6 +68,11 @@ def check_bind(host: str, port: int) -> None:
 def _cmd_serve(args) -> int:
     host = args.host if args.host is not None else "0.0.0.0" if args.classroom else "127.0.0.1"
     check_bind(host, args.port)
+    plug = (
+        None
+        if args.lti is None
+        else lti_plug(args.lti, host, args.lessons, args.trusted_proxy or [], args.allowed_host or [])
+    )
     from tpm_viz.ui.app import main as serve  # start-up speed of the other commands (module docstring)
     from tpm_viz.ui.continuity import default_path
 
@@ -80,6 +86,7 @@ def _cmd_serve(args) -> int:
         lessons=args.lessons,
         trusted_proxies=args.trusted_proxy or (),
         allowed_hosts=args.allowed_host or (),
+        lti=plug,
     )
     return 0
 
@@ -137,5 +144,12 @@ def register(sub, common: argparse.ArgumentParser) -> None:
         action="append",
         metavar="NAME",
         help="answer to this host name too (the name students type when a proxy or DNS serves the app; repeatable)",
+    )
+    s.add_argument(
+        "--lti",
+        type=Path,
+        metavar="CONFIG",
+        help="serve as an LTI 1.3 tool of the LMS in CONFIG.toml (docs/lti.md): only an instructor's launch (or the "
+        "presenter token) presents; needs the .[lti] extra",
     )
     s.set_defaults(func=_cmd_serve)

@@ -34,17 +34,20 @@ from tpm_viz.app.state import AppState
 from tpm_viz.classroom.access import Access
 from tpm_viz.classroom.guard import guarded, log, log_fault, report
 from tpm_viz.classroom.identity import Keys
+from tpm_viz.classroom.launches import Plug, Tickets
 from tpm_viz.classroom.network import HostRules, Network
 from tpm_viz.classroom.runtime import tune_for_serving
 from tpm_viz.classroom.session import Hub
 from tpm_viz.core.errors import InputError, TpmVizError
 from tpm_viz.core.params import Params
 from tpm_viz.core.words import Lang, Phrase, say
-from tpm_viz.ui.classroom import Classroom, Handshakes, local_addresses, qr_text, student_urls
+from tpm_viz.ui.announce import nobody, serving
+from tpm_viz.ui.classroom import Classroom, Handshakes, local_addresses
 from tpm_viz.ui.client import ClientView
 from tpm_viz.ui.continuity import LectureStore, lecture_store
 from tpm_viz.ui.guide import Guides
 from tpm_viz.ui.keyboard import keyboard_of
+from tpm_viz.ui.launched import Launched
 from tpm_viz.ui.login import LoginPanel
 from tpm_viz.ui.look import dock_panel
 from tpm_viz.ui.phone import is_touch
@@ -83,17 +86,22 @@ hall``)."""
 
 
 def build_server(
-    host: str = "127.0.0.1", port: int = 8080, hosts: HostRules | None = None, keys: Keys | None = None
+    host: str = "127.0.0.1",
+    port: int = 8080,
+    hosts: HostRules | None = None,
+    keys: Keys | None = None,
+    tickets: Tickets | None = None,
 ) -> viser.ViserServer:
     """A quiet viser server: no share tunnel, no environment map or shadows (fast first paint). ``hosts``: the
     ``Host`` names it answers to and the trusted proxies (default: this machine's names and addresses, no proxy);
-    ``keys``: the identity cookies' keys (default: the process's, :data:`~.classroom.DEFAULT_KEYS`).
+    ``keys``: the identity cookies' keys (default: the process's, :data:`~.classroom.DEFAULT_KEYS`); ``tickets``: the
+    LTI launches' (``serve --lti``).
 
     Raises :class:`~tpm_viz.viserkit.core.IncompatibleViserError` (one line) if the installed viser is not the tested
     one.
     """
     sys.setswitchinterval(GIL_SWITCH_INTERVAL)
-    handshakes = Handshakes(hosts or HostRules(addresses=local_addresses, bound=host), keys)
+    handshakes = Handshakes(hosts or HostRules(addresses=local_addresses, bound=host), keys, tickets=tickets)
     server = new_server(handshake=handshakes, host=host, port=port, label="tpm-viz", verbose=False)  # same-origin
     keyboard_of(server, handshakes.keyboard)  # the page script's keys reach this server's tabs (ui/keyboard.py)
     install(server)  # viser's patches on this server, in viserkit/PATCHES.md's order (viserkit/adapter.py)
@@ -124,10 +132,15 @@ class TpmApp:
         classroom: Classroom | None = None,
         store: LectureStore | None = None,
         lessons: tuple[Sequence[Demo], Sequence[str]] | None = None,
+        lti: Plug | None = None,
     ) -> None:
         self.server = server
         set_max_connections(server, max_connections)  # the next tab is told the class is full, then closed
-        self.access = Access(presenter_token if presenter_token or classroom is None else classroom.token)
+        token = presenter_token if presenter_token or classroom is None or lti else classroom.token
+        self.access = Access(token, required=lti is not None)  # --lti: an instructor's launch presents
+        self.lti = lti
+        self.launched = None if lti is None else Launched(self, lti.tickets)
+        """Tabs that arrive from the LMS (:mod:`.launched`), or None without ``--lti``."""
         state = AppState.initial(params)
         shared_scene = MechanismScene(server.scene, state.params, sink=server)  # drawn once for every tab
         self.hub = Hub(state, reference, self.access, shared_scene)
@@ -164,6 +177,7 @@ class TpmApp:
     def _connect(self, client: viser.ClientHandle) -> None:
         harden(client, lang=lambda: self._lang_of(client.client_id))  # malformed updates and big uploads dropped
         who = self.room.identify(client)  # before the view moves the camera
+        who, launch, fresh = (who, None, False) if self.launched is None else self.launched.arrive(client, who)
         view = self.room.build(who, lambda saved: ClientView(client, self.hub, self.services, saved=saved))
         if self.access.enabled:
             view.login = LoginPanel(view.gui, lambda event, view=view: self._login(event, view))
@@ -171,6 +185,8 @@ class TpmApp:
             self.views[client.client_id] = view
         self.keyboard.join(view)
         self.room.connected(view, who)  # presenter or not; what it had before a drop
+        if self.launched is not None:
+            self.launched.connected(view, launch, fresh)  # an LMS launch: presenter or student, its lesson
         self.guides.greet(view, who[0])  # the first visit's guide, unless this browser dismissed it (ui/guide.py)
         self.shares.connected(view, connection_request(self.server, client.client_id))  # a link: its own copy
         view.scene.set_touch(is_touch(connection_request(self.server, client.client_id)))  # a phone (ui/phone.py)
@@ -244,6 +260,8 @@ class TpmApp:
             tabs=len(views),
             shared=self.hub.shared_viewers(),
         )
+        if self.lti is not None and self.lti.tickets.course:  # the class label: the LMS course's title
+            count = Phrase("Course: {course}. {count}", course=self.lti.tickets.course, count=count)
         for view in views:
             if not view.session.shared:
                 parts = [count, Phrase("You see your own copy.")]
@@ -263,6 +281,8 @@ class TpmApp:
             if self._class_info_timer is not None:
                 self._class_info_timer.cancel()
         self.room.stop()
+        if self.lti is not None:
+            self.lti.stop()
         self.server.stop()
         self.hub.drag_pool.shutdown(wait=False, cancel_futures=True)
 
@@ -296,6 +316,7 @@ def main(
     lessons: str | Path | None = None,
     trusted_proxies: Sequence[str] = (),
     allowed_hosts: Sequence[str] = (),
+    lti: Plug | None = None,
 ) -> TpmApp:
     """Serve the app; print the real URL; block until Ctrl-C (or SIGTERM) unless ``block`` is False.
 
@@ -308,8 +329,10 @@ def main(
     tests inject theirs). ``lessons``: a folder of lesson files (or one file) for the *Demos* tab instead of the
     packaged ones; a refused file is one warning line, and no lesson at all is an error. ``trusted_proxies``: the
     reverse proxies whose X-Forwarded-For / Forwarded name the client; ``allowed_hosts``: more ``Host`` names to
-    answer to (:mod:`tpm_viz.classroom.network`)."""
+    answer to (:mod:`tpm_viz.classroom.network`). ``lti``: serve as an LTI tool too (``--lti``: docs/lti.md)."""
     access = Access(presenter_token)  # validates the token before anything starts
+    if lti is not None and session is None:
+        raise InputError("--lti keeps the LMS users and grades in the session store: give --session FILE")
     network = Network.of(trusted_proxies, allowed_hosts)
     tour = None if lessons is None else load_lessons(lessons)
     if tour is not None:
@@ -319,6 +342,8 @@ def main(
             print(f"warning: lesson refused: {problem}", file=sys.stderr)
     classroom = classroom or not is_loopback(host)
     room = Classroom(addresses=addresses or local_addresses) if classroom else None
+    if room is not None and lti is not None:
+        room.presenter_address = nobody  # --lti: this computer presents by a launch or the token only
     if room is not None and presenter_token:
         room.token = presenter_token
     if not is_loopback(host):
@@ -336,15 +361,16 @@ def main(
     if store is not None:
         store.open()  # its notices, and the cookie keys kept beside it, before the first page
     keys = None if store is None else store.keys
-    server = build_server(host, port, HostRules(network, addresses or local_addresses, bound=host), keys)
-    app = TpmApp(server, presenter_token=presenter_token, classroom=room, store=store, lessons=tour)
+    tickets = None if lti is None else lti.tickets
+    server = build_server(host, port, HostRules(network, addresses or local_addresses, bound=host), keys, tickets)
+    app = TpmApp(server, presenter_token=presenter_token, classroom=room, store=store, lessons=tour, lti=lti)
     tune_for_serving()  # the collector and the threads' turns of a serving process (classroom/runtime.py)
     if not block:
-        _serving(app, host, room)
+        serving(app, host, room)
         return app
     signal.signal(signal.SIGTERM, _interrupt)  # before the URL is printed: a stop right after it saves too
     try:
-        _serving(app, host, room)
+        serving(app, host, room)
         while True:  # short sleeps: a signal delivered to another thread does not cut the main thread's sleep,
             time.sleep(0.5)  # and Python runs the handler only when the main thread runs again
     except KeyboardInterrupt:
@@ -354,30 +380,5 @@ def main(
     return app
 
 
-def _serving(app: TpmApp, host: str, room: Classroom | None) -> None:
-    """The one line with the URL (and in classroom mode the students' URLs, QR code and token)."""
-    shown = "127.0.0.1" if host in ("0.0.0.0", "::") else host
-    print(f"tpm-viz serving at http://{shown}:{app.port}", flush=True)
-    if room is not None:
-        _announce(app, room, bound=host)
-
-
 def _interrupt(signum, frame) -> None:
     raise KeyboardInterrupt
-
-
-def _announce(app: TpmApp, room: Classroom, bound: str) -> None:
-    """Classroom mode: the URLs students type, a QR code of the first, and the presenter token (terminal only)."""
-    urls = student_urls("0.0.0.0", app.port, room.addresses())
-    if not urls:
-        print("No network address found: connect this computer to the room's network and restart.", flush=True)
-    for url in urls:
-        print(f"Students open: {url}", flush=True)
-    if is_loopback(bound):
-        print(f"(bound to {bound} only: students cannot connect; serve with --host 0.0.0.0)", flush=True)
-    if urls:
-        print(qr_text(urls[0]), end="", flush=True)
-    print(
-        "A tab opened on this computer is the presenter. To present from another device, log in there with", flush=True
-    )
-    print(f"the presenter token {room.token} (shown here only: keep it off the projector).", flush=True)

@@ -14,7 +14,8 @@
   how a tab that comes back after a wifi blip or a restart is recognised (:func:`identity`). A page asked with
   ``?share=TOKEN`` (a share link, :mod:`tpm_viz.classroom.links`) gets a short-lived ``tpmviz_share`` cookie naming
   where its token waits (:data:`PENDING`); that page's websocket brings it back and :func:`shared_token` hands the token
-  over once (:mod:`.share` opens it on the tab's own copy).
+  over once (:mod:`.share` opens it on the tab's own copy). A page asked with ``?lti=TICKET`` (``serve --lti``) spends
+  the LTI launch's one-time ticket and carries its launch the same way (``tpmviz_lti``, :mod:`.launched`).
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ from urllib.parse import urlsplit
 import segno
 
 from tpm_viz.classroom.identity import Keys, hashed
+from tpm_viz.classroom.launches import TICKET_SECONDS, Tickets, ticket_of_query
 from tpm_viz.classroom.links import PENDING_SECONDS, PendingLinks, token_of_query
 from tpm_viz.classroom.network import PROXIED, HostRules, client_address, header_problem, host_name
 from tpm_viz.ui.keyboard import Keyboard
@@ -43,12 +45,14 @@ from tpm_viz.viserkit.page import with_script
 
 __all__ = [
     "COOKIE",
+    "LAUNCH_COOKIE",
     "PENDING",
     "SHARE_COOKIE",
     "Classroom",
     "Handshakes",
     "identity",
     "is_loopback_address",
+    "launch_nonce",
     "local_addresses",
     "qr_data_uri",
     "qr_text",
@@ -66,6 +70,8 @@ DEFAULT_KEYS = Keys()
 _PAGES = ("/", "/index.html")
 SHARE_COOKIE = "tpmviz_share"
 """The short-lived cookie that carries a share link's nonce from the page to its websocket (:mod:`.share`)."""
+LAUNCH_COOKIE = "tpmviz_lti"
+"""The short-lived cookie that carries an LTI launch's nonce from the page to its websocket (:mod:`.launched`)."""
 PENDING = PendingLinks()
 """The share tokens of pages whose tab has not connected yet (this process's; :class:`Handshakes` fills it)."""
 
@@ -166,16 +172,26 @@ def _cookie(headers: Any, keys: Keys) -> str | None:
 
 def _share_nonce(headers: Any) -> str | None:
     """The value of the share cookie (:data:`SHARE_COOKIE`) a request carries, else None."""
+    return _cookie_value(headers, SHARE_COOKIE)
+
+
+def _cookie_value(headers: Any, name: str) -> str | None:
+    """The value of the cookie ``name`` a request carries, else None (a malformed Cookie header: None)."""
     raw = None if headers is None else headers.get("Cookie")
-    if not raw or SHARE_COOKIE not in raw:
+    if not raw or name not in raw:
         return None
     try:
         jar: SimpleCookie = SimpleCookie()
         jar.load(raw)
-    except Exception:  # a malformed Cookie header: no link
+    except Exception:
         return None
-    morsel = jar.get(SHARE_COOKIE)
+    morsel = jar.get(name)
     return None if morsel is None else morsel.value
+
+
+def launch_nonce(headers: Any) -> str | None:
+    """The value of the launch cookie (:data:`LAUNCH_COOKIE`) a websocket handshake carries, else None."""
+    return _cookie_value(headers, LAUNCH_COOKIE)
 
 
 def shared_token(headers: Any, links: PendingLinks = PENDING) -> str | None:
@@ -203,9 +219,15 @@ class Handshakes:
     identity, and keep a share link's token for the tab the page opens (:data:`SHARE_COOKIE`)."""
 
     def __init__(
-        self, hosts: HostRules | None = None, keys: Keys | None = None, links: PendingLinks | None = None
+        self,
+        hosts: HostRules | None = None,
+        keys: Keys | None = None,
+        links: PendingLinks | None = None,
+        tickets: Tickets | None = None,
     ) -> None:
         self.refused = 0
+        self.tickets = tickets
+        """The LTI launches' one-time tickets (``serve --lti``), or None."""
         self.links = links if links is not None else PENDING
         """Where a page's share token waits for its websocket (:func:`shared_token` reads it)."""
         self.keys = keys if keys is not None else DEFAULT_KEYS
@@ -278,7 +300,18 @@ class Handshakes:
             )
         if response is not None and response.status_code == 200 and path in _PAGES:
             self._share(connection, request.path, headers, response)
+            self._launch(request.path, response)
         return response
+
+    def _launch(self, target: str, response: Any) -> None:
+        """A page asked with ``?lti=TICKET`` (``serve --lti``): spend the ticket now, once, and keep its launch for
+        this page's tab under a nonce in a short-lived cookie (:class:`~tpm_viz.classroom.launches.Tickets`)."""
+        ticket = ticket_of_query(target.partition("?")[2])
+        if self.tickets is not None and ticket is not None:
+            nonce = self.tickets.arrive(ticket)
+            response.headers["Set-Cookie"] = (
+                f"{LAUNCH_COOKIE}={nonce}; Path=/; Max-Age={int(TICKET_SECONDS)}; HttpOnly; SameSite=Strict"
+            )
 
     def _share(self, connection: Any, target: str, headers: Any, response: Any) -> None:
         """A page asked with ``?share=TOKEN``: keep the token for this page's tab, its nonce in a cookie; a page

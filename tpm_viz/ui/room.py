@@ -100,11 +100,13 @@ class Room:
         return identity(remote, headers, self.store.keys), str(host), camera
 
     def build(self, who: tuple[str | None, str, Any], make: Callable[[Saved | None], V]) -> V:
-        """Build a connecting tab's view with ``make(saved)``: a browser known by its cookie that left an own copy
-        (:meth:`identify`'s ``who``) is built on that copy from its first draw (``saved``), any other on the shared
-        mechanism (None). What it left is taken back here, and kept again if the build fails."""
+        """Build a connecting tab's view with ``make(saved)``: a browser known by its cookie (or an LMS user,
+        :mod:`.launched`) that left an own copy (:meth:`identify`'s ``who``) is built on that copy from its first
+        draw (``saved``), any other on the shared mechanism (None). What it left is taken back here, and kept again
+        if the build fails."""
         key, host, camera = who
-        record = self.away.take(key, camera) if key is not None and key.startswith("c:") else None  # its own lock
+        known = key is not None and key.startswith(("c:", "u:"))  # a signed cookie, or an LMS user (.launched)
+        record = self.away.take(key, camera) if known and key is not None else None  # its own lock
         own = record is not None and record["private"] and record["saved"] is not None
         try:
             view = make(record["saved"] if own and record is not None else None)
