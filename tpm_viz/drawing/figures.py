@@ -16,6 +16,8 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from tpm_viz.core.files import write_atomically
+
 __all__ = ["FILE_NAMES", "PRINT_DPI", "TITLES", "ForceCurves", "force_plot_png", "force_plot_svg", "plot_forces"]
 
 TITLES = {
@@ -80,7 +82,7 @@ def plot_forces(cmp: ForceCurves, path: str | pathlib.Path, dpi: int = 100) -> p
     title = f"{TITLES.get(cmp.kind, cmp.kind)}, T = {cmp.duration:g} s"
     fig = _force_figure(cmp.t, cmp.tau_paper, cmp.tau_pinocchio, title, dpi)
     path = pathlib.Path(path)
-    fig.savefig(path, format="png", dpi=dpi)
+    write_atomically(path, _save(fig, "png", dpi))  # never into a device or FIFO (tpm_viz.core.files)
     return path
 
 

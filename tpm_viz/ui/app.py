@@ -338,6 +338,8 @@ def main(
     keys = None if store is None else store.keys
     server = build_server(host, port, HostRules(network, addresses or local_addresses, bound=host), keys)
     app = TpmApp(server, presenter_token=presenter_token, classroom=room, store=store, lessons=tour)
+    if store is not None:
+        store.serving(app.port)  # a second server on this store is refused naming this port (classroom/storelock.py)
     tune_for_serving()  # the collector and the threads' turns of a serving process (classroom/runtime.py)
     if not block:
         _serving(app, host, room)
