@@ -2,8 +2,8 @@
 
 :func:`harden_server` (called once by :func:`~.adapter.install`) installs, on one viser server:
 
-- **Bounded work per tab** (:class:`Gate`, in front of viser's callback thread pool): a tab's callbacks run one at a
-  time (a flooding tab holds one pool thread, not 32); meanwhile each callback has at most one call waiting
+- **Bounded work per tab** (:class:`~.gate.Gate`, in front of viser's callback thread pool): a tab's callbacks run
+  one at a time (a flooding tab holds one pool thread, not 32); meanwhile each callback has at most one call waiting
   (repeated clicks on an export coalesce into it, latest event wins) except clicks in the 3D view, which each
   carry their own point and wait in turn; at most :attr:`Limits.max_callbacks_per_tab` in all, the rest are
   dropped with a rate-limited log line. Connect and disconnect callbacks are never gated.
@@ -12,8 +12,12 @@
   installed by :mod:`.adapter`); a watchdog thread drops a connection whose
   outgoing backlog (messages queued and not yet written: a tab that stopped reading) stays over
   :attr:`Limits.max_backlog_bytes` for :attr:`Limits.backlog_grace` seconds, and meanwhile runs none of its callbacks;
-  after tabs leave it returns freed heap to the system (``malloc_trim``); at most :attr:`Limits.max_connections`
-  tabs (the next one is told so in a notification, then closed). Uploads are bounded per tab in :mod:`.transport`.
+  after tabs leave it returns freed heap to the system (``malloc_trim``). Uploads are bounded per tab in
+  :mod:`.transport`.
+- **Bounded connections** (:class:`~.admission.Admission`): at most :attr:`Limits.max_connections` tabs, at most
+  :attr:`Limits.max_per_address` from one source address, :attr:`Limits.lecturer_slots` kept for the lecturer's
+  machine, and a socket that sends nothing within :attr:`Limits.first_message_seconds` is dropped (a refused tab is
+  told why in a notification, then closed).
 - **Well-formed messages only**: every incoming message is checked against its declared field types
   (:func:`~.transport.message_problem`) before viser dispatches it; a handler that still fails is one log line. A
   tab that sends more than :attr:`Limits.max_malformed` malformed messages within :attr:`Limits.malformed_window`
@@ -26,7 +30,6 @@ All drops are logged through :func:`~.guard.log_fault` (one line per second per 
 from __future__ import annotations
 
 import collections
-import concurrent.futures
 import ctypes
 import dataclasses
 import functools
@@ -38,21 +41,29 @@ from typing import Any
 import viser
 
 from tpm_viz.classroom.guard import FAULTS, log_fault, report
+from tpm_viz.viserkit.admission import Admission, is_loopback
 from tpm_viz.viserkit.core import ServerDoor, thread_pool
+from tpm_viz.viserkit.gate import Gate
 from tpm_viz.viserkit.transport import message_problem
 from tpm_viz.viserkit.wire import Incoming, Wrapper
 
 __all__ = [
     "DEFAULT_MAX_CONNECTIONS",
+    "DEFAULT_MAX_PER_ADDRESS",
     "Gate",
     "Limits",
     "ServerGuard",
     "guard_of",
     "harden_server",
+    "set_admission",
     "set_max_connections",
 ]
 
 DEFAULT_MAX_CONNECTIONS = 200
+"""Most tabs at once (a lecture hall of 150 with room to spare; ``bench_load.py --mode hall`` measures 150)."""
+DEFAULT_MAX_PER_ADDRESS = 50
+"""Most tabs from one source address: a quarter of the total, so one student's sockets leave the class room, and a
+class of 50 behind one router (NAT) still fits."""
 
 
 @dataclasses.dataclass
@@ -60,6 +71,12 @@ class Limits:
     """The limits of one server (see the module docstring)."""
 
     max_connections: int = DEFAULT_MAX_CONNECTIONS
+    max_per_address: int = DEFAULT_MAX_PER_ADDRESS
+    lecturer_slots: int = 10
+    """Places only the lecturer's tabs may take (at most a quarter of ``max_connections``)."""
+    first_message_seconds: float = 10.0
+    lecturer: Callable[[str], bool] = is_loopback
+    """Whether a source address is the lecturer's machine (no per-address cap, the kept places)."""
     max_frame_bytes: int = 1 << 20
     max_callbacks_per_tab: int = 8
     max_backlog_bytes: int = 32 << 20
@@ -69,115 +86,6 @@ class Limits:
     refuse_close_delay: float = 1.0
     max_malformed: int = 1000
     malformed_window: float = 10.0
-
-
-def _client_of(args: tuple) -> int | None:
-    """The tab a pool task works for (its event's ``client_id``), or None (connect/disconnect, server tasks)."""
-    event = args[0] if args else None
-    if event is None or isinstance(event, viser.ClientHandle):
-        return None
-    client_id = getattr(event, "client_id", None)
-    return client_id if isinstance(client_id, int) and not isinstance(client_id, bool) else None
-
-
-_CLICKS = (viser.SceneClickEvent, viser.ScenePointerEvent, viser.SceneNodePointerEvent, viser.SceneRectSelectEvent)
-"""Events that carry where the tab clicked: never merged with another."""
-
-
-def _done() -> concurrent.futures.Future:
-    future: concurrent.futures.Future = concurrent.futures.Future()
-    future.set_result(None)
-    return future
-
-
-class Gate:
-    """Per-tab admission in front of an executor's ``submit`` (see the module docstring): one call of a tab runs at a
-    time; while it runs, each callback of that tab has at most one call waiting (a repeated call replaces the
-    waiting one's event: latest wins; a click in the 3D view waits as its own call, its point is not another's), at
-    most ``max_per_tab`` waiting in all; waiting calls run in arrival order."""
-
-    def __init__(self, submit: Callable[..., concurrent.futures.Future[Any]], max_per_tab: int = 8) -> None:
-        self._submit, self.max_per_tab = submit, max_per_tab
-        self._lock = threading.Lock()
-        self._waiting: dict[int, dict[Any, tuple]] = {}  # tab -> key -> (fn, args, kwargs); present = one running
-        self._clicks = 0  # numbers the waiting 3D clicks (each its own key)
-        self.blocked: set[int] = set()
-        self.merged = 0
-        self.dropped = 0
-
-    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> concurrent.futures.Future[Any]:
-        client_id = _client_of(args)
-        if client_id is None:  # connect and disconnect callbacks: never gated
-            try:
-                return self._submit(fn, *args, **kwargs)
-            except RuntimeError:  # the pool is shut down (a tab left while the server stops): nothing to run
-                return _done()
-        with self._lock:
-            waiting = self._waiting.get(client_id)
-            if isinstance(args[0], _CLICKS):  # each click its own key: never merged
-                self._clicks += 1
-                key: Any = (fn, self._clicks)
-            else:
-                key = fn
-            if client_id in self.blocked:
-                reason = "the tab is not reading what it is sent"
-            elif waiting is None:
-                self._waiting[client_id] = {}
-                reason = ""
-            elif key in waiting:
-                waiting[key] = (fn, args, kwargs)
-                self.merged += 1
-                return _done()
-            elif len(waiting) < self.max_per_tab:
-                waiting[key] = (fn, args, kwargs)
-                return _done()
-            else:
-                reason = "too many of its callbacks are queued"
-            if reason:
-                self.dropped += 1
-        if reason:
-            log_fault(client_id, "flood", f"callback dropped: {reason}")
-            return _done()
-        return self._start(client_id, fn, args, kwargs)
-
-    def _start(
-        self, client_id: int, fn: Callable[..., Any], args: tuple[Any, ...], kwargs: dict[str, Any]
-    ) -> concurrent.futures.Future[Any]:
-        @functools.wraps(fn)
-        def run(*a: Any, **k: Any) -> Any:
-            try:
-                return fn(*a, **k)
-            finally:
-                self._next(client_id)
-
-        try:
-            return self._submit(run, *args, **kwargs)
-        except RuntimeError:  # the pool is shut down (the server is stopping): nothing runs any more
-            with self._lock:
-                self._waiting.pop(client_id, None)
-            return _done()
-
-    def _next(self, client_id: int) -> None:
-        with self._lock:
-            waiting = self._waiting.get(client_id)
-            if not waiting:
-                self._waiting.pop(client_id, None)
-                return
-            fn, args, kwargs = waiting.pop(next(iter(waiting)))
-        self._start(client_id, fn, args, kwargs)
-
-    def forget(self, client_id: int) -> None:
-        """A tab left: its waiting calls are dropped (a running one finishes)."""
-        with self._lock:
-            self.blocked.discard(client_id)
-            if client_id in self._waiting:
-                self._waiting[client_id] = {}
-
-    def pending(self, client_id: int) -> int:
-        """Calls of this tab running or waiting."""
-        with self._lock:
-            waiting = self._waiting.get(client_id)
-            return 0 if waiting is None else 1 + len(waiting)
 
 
 @functools.cache
@@ -205,8 +113,8 @@ class ServerGuard:
         self._submit = pool.__dict__.get("submit")  # an instance's own (the callbacks' guard), or None: the class's
         self.gate = Gate(pool.submit, limits.max_callbacks_per_tab)
         pool.submit = self.gate.submit
-        self.accepted: set[int] = set()
-        self.refused: set[int] = set()
+        self.admission = Admission(self.door, limits, time.monotonic)
+        """Who gets a connection (:mod:`.admission`)."""
         self._malformed: dict[int, collections.deque[float]] = {}
         """Times of each tab's recent malformed messages (at most ``max_malformed + 1`` each)."""
         self.dropped = 0
@@ -220,21 +128,21 @@ class ServerGuard:
         self._thread.start()
 
     # -- connections ---------------------------------------------------------------------------------------------
+    @property
+    def accepted(self) -> dict[int, str]:
+        """The connections that hold a place, with their source address."""
+        return self.admission.accepted
+
+    @property
+    def refused(self) -> set[int]:
+        """The connections refused (told, closing) or dropped for malformed messages."""
+        return self.admission.refused
+
     def _connected(self, client_id: int) -> None:
-        if len(self.accepted) < self.limits.max_connections:
-            self.accepted.add(client_id)
-            return
-        self.refused.add(client_id)
-        n = self.limits.max_connections
-        log_fault("server", "full", f"connection {client_id} refused: {n} tabs are connected (max_connections)")
-        self.door.notify(client_id, "Too many tabs", f"This server takes at most {n} tabs. Try again later.")
-        loop = self.door.loop
-        if loop is not None:
-            loop.call_later(self.limits.refuse_close_delay, self.door.close, client_id, 1013, "too many tabs")
+        self.admission.admit(client_id)
 
     def _disconnected(self, client_id: int) -> None:
-        self.accepted.discard(client_id)
-        self.refused.discard(client_id)
+        self.admission.left(client_id)
         self._malformed.pop(client_id, None)
         self.gate.forget(client_id)
         FAULTS.forget(client_id)
@@ -242,6 +150,7 @@ class ServerGuard:
     def _wrap(self, log: bool) -> Wrapper:
         def wrap(dispatch: Incoming) -> Incoming:
             async def handle(client_id: int, message: Any) -> None:
+                self.admission.heard(client_id)  # its first message: the deadline is met
                 if client_id in self.refused:
                     return
                 problem = message_problem(message)
@@ -292,6 +201,7 @@ class ServerGuard:
             live = set(self.door.live())
             try:
                 self._check(live, over, now)
+                self.admission.expire(now)
             except Exception as exc:  # one bad round must not stop the watchdog: logged, the next one runs
                 report(exc, "the watchdog's round")
             if known - live:
@@ -356,6 +266,20 @@ def guard_of(server: viser.ViserServer) -> ServerGuard | None:
     """The guard installed on ``server``, if any (``TpmApp(max_connections=...)`` sets its limit)."""
     guard = getattr(server, _ATTR, None)
     return guard if isinstance(guard, ServerGuard) else None
+
+
+def set_admission(
+    server: viser.ViserServer, lecturer: Callable[[str], bool] | None = None, max_per_address: int | None = None
+) -> None:
+    """Who the lecturer's machine is (``lecturer(address)``) and the most tabs per address, on ``server``
+    (installs the limits first if needed; :mod:`.admission`)."""
+    limits = harden_server(server).limits
+    if lecturer is not None:
+        limits.lecturer = lecturer
+    if max_per_address is not None:
+        if not (isinstance(max_per_address, int) and max_per_address >= 1):
+            raise ValueError(f"max_per_address must be a positive integer, got {max_per_address!r}")
+        limits.max_per_address = max_per_address
 
 
 def set_max_connections(server: viser.ViserServer, max_connections: int) -> None:
