@@ -20,8 +20,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-import os
-import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -38,7 +36,7 @@ from tpm_viz.app.state import AppState, TrajectorySample
 from tpm_viz.app.transitions import MAX_ACCEL, MAX_FORCE, MAX_POSITION, MAX_SPEED
 from tpm_viz.classroom.ranges import check_samples, within
 from tpm_viz.core.errors import InputError, TpmVizError
-from tpm_viz.core.files import loads_json, read_bytes
+from tpm_viz.core.files import loads_json, read_bytes, write_atomically
 from tpm_viz.core.params import PARAM_INFO, Params
 from tpm_viz.core.words import Lang, Phrase
 from tpm_viz.paper.trajectories import Trajectory
@@ -355,16 +353,8 @@ def read_file(path: Path) -> Document:
 
 
 def write_atomic(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` in one step: a temporary file in the same folder, then ``os.replace``."""
+    """Write ``text`` to ``path`` in one step (:func:`tpm_viz.core.files.write_atomically`: a temporary file in the
+    same folder, then ``os.replace``; a device, FIFO or folder at ``path`` is refused, never replaced)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=".tpm-viz-", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    write_atomically(path, text)
