@@ -79,6 +79,8 @@ async def _scenario(server: ServerProcess, n: int, mode: str, seconds: float, ra
         for tab in tabs:
             await tab.set_value("Work on my own copy", True)
     draggers = tabs
+    if mode in ("hall", "presenter"):  # a busy server sends the login's widgets late: waited for, not assumed
+        await _widget(tabs[0], "Presenter token")
     if mode == "hall":
         await tabs[0].set_value("Presenter token", TOKEN)
         await tabs[0].set_value("Log in as presenter", True)
@@ -136,6 +138,15 @@ async def _scenario(server: ServerProcess, n: int, mode: str, seconds: float, ra
         "per_tab": per_tab,
         "split": {k: np.array(v) * 1e3 for k, v in split.items() if v},
     }
+
+
+async def _widget(tab: Tab, label: str, limit: float = 60.0) -> None:
+    """Wait (at most ``limit`` s) until ``tab`` was sent the widget labelled ``label``."""
+    deadline = time.monotonic() + limit
+    while label not in tab.uuids:
+        if time.monotonic() > deadline:
+            raise TimeoutError(f"no {label!r} widget within {limit:g} s")
+        await asyncio.sleep(0.05)
 
 
 async def _quiet(server: ServerProcess, limit: float = 30.0) -> None:
