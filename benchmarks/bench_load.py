@@ -65,14 +65,22 @@ async def _drag_loop(tab: Tab, seconds: float, rate: float, index: int, rng: ran
     return sends
 
 
-async def _scenario(server: ServerProcess, n: int, mode: str, seconds: float, rate: float) -> dict:
+OPEN_SECONDS = 2.0
+"""Time allowed per tab to open [s] (150 tabs on a busy 2-core machine take minutes), on top of the drag window."""
+
+
+async def _scenario(server: ServerProcess, n: int, mode: str, seconds: float, rate: float, progress: dict) -> dict:
     tabs = [Tab(server.port, f"tab{k}") for k in range(n)]
     for tab in tabs:  # one at a time, like a class arriving
         await tab.open()
+        progress["opened"] += 1
+    progress["step"] = "joining and logging in"
     if mode == "private":
         for tab in tabs:
             await tab.set_value("Work on my own copy", True)
     draggers = tabs
+    if mode in ("hall", "presenter"):  # a busy server sends the login's widgets late: waited for, not assumed
+        await _widget(tabs[0], "Presenter token")
     if mode == "hall":
         await tabs[0].set_value("Presenter token", TOKEN)
         await tabs[0].set_value("Log in as presenter", True)
@@ -93,6 +101,7 @@ async def _scenario(server: ServerProcess, n: int, mode: str, seconds: float, ra
     for tab in tabs:
         tab.latencies.clear()
         tab.in_server.clear()
+    progress["step"] = "dragging"
     rng = random.Random(0)
     profiler = _start_profile(server.pid, seconds)
     cpu0, t0, own0, all0 = server.cpu_seconds(), time.perf_counter(), time.process_time(), machine_busy_seconds()
@@ -131,6 +140,15 @@ async def _scenario(server: ServerProcess, n: int, mode: str, seconds: float, ra
     }
 
 
+async def _widget(tab: Tab, label: str, limit: float = 60.0) -> None:
+    """Wait (at most ``limit`` s) until ``tab`` was sent the widget labelled ``label``."""
+    deadline = time.monotonic() + limit
+    while label not in tab.uuids:
+        if time.monotonic() > deadline:
+            raise TimeoutError(f"no {label!r} widget within {limit:g} s")
+        await asyncio.sleep(0.05)
+
+
 async def _quiet(server: ServerProcess, limit: float = 30.0) -> None:
     """Wait (at most ``limit`` s) until the server spends under a quarter of a core for half a second: the tabs'
     own copies are built and their first frames sent, so the measurement starts on a settled class."""
@@ -154,18 +172,24 @@ def _start_profile(pid: int, seconds: float) -> subprocess.Popen | None:
     return subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
 
+def _stats(ms: np.ndarray) -> str:
+    """``median M ms   p95 P ms   max X ms`` of latencies [ms], or why there are none."""
+    if not len(ms):
+        return "no update came back (all merged, or the drags were refused)"
+    return f"median {np.median(ms):6.1f} ms   p95 {np.percentile(ms, 95):6.1f} ms   max {ms.max():6.1f} ms"
+
+
 def _line(r: dict, mode: str) -> str:
     own = r["own"]
     merged = 1 - len(own) / max(r["sends"], 1)
     text = (
-        f"  N = {r['n']:>3}   server CPU {100 * r['cpu']:5.1f} %   latency median {np.median(own):6.1f} ms"
-        f"   p95 {np.percentile(own, 95):6.1f} ms   max {own.max():6.1f} ms   merged {100 * merged:4.1f} %"
+        f"  N = {r['n']:>3}   server CPU {100 * r['cpu']:5.1f} %   latency {_stats(own)}   merged {100 * merged:4.1f} %"
         f"   ({r['sends']} updates, RSS {r['rss']:.0f} MB; CPU of this client {100 * r['client_cpu']:.0f} %,"
         f" of other processes {100 * r['others']:.0f} %, stolen by the host {100 * r['stolen']:.0f} %)"
     )
     if mode in ("presenter", "hall") and len(r["watched"]):
         w = r["watched"]
-        text += f"\n           watchers: median {np.median(w):6.1f} ms   p95 {np.percentile(w, 95):6.1f} ms"
+        text += f"\n           watchers: {_stats(w)}"
     if mode == "hall" and r["per_tab"]:
         p = np.array(r["per_tab"])
         text += (
@@ -173,10 +197,7 @@ def _line(r: dict, mode: str) -> str:
             f", {int((p > 150).sum())} tab(s) over 150 ms"
         )
     for who, part in r.get("split", {}).items():  # where the time goes: the rest is sending, the network, the tab
-        text += (
-            f"\n           {who}: in the server (input sent -> update encoded) median {np.median(part):6.1f} ms"
-            f"   p95 {np.percentile(part, 95):6.1f} ms"
-        )
+        text += f"\n           {who}: in the server (input sent -> update encoded) {_stats(part)}"
     return text
 
 
@@ -200,9 +221,19 @@ def main() -> None:
     for n in [min(max(args.hall, 2), 190)] if args.mode == "hall" else args.tabs:
         n = n if args.mode == "hall" else max(1, min(n, 60))
         server = ServerProcess(TOKEN if args.mode in ("presenter", "hall") else None)
+        progress = {"opened": 0, "step": "opening tabs"}
+        budget = seconds + 60.0 + OPEN_SECONDS * n
         try:
-            result = asyncio.run(asyncio.wait_for(_scenario(server, n, args.mode, seconds, args.rate), seconds + 120))
+            scenario = _scenario(server, n, args.mode, seconds, args.rate, progress)
+            result = asyncio.run(asyncio.wait_for(scenario, budget))
             print(_line(result, args.mode), flush=True)
+        except Exception as exc:  # a result line either way: what happened, never a bare traceback
+            why = f"{type(exc).__name__}: {str(exc)[:120]}" if str(exc) else type(exc).__name__
+            print(
+                f"  N = {n:>3}   no result ({why}) while {progress['step']}, {progress['opened']} of {n} tabs open "
+                f"after at most {budget:.0f} s (a busy machine? rerun on a quiet one)",
+                flush=True,
+            )
         finally:
             server.stop()
             found = server.log_problems()

@@ -7,6 +7,7 @@ Network: only 127.0.0.1 and 192.0.2.1 (TEST-NET, never bindable here) are used, 
 from __future__ import annotations
 
 import csv
+import errno
 import io
 import os
 import socket
@@ -17,6 +18,7 @@ import time
 import numpy as np
 import pytest
 
+from tpm_viz.cli import main
 from tpm_viz.cli.common import write_output
 from tpm_viz.cli.serve import check_bind
 from tpm_viz.core.csvio import MAX_BYTES, MAX_ROWS
@@ -87,13 +89,19 @@ def test_a_failure_while_writing_leaves_the_old_file_and_no_temporary(tmp_path):
     assert os.listdir(tmp_path) == ["out.csv"]
 
 
-@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
-def test_disk_full_is_one_line_naming_the_output(tmp_path):
+def test_disk_full_is_one_line_naming_the_output(tmp_path, monkeypatch, capsys):
     src = tmp_path / "poses.csv"
     src.write_text(POSES)
-    one_line_error(
-        run("kinematics", "--input", str(src), "--output", "/dev/full"), "No space left on device: /dev/full"
-    )
+    out = tmp_path / "out.csv"
+
+    def full(fd):  # what a full disk answers (/dev/full is a device: refused, tests/cli/test_common_device_nodes.py)
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(os, "fsync", full)
+    assert main(["kinematics", "--input", str(src), "--output", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"No space left on device: {out}" in err, err
+    assert os.listdir(tmp_path) == ["poses.csv"]
 
 
 def test_a_closed_pipe_stops_quietly():
@@ -127,7 +135,7 @@ def test_a_file_over_the_size_cap_is_refused_at_once(tmp_path):
 
 @pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="needs /dev/zero")
 def test_dev_zero_is_refused_at_once():
-    one_line_error(run("kinematics", "--input", "/dev/zero", timeout=30), "not a text CSV file")
+    one_line_error(run("kinematics", "--input", "/dev/zero", timeout=30), "a system file, not a data file")
 
 
 def test_rows_beyond_the_cap_are_refused_while_streaming():

@@ -98,7 +98,7 @@ def test_a_users_csv_trajectory(tmp_path, capsys):
         (["--trajectory", "circle", "--controller", "ctc", "--force-limit", "-5"], "--force-limit"),
         (["--trajectory", "circle", "--controller", "ctc", "--wn", "0"], "natural frequency"),
         (["--trajectory", "circle", "--controller", "ctc", "--duration", "-1"], "--duration"),
-        (["--trajectory", "no/such/file.csv", "--controller", "ctc"], "cannot read"),
+        (["--trajectory", "no/such/file.csv", "--controller", "ctc"], "No such file"),
         (["--trajectory", "circle", "--controller", "ctc", "--wn", "400"], "at t ="),
         (["--controller", "ctc"], "--trajectory"),
     ],

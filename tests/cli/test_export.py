@@ -12,6 +12,7 @@ import tpm_viz as tv
 from tests.support.cli import parser_for
 from tpm_viz.cli import export as cli_export
 from tpm_viz.cli.common import common_parent
+from tpm_viz.core import files
 from tpm_viz.core.errors import InputError, InvalidParametersError
 from tpm_viz.exchange.mjcf import DEFAULT_SETTINGS, MjcfSettings, mjcf_text
 from tpm_viz.exchange.topology import joint_motion, topology
@@ -91,7 +92,7 @@ def test_a_failed_write_leaves_the_old_file_and_no_temporary(tmp_path, monkeypat
     def broken_replace(src, dst):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(cli_export.os, "replace", broken_replace)
+    monkeypatch.setattr(files.os, "replace", broken_replace)
     with pytest.raises(OSError):
         cli_export.write_atomically(str(out), "new model")
     assert out.read_text() == "previous model"

@@ -8,7 +8,8 @@ left is kept for :data:`~tpm_viz.classroom.sessionfile.KEEP_SECONDS`.
 Bounds: :data:`MAX_PER_BROWSER` tabs per browser, :data:`MAX_PER_ADDRESS` browsers per source address and
 :data:`MAX_AWAY` browsers in all. A new browser of an address that has its share pushes out that address's own
 oldest; when all are full, the oldest browser of the address holding the most goes (never another address's while
-this one has any). Every eviction is logged.
+this one has any). Evictions are logged at most once a minute per address (:data:`EVICTION_LOG_SECONDS`), the next
+line counting those not said (a student minting 400 cookies is one line, not 250).
 
 The presenter's right is never restored from a cookie alone: :meth:`Away.presenter` is true only for a record of a
 presenter's tab coming back from the same address within :data:`PRESENTER_SECONDS`; :meth:`Away.end_presenters`
@@ -23,9 +24,10 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+from tpm_viz.classroom.guard import Faults
 from tpm_viz.classroom.sessionfile import KEEP_SECONDS, Saved
 
-__all__ = ["MAX_AWAY", "MAX_PER_ADDRESS", "MAX_PER_BROWSER", "PRESENTER_SECONDS", "Away"]
+__all__ = ["EVICTION_LOG_SECONDS", "MAX_AWAY", "MAX_PER_ADDRESS", "MAX_PER_BROWSER", "PRESENTER_SECONDS", "Away"]
 
 log = logging.getLogger("tpm_viz.classroom")
 
@@ -35,6 +37,8 @@ MAX_PER_ADDRESS = 150
 MAX_AWAY = 2000
 PRESENTER_SECONDS = 120.0
 """How long [s] a presenter's tab that dropped may come back as the presenter (from the same address only)."""
+EVICTION_LOG_SECONDS = 60.0
+"""At most one log line per source address per this many seconds [s] about the browsers it had forgotten."""
 
 
 def _close(a: Any, b: Any) -> bool:
@@ -53,8 +57,10 @@ class Away:
 
     A record is ``{"private", "saved", "left_at", "camera", "presenter", "address"}``."""
 
-    def __init__(self, clock: Callable[[], float] = time.time) -> None:
+    def __init__(self, clock: Callable[[], float] = time.time, log_clock: Callable[[], float] = time.monotonic) -> None:
         self._clock = clock
+        self._said = Faults(EVICTION_LOG_SECONDS, log_clock, log, "browsers from %s: %s%s")
+        """The rate-limited log of evictions (one line per address per minute, then the count suppressed)."""
         self._lock = threading.Lock()
         self._tabs: dict[str, list[dict[str, Any]]] = {}
         self._address: dict[str, str] = {}
@@ -92,7 +98,7 @@ class Away:
             why = f"{MAX_AWAY} browsers remembered in all"
         else:
             return
-        log.warning("forgot the oldest remembered tabs of a browser at %s (%s)", self._address.get(victim), why)
+        self._said(self._address.get(victim), "evicted", f"forgot the oldest one's remembered tabs ({why})")
         self._forget(victim)
 
     def park(

@@ -85,13 +85,22 @@ ACTIVITY = Activity()
 
 
 class Faults:
-    """Rate-limited warnings: one line per ``interval`` seconds per ``(tab, kind)``, with the count suppressed."""
+    """Rate-limited warnings: one line per ``interval`` seconds per ``(tab, kind)``, with the count suppressed.
+    ``logger`` and ``line`` (a ``%``-format of the tab, the text and the count) say where and how (default: the
+    ``tpm_viz.ui`` logger, ``client <tab>: <text>``); a source address works as well as a tab."""
 
     MAX_KEYS = 10_000
     """Most ``(tab, kind)`` pairs remembered (older ones are forgotten first: tabs that left)."""
 
-    def __init__(self, interval: float = 1.0, clock: Callable[[], float] = time.monotonic) -> None:
+    def __init__(
+        self,
+        interval: float = 1.0,
+        clock: Callable[[], float] = time.monotonic,
+        logger: logging.Logger | None = None,
+        line: str = "client %s: %s%s",
+    ) -> None:
         self.interval, self._clock = interval, clock
+        self._log, self._line = logger or log, line
         self._lock = threading.Lock()
         self._last: dict[tuple[object, str], list[float]] = {}  # key -> [time of the last line, suppressed since]
         self.lines = 0
@@ -114,7 +123,7 @@ class Faults:
                 del self._last[next(iter(self._last))]
             self.lines += 1
         more = f" (+{dropped} more in the last {now - entry[0]:.1f} s)" if entry is not None and dropped else ""
-        log.warning("client %s: %s%s", client_id, text, more)
+        self._log.warning(self._line, client_id, text, more)
         return True
 
     def forget(self, client_id: object) -> None:

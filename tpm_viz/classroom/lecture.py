@@ -6,6 +6,12 @@ a way to tell the terminal and the lecturer.
 ``--session FILE`` naming a JSON session file (a *Save session* download, or the file of an older tpm-viz) imports
 it once into a store beside it (``FILE.sqlite3``) and never writes it; the old ``session.json`` of the data folder is
 imported the same way. The cookie secret is kept beside the store.
+
+One server per store: :meth:`LectureStore.open` first takes the store's lock (:mod:`.storelock`) and refuses, with
+one line naming the other server's port, a store another live server holds; a store path that exists and is not a
+regular file (a device, a FIFO, a folder) is refused in one line too (:func:`tpm_viz.core.files.output_target`).
+Both refusals stop the start (:class:`~tpm_viz.core.errors.InputError`); every other problem is a notice and the
+lesson goes on unsaved.
 """
 
 from __future__ import annotations
@@ -24,8 +30,10 @@ from tpm_viz.classroom.records import Records, import_json
 from tpm_viz.classroom.saver import Saver
 from tpm_viz.classroom.sessionfile import MAX_DOCUMENT_BYTES, Document
 from tpm_viz.classroom.store import Limits, SqliteStore, is_sqlite, open_store
-from tpm_viz.core.errors import TpmVizError
-from tpm_viz.core.files import read_bytes
+from tpm_viz.classroom.storelock import StoreLock
+from tpm_viz.core.errors import FileRefusedError, InputError, TpmVizError
+from tpm_viz.core.files import output_target, read_bytes
+from tpm_viz.core.words import Phrase
 
 __all__ = ["LectureStore", "default_path"]
 
@@ -62,6 +70,7 @@ class LectureStore:
         self.records: Records | None = None
         self.where = "" if path is None else str(path)
         self._saver: Saver | None = None
+        self._lock: StoreLock | None = None
         self._opened = False
 
     def _notice(self, line: str | None) -> None:
@@ -71,17 +80,25 @@ class LectureStore:
 
     def open(self) -> None:
         """Open (or make) the store, move an unreadable one aside, import a JSON session file once; idempotent.
-        Problems are notices: the app starts with the defaults rather than not at all."""
+        Problems are notices: the app starts with the defaults rather than not at all, except a store another live
+        server holds (:class:`~tpm_viz.classroom.storelock.StoreBusyError`) or a path that is not a regular file:
+        one-line :class:`~tpm_viz.core.errors.InputError`, nothing read, moved or written."""
         if self._opened or self.path is None:
             return
-        self._opened = True
         target, source = _places(self.path)
+        try:
+            output_target(target, folder=False)  # the store makes its folder
+        except FileRefusedError as exc:
+            raise InputError(Phrase("session store {why}", why=exc.args[0])) from None
+        self._lock, lock_notice = StoreLock.take(target)  # before anything is read or moved aside (--fresh)
+        self._opened = True
         self.where = str(target)
         try:
             self.store, notice = open_store(target, self.limits, fresh=self.fresh)
         except Exception as exc:  # e.g. an unwritable folder or a locked file: the lesson goes on unsaved
             self._notice(f"cannot open the session store {target} ({str(exc)[:160]}); nothing will be saved")
             return
+        self._notice(lock_notice)  # a store that saves without a lock (a store that cannot save said so above)
         self._notice(notice)
         self.records = Records(self.store)
         self.keys, notice = Keys.in_folder(target.parent)
@@ -122,12 +139,19 @@ class LectureStore:
         self._saver = Saver(self.records, document, say, self.where)
         self._saver.start()
 
+    def serving(self, port: int) -> None:
+        """The server listens on ``port``: a second server refused on this store is told which one holds it."""
+        if self._lock is not None:
+            self._lock.serving(port)
+
     def stop(self) -> None:
-        """Stop saving after a last save; close the store."""
+        """Stop saving after a last save; close the store; let the next server take it."""
         if self._saver is not None:
             self._saver.stop(final=True)
         if self.store is not None:
             self.store.close()
+        if self._lock is not None:
+            self._lock.release()
 
 
 def _digest(path: Path) -> str:

@@ -6,6 +6,13 @@ and view options, for :data:`KEEP_SECONDS` after they left), keyed by the browse
 it, :func:`loads` reads it back through the library's own checks (``Params``, ``Pose.working``, ``Load``,
 ``Source.paper`` / ``Source.from_trajectory``, the upload limits of :mod:`tpm_viz.app.inputs`); anything wrong is
 one :class:`~tpm_viz.InputError`. :func:`write_atomic` replaces a file in one step (temporary file + ``os.replace``).
+
+Every number read must be finite and physically meaningful, as a browser could have typed it (a share link is read
+here too, and anyone can mint one): positions within :data:`~tpm_viz.app.transitions.MAX_POSITION`, the load within
+the panel's bounds (:data:`~tpm_viz.app.transitions.MAX_FORCE`, ``MAX_SPEED``, ``MAX_ACCEL``), times within
+:data:`~tpm_viz.app.inputs.MAX_UPLOAD_SECONDS`, an uploaded trajectory within the upload's own limits (positions,
+duration, finite velocities and accelerations): :mod:`.ranges`. ``1e308`` is refused like NaN, in one line naming the
+field.
 """
 
 from __future__ import annotations
@@ -13,8 +20,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-import os
-import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,13 +28,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tpm_viz.app.inputs import MAX_UPLOAD_BYTES, MAX_UPLOAD_ROWS
+from tpm_viz.app.inputs import MAX_UPLOAD_BYTES, MAX_UPLOAD_ROWS, MAX_UPLOAD_SECONDS
 from tpm_viz.app.moves import Pose, check
 from tpm_viz.app.readouts import Load, reason
 from tpm_viz.app.runs import Source
 from tpm_viz.app.state import AppState, TrajectorySample
+from tpm_viz.app.transitions import MAX_ACCEL, MAX_FORCE, MAX_POSITION, MAX_SPEED
+from tpm_viz.classroom.ranges import check_samples, within
 from tpm_viz.core.errors import InputError, TpmVizError
-from tpm_viz.core.files import loads_json, read_bytes
+from tpm_viz.core.files import loads_json, read_bytes, write_atomically
 from tpm_viz.core.params import PARAM_INFO, Params
 from tpm_viz.core.words import Lang, Phrase
 from tpm_viz.paper.trajectories import Trajectory
@@ -56,6 +63,8 @@ KEEP_SECONDS = 30 * 60.0
 MAX_DOCUMENT_BYTES = 4 * MAX_UPLOAD_BYTES + (1 << 20)
 MAX_TABS = 2000
 _SOURCE_KINDS = ("line", "circle", "segment", "csv")
+_TIMES = (0.0, MAX_UPLOAD_SECONDS)
+"""Range of every duration and time read [s] (the longest trajectory anything plays)."""
 
 
 @dataclass
@@ -161,8 +170,16 @@ def _get(obj: Any, name: str, kind: type | tuple[type, ...], where: str) -> Any:
     return obj[name]
 
 
+def _float(value: float, name: str, where: str) -> float:
+    """``float(value)``; a JSON integer beyond float's range (``1e400`` written out) is not finite either."""
+    try:
+        return float(value)
+    except OverflowError:
+        raise InputError(Phrase("session file: {where}{name} is not finite", where=where, name=name)) from None
+
+
 def _number(obj: Any, name: str, where: str) -> float:
-    value = float(_get(obj, name, (int, float), where))
+    value = _float(_get(obj, name, (int, float), where), name, where)
     if not math.isfinite(value):
         raise InputError(Phrase("session file: {where}{name} is not finite", where=where, name=name))
     return value
@@ -172,21 +189,36 @@ def _pair(obj: Any, name: str, where: str) -> tuple[float, float]:
     value = _get(obj, name, list, where)
     if len(value) != 2 or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
         raise InputError(Phrase("session file: {where}{name} must be two numbers", where=where, name=name))
-    out = (float(value[0]), float(value[1]))
+    out = (_float(value[0], name, where), _float(value[1], name, where))
     if not all(math.isfinite(v) for v in out):
         raise InputError(Phrase("session file: {where}{name} is not finite", where=where, name=name))
     return out
+
+
+def _bounded(obj: Any, name: str, where: str, span: tuple[float, float], unit: str) -> float:
+    """:func:`_number` within ``span``."""
+    value = _number(obj, name, where)
+    within(value, name, where, span, unit)
+    return value
+
+
+def _bounded_pair(obj: Any, name: str, where: str, most: float, unit: str) -> tuple[float, float]:
+    """:func:`_pair` within ``±most`` each."""
+    value = _pair(obj, name, where)
+    within(value, name, where, (-most, most), unit)
+    return value
 
 
 def _read_source(raw: Any) -> Source | None:
     if raw is None:
         return None
     kind = _get(raw, "kind", str, "trajectory.")
-    duration = _number(raw, "duration", "trajectory.")
+    duration = _bounded(raw, "duration", "trajectory.", _TIMES, "s")
     if kind in ("line", "circle"):
         return Source.paper(kind, duration)
     if kind == "segment":
-        return Source.segment(_pair(raw, "start", "trajectory."), _pair(raw, "end", "trajectory."), duration)
+        start = _bounded_pair(raw, "start", "trajectory.", MAX_POSITION, "m")
+        return Source.segment(start, _bounded_pair(raw, "end", "trajectory.", MAX_POSITION, "m"), duration)
     if kind != "csv":
         raise InputError(Phrase("session file: trajectory kind must be one of {kinds}", kinds=", ".join(_SOURCE_KINDS)))
     t = np.asarray(_get(raw, "t", list, "trajectory."), dtype=float)
@@ -201,6 +233,7 @@ def _read_source(raw: Any) -> Source | None:
         raise InputError(
             Phrase("session file: the uploaded trajectory's times must increase and every value be finite")
         )
+    check_samples(t, p)
     label = _get(raw, "label", str, "trajectory.")[:200]
     name = label.rsplit(", T =", 1)[0]
     zeros = np.zeros_like(p)
@@ -213,7 +246,8 @@ def _read_saved(raw: Any, where: str) -> Saved:
     if unknown:
         raise InputError(Phrase("session file: unknown parameter {name}", name=repr(sorted(unknown)[0])))
     params = Params(**{k: v for k, v in params_raw.items()})  # validated: one-line InvalidParametersError
-    pose = Pose(np.array(_pair(raw, "p", where)), np.array(_pair(raw, "d", where)))
+    p, d = _bounded_pair(raw, "p", where, MAX_POSITION, "m"), _bounded_pair(raw, "d", where, MAX_POSITION, "m")
+    pose = Pose(np.array(p), np.array(d))
     if check(params, pose) != 0:
         pose = Pose.working(params, pose.p)  # not valid as saved: the working-mode pose at the same p
         if check(params, pose) != 0:
@@ -221,21 +255,21 @@ def _read_saved(raw: Any, where: str) -> Saved:
     load_raw = _get(raw, "load", dict, where)
     load = Load(
         _get(load_raw, "mode", str, where + "load."),
-        _pair(load_raw, "f_ext", where + "load."),
-        _pair(load_raw, "dp", where + "load."),
-        _pair(load_raw, "ddp", where + "load."),
+        _bounded_pair(load_raw, "f_ext", where + "load.", MAX_FORCE, "N"),
+        _bounded_pair(load_raw, "dp", where + "load.", MAX_SPEED, "m/s"),
+        _bounded_pair(load_raw, "ddp", where + "load.", MAX_ACCEL, "m/s²"),
     )
     sample_raw = _get(raw, "sample", dict, where)
     sample = TrajectorySample(
         _get(sample_raw, "kind", str, where + "sample."),
-        _number(sample_raw, "duration", where + "sample."),
-        _number(sample_raw, "t", where + "sample."),
+        _bounded(sample_raw, "duration", where + "sample.", _TIMES, "s"),
+        _bounded(sample_raw, "t", where + "sample.", _TIMES, "s"),
     )
     source = _read_source(raw.get("trajectory"))
     state = _honest(AppState(params=params, pose=pose, load=load, trajectory=sample), source)
     show_raw = raw.get("show", {}) if isinstance(raw, dict) else {}
     show = {str(k): v for k, v in show_raw.items() if isinstance(v, bool)} if isinstance(show_raw, dict) else {}
-    player_t = _number(raw, "player_t", where) if "player_t" in raw else 0.0
+    player_t = _bounded(raw, "player_t", where, _TIMES, "s") if "player_t" in raw else 0.0
     lang = Lang.parse(raw.get("lang")).value  # absent (older files) or unknown: English
     return Saved(state, source, max(0.0, player_t), show, lang)
 
@@ -259,7 +293,7 @@ def _checked(read: Any) -> Any:
         raise InputError(
             why if str(why).startswith("session file") else Phrase("session file: {why}", why=why)
         ) from None
-    except (TypeError, ValueError, AttributeError, RecursionError) as exc:
+    except (TypeError, ValueError, AttributeError, RecursionError, OverflowError) as exc:
         raise InputError(Phrase("session file: malformed ({kind})", kind=type(exc).__name__)) from None
 
 
@@ -319,16 +353,8 @@ def read_file(path: Path) -> Document:
 
 
 def write_atomic(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` in one step: a temporary file in the same folder, then ``os.replace``."""
+    """Write ``text`` to ``path`` in one step (:func:`tpm_viz.core.files.write_atomically`: a temporary file in the
+    same folder, then ``os.replace``; a device, FIFO or folder at ``path`` is refused, never replaced)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=".tpm-viz-", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    write_atomically(path, text)

@@ -23,7 +23,7 @@ import csv
 import sys
 
 from tpm_viz.cli import control, design, exercise, export, lti, multibody, outputs, paper, plan, serve
-from tpm_viz.cli.common import Parser, common_parent, one_line, params_from_args
+from tpm_viz.cli.common import Parser, check_outputs, common_parent, one_line, params_from_args
 from tpm_viz.core.errors import TpmVizError
 
 __all__ = ["build_parser", "main", "params_from_args"]
@@ -43,6 +43,7 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of ``tpm-viz``; returns the exit status (2 for bad input)."""
     try:
         args = build_parser().parse_args(argv)
+        check_outputs(args)  # a device, FIFO or folder as --output: refused before any work
         return int(args.func(args) or 0)
     except TpmVizError as exc:
         print(f"tpm-viz: error: {one_line(str(exc))}", file=sys.stderr)

@@ -1,5 +1,6 @@
 """What every ``tpm-viz`` subcommand shares: the one-line-error parser, ``--set NAME=VALUE``, number checks,
-and the output file: never the input (:func:`check_output`), written atomically (:func:`write_output`).
+and the output file: never the input (:func:`check_output`), never a device, FIFO or folder (:func:`check_outputs`,
+before any work; the writer checks again), written atomically (:func:`write_output`).
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import numpy as np
 
 from tpm_viz.core.csvio import write_columns
 from tpm_viz.core.errors import InputError
+from tpm_viz.core.files import output_target
 from tpm_viz.core.numbers import parse_number
 from tpm_viz.core.params import PARAM_INFO, Params
 
@@ -25,6 +27,7 @@ __all__ = [
     "MIN_SECONDS",
     "Parser",
     "check_output",
+    "check_outputs",
     "common_parent",
     "one_line",
     "params_from_args",
@@ -156,6 +159,23 @@ def check_output(output: str | None, input_path: str | None) -> None:
         return
     if _same_file(out, src):
         raise InputError(f"--output {output!r} is the input file; write to another file (the input is kept)")
+
+
+OUTPUT_OPTIONS = ("output", "sidecar")
+"""The options that name a file a subcommand writes (``figures --output-dir`` and ``export --format c`` name a
+folder: their files go through the same writer)."""
+
+
+def check_outputs(args: argparse.Namespace) -> None:
+    """Refuse at once, before any work, an output option (:data:`OUTPUT_OPTIONS`) naming something that exists and is
+    not a regular file, a kernel pseudo-file or a path in a missing folder
+    (:func:`tpm_viz.core.files.output_target`; the writer checks again when it writes)."""
+    for name in OUTPUT_OPTIONS:
+        value = getattr(args, name, None)
+        folder = getattr(args, "output_is_folder", False) or getattr(args, "format", None) == "c"
+        if value in (None, "-") or (name == "output" and folder):
+            continue  # stdout, or a folder the command writes into (export --format c, lti keygen)
+        output_target(value)
 
 
 def write_output(path: str | None, columns: Mapping[str, np.ndarray]) -> None:

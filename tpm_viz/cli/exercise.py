@@ -26,6 +26,7 @@ import json
 import sys
 
 from tpm_viz.cli.common import within
+from tpm_viz.core.errors import InputError
 
 __all__ = ["MAX_VARIANTS", "register"]
 
@@ -39,6 +40,8 @@ def _lessons(args: argparse.Namespace, strict: bool = False):  # -> tuple[Demo, 
     if args.lessons is None:
         return DEMOS, ()
     lessons, problems = load_lessons(args.lessons)
+    if not lessons and not strict:  # nothing to list, show or grade (selftest reports it as a failure)
+        raise InputError(str(problems[0]) if problems else f"{args.lessons}: no lesson files (*.toml)")
     for problem in problems:
         print(f"tpm-viz: {'error' if strict else 'warning'}: {problem}", file=sys.stderr)
     return lessons, problems

@@ -1,8 +1,10 @@
 """``tpm-viz export --format mjcf|urdf --output FILE`` and ``--format c --output DIR``: the mechanism for other tools.
 
 :func:`register` adds the subcommand to the ``tpm-viz`` parser (:mod:`tpm_viz.cli`). The text comes from
-:mod:`tpm_viz.exchange` (no MuJoCo or Pinocchio needed to write it). The file is written atomically: a
-temporary file in the same directory, then ``os.replace``, so a reader never sees half a model. ``--output -``
+:mod:`tpm_viz.exchange` (no MuJoCo or Pinocchio needed to write it). The file is written atomically
+(:func:`tpm_viz.core.files.write_atomically`, the command line's one writer: a temporary file in the same directory,
+then ``os.replace``, so a reader never sees half a model; a device, FIFO or folder at ``--output`` is refused and left
+as it is). ``--output -``
 prints to stdout. ``--format c`` writes ``tpm_2ppa.h`` and ``tpm_2ppa.c`` (:mod:`tpm_viz.exchange.c.code`) into
 the directory ``--output`` (created if missing; not through a symbolic link), each file atomically, and replaces a
 file there only if it is untouched since its export, or with ``--force`` (:mod:`tpm_viz.exchange.c.folder`). The
@@ -13,55 +15,17 @@ one line and exits with 2).
 from __future__ import annotations
 
 import argparse
-import contextlib
 import dataclasses
-import os
 import sys
-import tempfile
 
 from tpm_viz.cli.common import params_from_args, positive
 from tpm_viz.core.errors import InputError
+from tpm_viz.core.files import write_atomically
 
 __all__ = ["FORMATS", "register", "write_atomically"]
 
 FORMATS = ("mjcf", "urdf", "c")
 """Export formats: MJCF (MuJoCo, Pinocchio's MJCF reader), URDF and C99 source (the closed form)."""
-
-
-def _file_mode(path: str) -> int:
-    """The existing file's permission bits, or ``0o666`` less the process umask for a new file."""
-    try:
-        return os.stat(path).st_mode & 0o777
-    except FileNotFoundError:
-        umask = os.umask(0)
-        os.umask(umask)
-        return 0o666 & ~umask
-
-
-def write_atomically(path: str, data: str | bytes) -> None:
-    """Write ``data`` (text as UTF-8) to ``path`` through a temporary file in the same directory, ``fsync`` and
-    ``os.replace``, with the permissions a plain ``open()`` would give it (a replaced file keeps its own). Every
-    file the CLI writes whole goes through here (models, C, clips, reports: :mod:`tpm_viz.cli.outputs`)."""
-    directory = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(directory):
-        raise InputError(f"cannot write --output {path!r}: directory {directory!r} does not exist")
-    try:  # a failure names the user's path, never the temporary file
-        fd, tmp = tempfile.mkstemp(prefix=".tpm-viz-", suffix=".tmp", dir=directory)
-    except OSError as exc:
-        raise OSError(exc.errno, exc.strerror, path) from None
-    try:
-        os.fchmod(fd, _file_mode(path))  # mkstemp makes 0600; give the file the mode a plain open() would
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data.encode("utf-8") if isinstance(data, str) else data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException as exc:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        if isinstance(exc, OSError):
-            raise OSError(exc.errno, exc.strerror, path) from None
-        raise
 
 
 def _write_c(params, directory: str, force: bool) -> None:

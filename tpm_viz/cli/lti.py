@@ -56,4 +56,4 @@ def register(sub, common: argparse.ArgumentParser) -> None:
     commands = lti.add_subparsers(dest="lti_command", required=True, parser_class=Parser)
     keygen = commands.add_parser("keygen", help="make the tool's RSA key: DIR/tool-key.pem (0600); print its JWKS")
     keygen.add_argument("--output", type=Path, required=True, metavar="DIR", help="the folder of tool-key.pem")
-    keygen.set_defaults(func=_cmd_keygen)
+    keygen.set_defaults(func=_cmd_keygen, output_is_folder=True)

@@ -16,9 +16,9 @@ import sys
 
 from tpm_viz.app.runs import MAX_DURATION, RUN_SAMPLES, Run, Source, build_run
 from tpm_viz.cli.common import check_output, params_from_args
-from tpm_viz.cli.export import write_atomically
 from tpm_viz.core.csvio import read_text
 from tpm_viz.core.errors import InputError
+from tpm_viz.core.files import write_atomically
 from tpm_viz.paper.trajectories import parse_trajectory_csv
 
 __all__ = ["MAX_SAMPLES", "register", "run_from_args", "write_bytes"]
@@ -48,7 +48,7 @@ def run_from_args(args: argparse.Namespace, reference=None) -> Run:
 
 
 write_bytes = write_atomically
-"""Write a clip, sidecar or report atomically: :func:`tpm_viz.cli.export.write_atomically`, the CLI's one writer."""
+"""Write a clip, sidecar or report atomically: :func:`tpm_viz.core.files.write_atomically`, the CLI's one writer."""
 
 
 def _suffix(path: str, allowed: tuple[str, ...]) -> str:

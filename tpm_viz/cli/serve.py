@@ -22,10 +22,12 @@ from tpm_viz.cli.lti import lti_plug
 from tpm_viz.core.errors import InputError
 from tpm_viz.core.numbers import shorten
 
-__all__ = ["RESOLVE_SECONDS", "check_bind", "register"]
+__all__ = ["MAX_TABS", "RESOLVE_SECONDS", "TABS_PER_ADDRESS", "check_bind", "register", "tabs_per_address"]
 
 RESOLVE_SECONDS = 4.0
 """Longest wait for the host name to resolve [s]."""
+TABS_PER_ADDRESS, MAX_TABS = 50, 200
+"""``--tabs-per-address``: its default and its largest value (the server's connection limit), tabs."""
 
 
 def _resolve(host: str, port: int) -> list:
@@ -45,6 +47,17 @@ def _resolve(host: str, port: int) -> list:
     if isinstance(result[0], BaseException):
         raise InputError(f"--host {shorten(host)} is not a known address or name of this machine")
     return result[0]
+
+
+def tabs_per_address(text: str) -> int:
+    """argparse type of ``--tabs-per-address``: a whole number from 1 to :data:`MAX_TABS`."""
+    try:
+        value = int(text.strip())
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number of tabs from 1 to {MAX_TABS}") from None
+    if not 1 <= value <= MAX_TABS:
+        raise argparse.ArgumentTypeError(f"expected a whole number of tabs from 1 to {MAX_TABS}, got {value}")
+    return value
 
 
 def check_bind(host: str, port: int) -> None:
@@ -87,6 +100,7 @@ def _cmd_serve(args) -> int:
         trusted_proxies=args.trusted_proxy or (),
         allowed_hosts=args.allowed_host or (),
         lti=plug,
+        tabs_per_address=args.tabs_per_address,
     )
     return 0
 
@@ -151,5 +165,15 @@ def register(sub, common: argparse.ArgumentParser) -> None:
         metavar="CONFIG",
         help="serve as an LTI 1.3 tool of the LMS in CONFIG.toml (docs/lti.md): only an instructor's launch (or the "
         "presenter token) presents; needs the .[lti] extra",
+    )
+    s.add_argument(
+        "--tabs-per-address",
+        type=tabs_per_address,
+        default=TABS_PER_ADDRESS,
+        metavar="N",
+        help=f"most tabs from one network address ({TABS_PER_ADDRESS}; 1-{MAX_TABS}): one student's idle sockets "
+        "never lock the class out. Without --trusted-proxy a class behind one router (NAT) or one proxy counts as "
+        "one address: raise N for more students than that; tabs on this computer (the lecturer's) are never "
+        "refused for the students' (docs/classroom.md)",
     )
     s.set_defaults(func=_cmd_serve)

@@ -15,13 +15,10 @@ Writing uses 17 significant digits (lossless for float64) and leaves a cell empt
 
 from __future__ import annotations
 
-import contextlib
 import csv
 import io
 import math
-import os
 import sys
-import tempfile
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from typing import IO, Protocol, cast
 
@@ -39,6 +36,7 @@ from tpm_viz.core.csvdialect import (
     text_lines,
 )
 from tpm_viz.core.errors import InputError
+from tpm_viz.core.files import atomic_writer, open_regular
 from tpm_viz.core.numbers import parse_number, shorten, unit_factor
 from tpm_viz.core.words import Phrase, T
 
@@ -85,7 +83,7 @@ def _open_lines(path: str, max_bytes: int) -> tuple[Iterator[str], IO[bytes] | N
         raw = cast(io.BufferedReader, sys.stdin.buffer)  # typed BinaryIO; binary_lines needs its peek
         fh = None
     else:
-        raw = fh = open(path, "rb")
+        raw = fh = open_regular(path)  # a device, a FIFO or a folder is refused (one line), nothing hangs
         try:
             if raw.seekable() and raw.seek(0, 2) > max_bytes:
                 size, mib = raw.tell() // 1048576, max_bytes // 1048576
@@ -281,44 +279,16 @@ def write_csv(fh: IO[str], columns: Mapping[str, np.ndarray]) -> None:
 
 
 def write_columns(path: str | None, columns: Mapping[str, np.ndarray]) -> None:
-    """Write columns as CSV to ``path`` (stdout when None or ``-``), atomically: a temporary file in the same
-    directory, renamed over ``path`` once complete, so that a failure leaves any previous file as it was.
+    """Write columns as CSV to ``path`` (stdout when None or ``-``), atomically
+    (:func:`tpm_viz.core.files.atomic_writer`: a temporary file in the same folder, renamed over ``path`` once
+    complete, so that a failure leaves any previous file as it was).
 
-    The permissions of an existing file are kept and a symbolic link is followed; a path that is not a regular
-    file (``/dev/null``, a FIFO) is written directly. An ``OSError`` names ``path``, not the temporary file.
+    The permissions of an existing file are kept and a symbolic link is followed; a path that exists and is not a
+    regular file (``/dev/full``, a FIFO, a folder) is refused in one line and left as it is. An ``OSError`` names
+    ``path``, not the temporary file.
     """
     if path in (None, "-"):
         write_csv(sys.stdout, columns)
         return
-    try:
-        _write_atomic(os.path.realpath(path), columns)
-    except OSError as exc:
-        if exc.filename != path:  # disk full names no file, a missing directory the temporary one
-            raise OSError(exc.errno, exc.strerror, path) from None
-        raise
-
-
-def _write_atomic(target: str, columns: Mapping[str, np.ndarray]) -> None:
-    if os.path.exists(target) and not os.path.isfile(target):
-        with open(target, "w", encoding="utf-8", newline="") as fh:
-            write_csv(fh, columns)
-        return
-    directory, name = os.path.split(target)
-    fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".tmp", dir=directory)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
-            write_csv(fh, columns)
-            fh.flush()
-            os.fsync(fh.fileno())
-        try:
-            mode = os.stat(target).st_mode & 0o7777
-        except FileNotFoundError:
-            umask = os.umask(0)
-            os.umask(umask)
-            mode = 0o666 & ~umask
-        os.chmod(tmp, mode)
-        os.replace(tmp, target)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
+    with atomic_writer(path, text=True) as fh:
+        write_csv(fh, columns)

@@ -1,6 +1,7 @@
-"""One reader for every file the app reads (session store imports, lessons, uploads, *Open session*).
+"""One reader for every file the app reads (session store imports, lessons, uploads, *Open session*, the command
+line's inputs) and one writer for every file the command line writes (:func:`atomic_writer`).
 
-The rules, in the order they are checked:
+The reader's rules, in the order they are checked:
 
 - an optional ``root`` folder: the path, with every symlink resolved, must lie inside the resolved root (no
   symlink or ``..`` out of a lessons folder);
@@ -13,21 +14,34 @@ The rules, in the order they are checked:
 - JSON and TOML are parsed with a nesting ``depth`` limit (levels of arrays and tables/objects); the parsers'
   ``RecursionError`` is turned into the same refusal, never raised.
 
+Streaming readers (the command line's CSV) open the file with :func:`open_regular`: the same rules but the size.
+
+The writer (:func:`atomic_writer`, :func:`write_atomically`) writes a temporary file in the target's folder, then
+``os.replace`` it over the target, so that a failure leaves any previous file as it was. The target is the path with
+every symlink resolved (:func:`output_target`), and it is refused, before anything is written and again just before
+the replace, when it exists and is not a regular file (a device such as ``/dev/full``, a FIFO, a socket, a folder:
+never opened, never replaced) or lies under ``/proc``, ``/sys`` or ``/dev``; a missing folder is refused too.
+
 Every failure is one :class:`~tpm_viz.core.errors.FileRefusedError` whose one-line message names the path and what to
-change, and never quotes the file's contents (no first line, no offending byte, no parser excerpt).
+change, and never quotes the file's contents (no first line, no offending byte, no parser excerpt); an ``OSError``
+while writing names the given path, never the temporary file.
 
 Base layer: standard library only.
 """
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import os
 import re
 import stat
+import tempfile
 import tomllib
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 from tpm_viz.core.errors import FileRefusedError
 from tpm_viz.core.words import Phrase, T
@@ -36,14 +50,18 @@ __all__ = [
     "DEFAULT_DEPTH",
     "TOO_DEEP",
     "FileRefusedError",
+    "atomic_writer",
     "depth_of",
     "loads_json",
     "loads_toml",
+    "open_regular",
+    "output_target",
     "read_bytes",
     "read_json",
     "read_text",
     "read_toml",
     "resolve_inside",
+    "write_atomically",
 ]
 
 DEFAULT_DEPTH = 32
@@ -61,6 +79,9 @@ _NOT_JSON = T("not valid JSON (line {line}); fix or replace the file")
 _NOT_TOML = T("not valid TOML ({why}); fix the file")
 TOO_DEEP = T("nested deeper than {depth} levels; flatten the file")
 _NOT_UTF8 = T("not UTF-8 text (line {line}); save it as UTF-8")
+_NOT_REGULAR_OUT = T("a {kind}, not a regular file: it is not replaced; write to a regular file or a new name")
+_NO_FOLDER = T("the folder {folder} does not exist; create it or write elsewhere")
+_FLAGS = os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NOCTTY", 0)
 
 
 def _size(limit: int) -> str:
@@ -91,20 +112,38 @@ def resolve_inside(path: str | os.PathLike[str], root: str | os.PathLike[str] | 
     return real
 
 
-def read_bytes(path: str | os.PathLike[str], limit: int, root: str | os.PathLike[str] | None = None) -> bytes:
-    """The bytes of the regular file ``path`` (at most ``limit`` bytes, inside ``root`` if given); any problem is
-    one :class:`FileRefusedError`."""
+def _open(path: str | os.PathLike[str], root: str | os.PathLike[str] | None) -> tuple[int, os.stat_result]:
+    """A descriptor of the regular file ``path`` and its ``fstat``; refused as the module docstring says."""
     real = resolve_inside(path, root)
-    flags = os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NOCTTY", 0)
     try:
-        fd = os.open(real, flags)
+        fd = os.open(real, _FLAGS)  # O_NONBLOCK: a FIFO without a writer cannot hang the open
     except OSError as exc:
         raise _refuse(_NO_OPEN, path, why=_why(exc)) from None
     try:
         info = os.fstat(fd)
         if not stat.S_ISREG(info.st_mode):
-            kind = _kind(info.st_mode)
-            raise _refuse(_NOT_REGULAR, path, kind=kind)
+            raise _refuse(_NOT_REGULAR, path, kind=_kind(info.st_mode))
+    except BaseException as exc:
+        os.close(fd)
+        if isinstance(exc, OSError):
+            raise _refuse(_NO_READ, path, why=_why(exc)) from None
+        raise
+    return fd, info
+
+
+def open_regular(path: str | os.PathLike[str], root: str | os.PathLike[str] | None = None) -> io.BufferedReader:
+    """The regular file ``path`` opened for reading in binary (for a streaming reader, which keeps its own size
+    limit); anything else (a device, a FIFO, a folder, a kernel pseudo-file, a path outside ``root``) is one
+    :class:`FileRefusedError`, and nothing hangs."""
+    fd, _info = _open(path, root)
+    return open(fd, "rb")  # the caller closes it
+
+
+def read_bytes(path: str | os.PathLike[str], limit: int, root: str | os.PathLike[str] | None = None) -> bytes:
+    """The bytes of the regular file ``path`` (at most ``limit`` bytes, inside ``root`` if given); any problem is
+    one :class:`FileRefusedError`."""
+    fd, info = _open(path, root)
+    try:
         if info.st_size > limit:
             raise _refuse(_TOO_BIG, path, limit=_size(limit))
         chunks: list[bytes] = []
@@ -224,3 +263,69 @@ def _kind(mode: int) -> Phrase:
 
 def _why(exc: OSError) -> str:
     return exc.strerror or type(exc).__name__
+
+
+# -- writing ---------------------------------------------------------------------------------------------------------
+def output_target(path: str | os.PathLike[str], folder: bool = True) -> Path:
+    """The file that writing ``path`` makes or replaces: ``path`` with every symlink resolved. Refused (one
+    :class:`FileRefusedError` naming ``path``) when it exists and is not a regular file, is a kernel pseudo-file
+    (``/proc``, ``/sys``, ``/dev``) or (``folder``) its folder does not exist. Nothing is opened: a FIFO cannot hang
+    it."""
+    real = Path(os.path.realpath(path))
+    try:
+        info: os.stat_result | None = os.stat(real)
+    except (FileNotFoundError, NotADirectoryError):  # not there (a file where a folder should be: not there either)
+        info = None
+    except OSError as exc:  # a symlink loop, a folder that cannot be searched
+        raise _refuse(_NO_OPEN, path, why=_why(exc)) from None
+    if info is not None and not stat.S_ISREG(info.st_mode):
+        raise _refuse(_NOT_REGULAR_OUT, path, kind=_kind(info.st_mode))
+    if any(real.is_relative_to(p) for p in _PSEUDO):
+        raise _refuse(_SYSTEM, path)
+    if folder and not real.parent.is_dir():
+        raise _refuse(_NO_FOLDER, path, folder=str(real.parent))
+    return real
+
+
+def _new_file_mode(target: Path) -> int:
+    """The existing file's permission bits, or ``0o666`` less the process umask for a new file."""
+    try:
+        return os.stat(target).st_mode & 0o777
+    except FileNotFoundError:
+        umask = os.umask(0)
+        os.umask(umask)
+        return 0o666 & ~umask
+
+
+@contextlib.contextmanager
+def atomic_writer(path: str | os.PathLike[str], text: bool = False) -> Iterator[IO[Any]]:
+    """A file object whose contents replace ``path`` in one step when the ``with`` block ends without an error
+    (``text``: UTF-8 text with ``\n`` kept as written; else bytes). The target is checked by :func:`output_target`
+    before anything is written and again just before the replace; it keeps its permissions (a new file gets those a
+    plain ``open()`` would give it). On any failure the temporary file is removed and a previous file is kept; an
+    ``OSError`` names ``path``."""
+    target = output_target(path)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".tpm-viz-", suffix=".tmp", dir=target.parent)
+    except OSError as exc:
+        raise OSError(exc.errno, exc.strerror, str(path)) from None
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") if text else os.fdopen(fd, "wb") as handle:
+            os.fchmod(handle.fileno(), _new_file_mode(target))  # mkstemp makes 0600
+            yield handle
+            handle.flush()
+            os.fsync(handle.fileno())
+        output_target(path)  # a device or FIFO put there meanwhile is not replaced either
+        os.replace(tmp, target)
+    except BaseException as exc:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise OSError(exc.errno, exc.strerror, str(path)) from None
+        raise
+
+
+def write_atomically(path: str | os.PathLike[str], data: str | bytes) -> None:
+    """Write ``data`` (text as UTF-8) to ``path`` with :func:`atomic_writer`."""
+    with atomic_writer(path) as handle:
+        handle.write(data.encode("utf-8") if isinstance(data, str) else data)

@@ -16,6 +16,9 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from tpm_viz.core.files import write_atomically
+from tpm_viz.drawing.labels import name_props, quiet_glyphs
+
 __all__ = ["FILE_NAMES", "PRINT_DPI", "TITLES", "ForceCurves", "force_plot_png", "force_plot_svg", "plot_forces"]
 
 TITLES = {
@@ -59,7 +62,7 @@ def _force_figure(t, tau_paper, tau_ref, title: str, dpi: int):
     top.set_ylabel("actuator force [N]")
     top.legend(loc="lower center", bbox_to_anchor=(0.5, 1.0), fontsize=8, ncols=2, frameon=False)
     top.grid(alpha=0.3)
-    fig.suptitle(title, fontsize=11)
+    fig.suptitle(title, fontsize=11, **name_props())  # a run's name is text: "$x$" is not maths
     last = top
     if bottom is not None:
         diff = np.asarray(tau_ref) - np.asarray(tau_paper)
@@ -80,7 +83,7 @@ def plot_forces(cmp: ForceCurves, path: str | pathlib.Path, dpi: int = 100) -> p
     title = f"{TITLES.get(cmp.kind, cmp.kind)}, T = {cmp.duration:g} s"
     fig = _force_figure(cmp.t, cmp.tau_paper, cmp.tau_pinocchio, title, dpi)
     path = pathlib.Path(path)
-    fig.savefig(path, format="png", dpi=dpi)
+    write_atomically(path, _save(fig, "png", dpi))  # never into a device or FIFO (tpm_viz.core.files)
     return path
 
 
@@ -101,5 +104,6 @@ def force_plot_svg(t, tau_paper, tau_ref=None, title: str = "actuator forces") -
 
 def _save(fig: Figure, fmt: str, dpi: int) -> bytes:
     out = io.BytesIO()
-    fig.savefig(out, format=fmt, dpi=dpi)
+    with quiet_glyphs():  # a Hangul name on a machine without a Hangul font: boxes, not a warning per glyph
+        fig.savefig(out, format=fmt, dpi=dpi)
     return out.getvalue()

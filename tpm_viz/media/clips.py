@@ -28,6 +28,7 @@ from tpm_viz.core.errors import InputError
 from tpm_viz.core.numbers import fixed
 from tpm_viz.core.params import Params
 from tpm_viz.core.words import Phrase
+from tpm_viz.drawing.labels import name_props, quiet_glyphs
 from tpm_viz.drawing.meshes import SLIDER_LENGTH, SLIDER_MARGIN, platform_half_size
 from tpm_viz.paper.kinematics import mechanism_pose
 
@@ -150,7 +151,8 @@ class ClipRenderer:
         self._moving: list = []
         self._mechanism(title)
         self._panel()
-        self.canvas.draw()  # the static parts (moving artists are animated: not drawn here)
+        with quiet_glyphs():
+            self.canvas.draw()  # the static parts (moving artists are animated: not drawn here)
         self._background = self.canvas.copy_from_bbox(self.fig.bbox)
 
     def __len__(self) -> int:
@@ -175,7 +177,7 @@ class ClipRenderer:
         ax.set_xlabel("x [mm]", fontsize=fs * 0.85, labelpad=1)
         ax.set_ylabel("y [mm]", fontsize=fs * 0.85, labelpad=1)
         ax.grid(alpha=0.25)
-        self.fig.text(0.01, 0.97, title, fontsize=fs * 1.1, va="top", ha="left")
+        self.fig.text(0.01, 0.97, title, fontsize=fs * 1.1, va="top", ha="left", **name_props())  # a name is text
         for i in range(2):
             ends = np.zeros((2, 2))
             ends[:, i] = (-params.a - SLIDER_LENGTH / 2, -params.a + params.stroke + SLIDER_LENGTH / 2)

@@ -57,7 +57,7 @@ from tpm_viz.ui.share import ShareDesk
 from tpm_viz.ui.teaching.tabs import Services
 from tpm_viz.viserkit.adapter import install, new_server
 from tpm_viz.viserkit.core import connection_request
-from tpm_viz.viserkit.limits import DEFAULT_MAX_CONNECTIONS, set_max_connections
+from tpm_viz.viserkit.limits import DEFAULT_MAX_CONNECTIONS, DEFAULT_MAX_PER_ADDRESS, set_admission, set_max_connections
 from tpm_viz.viserkit.transport import harden
 
 __all__ = ["TpmApp", "build_server", "main"]
@@ -91,11 +91,13 @@ def build_server(
     hosts: HostRules | None = None,
     keys: Keys | None = None,
     tickets: Tickets | None = None,
+    per_address: int = DEFAULT_MAX_PER_ADDRESS,
 ) -> viser.ViserServer:
     """A quiet viser server: no share tunnel, no environment map or shadows (fast first paint). ``hosts``: the
     ``Host`` names it answers to and the trusted proxies (default: this machine's names and addresses, no proxy);
     ``keys``: the identity cookies' keys (default: the process's, :data:`~.classroom.DEFAULT_KEYS`); ``tickets``: the
-    LTI launches' (``serve --lti``).
+    LTI launches' (``serve --lti``); ``per_address``: the most tabs from one network address
+    (:mod:`tpm_viz.viserkit.admission`).
 
     Raises :class:`~tpm_viz.viserkit.core.IncompatibleViserError` (one line) if the installed viser is not the tested
     one.
@@ -105,6 +107,7 @@ def build_server(
     server = new_server(handshake=handshakes, host=host, port=port, label="tpm-viz", verbose=False)  # same-origin
     keyboard_of(server, handshakes.keyboard)  # the page script's keys reach this server's tabs (ui/keyboard.py)
     install(server)  # viser's patches on this server, in viserkit/PATCHES.md's order (viserkit/adapter.py)
+    set_admission(server, max_per_address=per_address)  # one student's sockets never lock the class out
     server.gui.configure_theme(
         control_width="large", show_share_button=False, show_logo=False, brand_color=BRAND, dark_mode=False
     )
@@ -136,6 +139,7 @@ class TpmApp:
     ) -> None:
         self.server = server
         set_max_connections(server, max_connections)  # the next tab is told the class is full, then closed
+        set_admission(server, classroom.lecturer_address if classroom else None)  # the lecturer's: never crowded out
         token = presenter_token if presenter_token or classroom is None or lti else classroom.token
         self.access = Access(token, required=lti is not None)  # --lti: an instructor's launch presents
         self.lti = lti
@@ -317,6 +321,7 @@ def main(
     trusted_proxies: Sequence[str] = (),
     allowed_hosts: Sequence[str] = (),
     lti: Plug | None = None,
+    tabs_per_address: int = DEFAULT_MAX_PER_ADDRESS,
 ) -> TpmApp:
     """Serve the app; print the real URL; block until Ctrl-C (or SIGTERM) unless ``block`` is False.
 
@@ -329,7 +334,8 @@ def main(
     tests inject theirs). ``lessons``: a folder of lesson files (or one file) for the *Demos* tab instead of the
     packaged ones; a refused file is one warning line, and no lesson at all is an error. ``trusted_proxies``: the
     reverse proxies whose X-Forwarded-For / Forwarded name the client; ``allowed_hosts``: more ``Host`` names to
-    answer to (:mod:`tpm_viz.classroom.network`). ``lti``: serve as an LTI tool too (``--lti``: docs/lti.md)."""
+    answer to (:mod:`tpm_viz.classroom.network`); ``tabs_per_address``: the most tabs from one network address
+    (:mod:`tpm_viz.viserkit.admission`); ``lti``: serve as an LTI tool too (``--lti``: docs/lti.md)."""
     access = Access(presenter_token)  # validates the token before anything starts
     if lti is not None and session is None:
         raise InputError("--lti keeps the LMS users and grades in the session store: give --session FILE")
@@ -362,8 +368,11 @@ def main(
         store.open()  # its notices, and the cookie keys kept beside it, before the first page
     keys = None if store is None else store.keys
     tickets = None if lti is None else lti.tickets
-    server = build_server(host, port, HostRules(network, addresses or local_addresses, bound=host), keys, tickets)
+    hosts = HostRules(network, addresses or local_addresses, bound=host)
+    server = build_server(host, port, hosts, keys, tickets, tabs_per_address)
     app = TpmApp(server, presenter_token=presenter_token, classroom=room, store=store, lessons=tour, lti=lti)
+    if store is not None:
+        store.serving(app.port)  # a second server on this store is refused naming this port (classroom/storelock.py)
     tune_for_serving()  # the collector and the threads' turns of a serving process (classroom/runtime.py)
     if not block:
         serving(app, host, room)

@@ -129,11 +129,14 @@ def qr_data_uri(url: str) -> str:
 @dataclass
 class Classroom:
     """Classroom mode's settings. ``addresses`` is the lookup of this machine's addresses (tests inject one);
-    ``presenter_address`` says which connecting address makes a tab the presenter (default: loopback)."""
+    ``presenter_address`` says which connecting address makes a tab the presenter (default: loopback);
+    ``lecturer_address`` which one is the lecturer's machine, whose tabs a student's sockets never crowd out
+    (default: loopback; :mod:`tpm_viz.viserkit.admission`)."""
 
     addresses: Callable[[], list[str]] = local_addresses
     presenter_address: Callable[[str], bool] = is_loopback_address
     token: str = field(default_factory=lambda: secrets.token_urlsafe(9))
+    lecturer_address: Callable[[str], bool] = is_loopback_address
 
 
 def same_origin(headers: Any) -> bool:

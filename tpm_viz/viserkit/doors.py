@@ -126,6 +126,22 @@ class ServerDoor:
         if cb in callbacks:
             callbacks.remove(cb)
 
+    def address(self, client_id: int) -> str:
+        """The source address of a connection: as the handshake hook read it (``tpm_viz_client``, through a trusted
+        proxy), else its peer's; ``""`` for a connection that is gone."""
+        connection = self._ws._live_connections.get(client_id)
+        if connection is None:
+            return ""
+        client = getattr(connection, "tpm_viz_client", None)
+        remote = connection.remote_address
+        return str(client) if client is not None else str(remote[0]) if remote else ""
+
+    def header(self, client_id: int, name: str) -> str | None:
+        """A header of a connection's websocket handshake (None: no such header, or the connection is gone)."""
+        connection = self._ws._live_connections.get(client_id)
+        request = None if connection is None else connection.request
+        return None if request is None else cast("str | None", request.headers.get(name))
+
     def live(self) -> list[int]:
         """Ids of the open websocket connections."""
         return list(self._ws._live_connections)

@@ -12,8 +12,12 @@
   installed by :mod:`.adapter`); a watchdog thread drops a connection whose
   outgoing backlog (messages queued and not yet written: a tab that stopped reading) stays over
   :attr:`Limits.max_backlog_bytes` for :attr:`Limits.backlog_grace` seconds, and meanwhile runs none of its callbacks;
-  after tabs leave it returns freed heap to the system (``malloc_trim``); at most :attr:`Limits.max_connections`
-  tabs (the next one is told so in a notification, then closed). Uploads are bounded per tab in :mod:`.transport`.
+  after tabs leave it returns freed heap to the system (``malloc_trim``). Uploads are bounded per tab in
+  :mod:`.transport`.
+- **Bounded connections** (:class:`~.admission.Admission`): at most :attr:`Limits.max_connections` tabs, at most
+  :attr:`Limits.max_per_address` from one source address, :attr:`Limits.lecturer_slots` kept for the lecturer's
+  machine, and a socket that sends nothing within :attr:`Limits.first_message_seconds` is dropped (a refused tab is
+  told why in a notification, then closed).
 - **Well-formed messages only**: every incoming message is checked against its declared field types
   (:func:`~.transport.message_problem`) before viser dispatches it; a handler that still fails is one log line. A
   tab that sends more than :attr:`Limits.max_malformed` malformed messages within :attr:`Limits.malformed_window`
@@ -31,11 +35,13 @@ import dataclasses
 import functools
 import threading
 import time
+from collections.abc import Callable
 from typing import Any
 
 import viser
 
 from tpm_viz.classroom.guard import FAULTS, log_fault, report
+from tpm_viz.viserkit.admission import Admission, is_loopback
 from tpm_viz.viserkit.core import thread_pool
 from tpm_viz.viserkit.doors import ServerDoor
 from tpm_viz.viserkit.gate import Gate
@@ -44,15 +50,21 @@ from tpm_viz.viserkit.wire import Incoming, Wrapper
 
 __all__ = [
     "DEFAULT_MAX_CONNECTIONS",
+    "DEFAULT_MAX_PER_ADDRESS",
     "Gate",
     "Limits",
     "ServerGuard",
     "guard_of",
     "harden_server",
+    "set_admission",
     "set_max_connections",
 ]
 
 DEFAULT_MAX_CONNECTIONS = 200
+"""Most tabs at once (a lecture hall of 150 with room to spare; ``bench_load.py --mode hall`` measures 150)."""
+DEFAULT_MAX_PER_ADDRESS = 50
+"""Most tabs from one source address: a quarter of the total, so one student's sockets leave the class room, and a
+class of 50 behind one router (NAT) still fits."""
 
 
 @dataclasses.dataclass
@@ -60,6 +72,12 @@ class Limits:
     """The limits of one server (see the module docstring)."""
 
     max_connections: int = DEFAULT_MAX_CONNECTIONS
+    max_per_address: int = DEFAULT_MAX_PER_ADDRESS
+    lecturer_slots: int = 10
+    """Places only the lecturer's tabs may take (at most a quarter of ``max_connections``)."""
+    first_message_seconds: float = 10.0
+    lecturer: Callable[[str], bool] = is_loopback
+    """Whether a source address is the lecturer's machine (no per-address cap, the kept places)."""
     max_frame_bytes: int = 1 << 20
     max_callbacks_per_tab: int = 8
     max_backlog_bytes: int = 32 << 20
@@ -96,8 +114,8 @@ class ServerGuard:
         self._submit = pool.__dict__.get("submit")  # an instance's own (the callbacks' guard), or None: the class's
         self.gate = Gate(pool.submit, limits.max_callbacks_per_tab)
         pool.submit = self.gate.submit
-        self.accepted: set[int] = set()
-        self.refused: set[int] = set()
+        self.admission = Admission(self.door, limits, time.monotonic)
+        """Who gets a connection (:mod:`.admission`)."""
         self._malformed: dict[int, collections.deque[float]] = {}
         """Times of each tab's recent malformed messages (at most ``max_malformed + 1`` each)."""
         self.dropped = 0
@@ -111,21 +129,21 @@ class ServerGuard:
         self._thread.start()
 
     # -- connections ---------------------------------------------------------------------------------------------
+    @property
+    def accepted(self) -> dict[int, str]:
+        """The connections that hold a place, with their source address."""
+        return self.admission.accepted
+
+    @property
+    def refused(self) -> set[int]:
+        """The connections refused (told, closing) or dropped for malformed messages."""
+        return self.admission.refused
+
     def _connected(self, client_id: int) -> None:
-        if len(self.accepted) < self.limits.max_connections:
-            self.accepted.add(client_id)
-            return
-        self.refused.add(client_id)
-        n = self.limits.max_connections
-        log_fault("server", "full", f"connection {client_id} refused: {n} tabs are connected (max_connections)")
-        self.door.notify(client_id, "Too many tabs", f"This server takes at most {n} tabs. Try again later.")
-        loop = self.door.loop
-        if loop is not None:
-            loop.call_later(self.limits.refuse_close_delay, self.door.close, client_id, 1013, "too many tabs")
+        self.admission.admit(client_id)
 
     def _disconnected(self, client_id: int) -> None:
-        self.accepted.discard(client_id)
-        self.refused.discard(client_id)
+        self.admission.left(client_id)
         self._malformed.pop(client_id, None)
         self.gate.forget(client_id)
         FAULTS.forget(client_id)
@@ -133,6 +151,7 @@ class ServerGuard:
     def _wrap(self, log: bool) -> Wrapper:
         def wrap(dispatch: Incoming) -> Incoming:
             async def handle(client_id: int, message: Any) -> None:
+                self.admission.heard(client_id)  # its first message: the deadline is met
                 if client_id in self.refused:
                     return
                 problem = message_problem(message)
@@ -183,6 +202,7 @@ class ServerGuard:
             live = set(self.door.live())
             try:
                 self._check(live, over, now)
+                self.admission.expire(now)
             except Exception as exc:  # one bad round must not stop the watchdog: logged, the next one runs
                 report(exc, "the watchdog's round")
             if known - live:
@@ -247,6 +267,20 @@ def guard_of(server: viser.ViserServer) -> ServerGuard | None:
     """The guard installed on ``server``, if any (``TpmApp(max_connections=...)`` sets its limit)."""
     guard = getattr(server, _ATTR, None)
     return guard if isinstance(guard, ServerGuard) else None
+
+
+def set_admission(
+    server: viser.ViserServer, lecturer: Callable[[str], bool] | None = None, max_per_address: int | None = None
+) -> None:
+    """Who the lecturer's machine is (``lecturer(address)``) and the most tabs per address, on ``server``
+    (installs the limits first if needed; :mod:`.admission`)."""
+    limits = harden_server(server).limits
+    if lecturer is not None:
+        limits.lecturer = lecturer
+    if max_per_address is not None:
+        if not (isinstance(max_per_address, int) and max_per_address >= 1):
+            raise ValueError(f"max_per_address must be a positive integer, got {max_per_address!r}")
+        limits.max_per_address = max_per_address
 
 
 def set_max_connections(server: viser.ViserServer, max_connections: int) -> None:
