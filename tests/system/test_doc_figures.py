@@ -11,7 +11,8 @@
   below it plots round-off (1e-13 N) and may differ.
 
 Elsewhere: the design tables (``tests/cli/test_design.py``), the clip (``tests/cli/test_outputs_clip.py``), the
-stage screenshots (``tests/e2e/test_browser_stage.py``), the examples' figures (``test_examples.py``).
+stage screenshots (``tests/e2e/test_browser_stage.py``), the app's and the teaching demo's screenshots
+(``tests/e2e/test_browser_docs_figures.py``), the examples' figures (``test_examples.py``).
 """
 
 from __future__ import annotations

@@ -20,6 +20,8 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 EXAMPLES = sorted((ROOT / "examples").glob("[0-9][0-9]_*/[0-9][0-9]_*.py"))
 SERVES = {"05_the_app/00_start_the_app.py"}
 """Examples that serve until Ctrl-C (slow: viser starts)."""
+SLOW = {"01_the_model/01_singularity_map.py", "02_motion/00_time_optimal_planner.py", "03_design/00_design_indices.py"}
+"""Examples over a second on a quiet machine (matplotlib, toppra, the design's planner): left out of the fast loop."""
 PRINTS = {
     "00_getting_started/00_closed_form_at_a_pose.py": ["status: REGULAR"],
     "00_getting_started/01_the_papers_line_and_circle.py": ["177.1 N / 44.3 N = 4.000", "wrote circle.csv"],
@@ -55,7 +57,11 @@ def test_every_example_is_numbered_documented_and_pinned():
     assert set(PRINTS) | SERVES == {_name(p) for p in EXAMPLES}
 
 
-@pytest.mark.parametrize("path", [p for p in EXAMPLES if _name(p) not in SERVES], ids=_name)
+@pytest.mark.parametrize(
+    "path",
+    [pytest.param(p, marks=[pytest.mark.slow] if _name(p) in SLOW else []) for p in EXAMPLES if _name(p) not in SERVES],
+    ids=_name,
+)
 def test_the_example_runs_in_an_empty_folder(path, tmp_path):
     done = subprocess.run(
         [sys.executable, str(path)], cwd=tmp_path, env=_env(), capture_output=True, text=True, timeout=600
