@@ -40,6 +40,7 @@ suppress_warnings = ["myst.xref_ambiguous"]
 # a module's own members (its __all__ may re-export: those are documented where they are defined)
 autodoc_default_options = {
     "members": True,
+    "undoc-members": True,  # dataclass fields, enum members, constants: listed even without a docstring of their own
     "ignore-module-all": True,
     "show-inheritance": True,
     "member-order": "bysource",

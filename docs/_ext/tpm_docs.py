@@ -222,6 +222,11 @@ def on_signature(app: Sphinx, what: str, name: str, obj: Any, options: Any, sign
     return short_types(signature), short_types(ret)
 
 
+def on_bases(app: Sphinx, name: str, obj: Any, options: Any, bases: list[Any]) -> None:
+    """No "Bases: object" under every plain class (the bases that say something, e.g. an error's, stay)."""
+    bases[:] = [base for base in bases if base is not object]
+
+
 # --------------------------------------------------------------------------------------------------------------------
 # API pages
 
@@ -411,6 +416,7 @@ def setup(app: Sphinx) -> dict[str, Any]:
     app.connect("builder-inited", write_example_pages)
     app.connect("builder-inited", write_api_pages)
     app.connect("autodoc-process-signature", on_signature)
+    app.connect("autodoc-process-bases", on_bases)
     app.add_directive("tpm-modules", ModulesDirective)
     app.add_directive("tpm-public", PublicDirective)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
