@@ -1,8 +1,8 @@
 """Root of the tests, which mirror the package: ``tests/<folder>/test_<module>.py`` tests
 ``tpm_viz/<folder>/<module>.py`` (``core/``, ``paper/``, ``drawing/``, ``media/``, ``exchange/``, ``multibody/``,
 ``app/``, ``design/``, ``classroom/``, ``viserkit/``, ``ui/``, ``cli/``), plus ``e2e/`` (a served app with its browsers
-and attackers, as a class meets it) and ``system/`` (the rules of the repository: layering, cross-references, README,
-lock).
+and attackers, as a class meets it) and ``system/`` (the rules of the repository: layering, cross-references, the README
+and the docs site, the examples, the lock).
 
 Shared helpers live in ``tests/support/``; only ``classroom/``, ``viserkit/``, ``ui/`` and ``e2e/`` load the server
 and browser fixtures, so the maths tests run without websockets or Chromium.

@@ -20,7 +20,7 @@ from tpm_viz.cli import main
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 DOC = ROOT / "docs" / "exercises.md"
 COMMAND = ["exercise", "selftest", "--variants", "20"]
-BLOCK = re.compile(r"(<!-- selftest: tpm-viz exercise selftest --variants 20 -->\n```csv\n)(.*?)(```)", re.S)
+BLOCK = re.compile(r"(<!-- selftest: tpm-viz exercise selftest --variants 20 -->\n```text\n)(.*?)(```)", re.S)
 
 
 def _rows(text: str) -> list[list[str]]:

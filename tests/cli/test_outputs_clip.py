@@ -1,6 +1,7 @@
 """``tpm-viz clip``: the GIF and the MP4 decoded back (frames, size, rate, motion), the forces drawn in each frame
 measured in pixels and compared with ``tpm-viz trajectory``'s forces at the same times, byte-identical reruns, and
-one-line refusals. The clip of the README (docs/images/clip.gif) is made by :data:`README_CLIP`, run here."""
+one-line refusals. The clip of the docs (docs/images/clip.gif, shown by docs/media.md) is made by :data:`DOCS_CLIP`, run
+here, the command the page states."""
 
 from __future__ import annotations
 
@@ -22,11 +23,11 @@ from tpm_viz.cli import main
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-README_CLIP = [
+DOCS_CLIP = [
     "clip", "--trajectory", "circle", "--samples", "101", "--fps", "20", "--size", "640x360",
     "--output", str(ROOT / "docs" / "images" / "clip.gif"),
 ]  # fmt: skip
-"""The command that makes the README's clip (the circle of Fig. 5, 101 frames, 5 s at 20 frames/s)."""
+"""The command that makes the clip of docs/media.md (the circle of Fig. 5, 101 frames, 5 s at 20 frames/s)."""
 BLUE, RED = (31, 119, 180), (214, 39, 40)  # tpm_viz.media.clips.BAR_COLOURS, written out: the test reads pixels
 
 
@@ -131,9 +132,11 @@ def test_the_papers_circle_at_20_fps_is_under_5_mb(tmp_path):
     assert Image.open(io.BytesIO(data)).n_frames == 401
 
 
-def test_the_readme_clip_is_made_by_its_command(capsys):
-    assert main(README_CLIP) == 0
-    path = pathlib.Path(README_CLIP[-1])
+def test_the_docs_clip_is_made_by_the_command_its_page_states(capsys):
+    stated = " ".join((ROOT / "docs" / "media.md").read_text().split())
+    assert "tpm-viz " + " ".join(DOCS_CLIP[:-1]) + " docs/images/clip.gif" in stated
+    assert main(DOCS_CLIP) == 0
+    path = pathlib.Path(DOCS_CLIP[-1])
     im = Image.open(path)
     assert (im.n_frames, im.size) == (101, (640, 360))
     assert path.stat().st_size < 2**20

@@ -97,7 +97,7 @@ def test_numbers_equal_the_command_lines(english, capsys):
     tau_pin = np.stack([pin["tau1"], pin["tau2"]], -1)
     k = int(np.argmax(np.abs(tau).max(axis=1)))
     assert rep.values["peak"] == [pytest.approx(np.abs(tau).max(), rel=1e-12)]
-    assert rep.values["peak"][0] == pytest.approx(177.1, abs=0.05)  # the README's circle at 0.5 s
+    assert rep.values["peak"][0] == pytest.approx(177.1, abs=0.05)  # the circle at 0.5 s of docs/teaching.md
     assert rep.values["peak_t"] == [pytest.approx(paper["t"][k], abs=1e-15)]
     assert rep.values["peak_tau1"] == [pytest.approx(tau[k, 0], rel=1e-12)]
     assert rep.values["max_diff"] == [pytest.approx(np.abs(tau_pin - tau).max(), rel=1e-6, abs=1e-12)]

@@ -79,7 +79,7 @@ def _room_for_the_forces(page, where: str) -> None:
 
 @pytest.fixture(scope="module")
 def shots():
-    """Where the screenshots go: ``TPM_VIZ_SCREENSHOTS`` (the README's come from there), else a temporary folder."""
+    """Where the screenshots go: ``TPM_VIZ_SCREENSHOTS`` (docs/app.md's come from there), else a temporary folder."""
     folder = os.environ.get("TPM_VIZ_SCREENSHOTS") or tempfile.mkdtemp(prefix="tpm-viz-stage-")
     os.makedirs(folder, exist_ok=True)
     yield folder

@@ -13,7 +13,7 @@ from tpm_viz.multibody.control import ControlSetup, simulate
 from tpm_viz.paper.control import Gains
 
 P = Params.paper()
-GAINS = Gains(10.0, 1.0)  # the README's settings: ω_n = 10 Hz, ζ = 1
+GAINS = Gains(10.0, 1.0)  # the settings of docs/control.md: ω_n = 10 Hz, ζ = 1
 
 
 def max_error(controller: str, rate: float, at: str) -> float:

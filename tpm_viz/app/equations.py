@@ -52,7 +52,7 @@ _DET = T(
     "4 l<sub>a</sub>² det J<sub>x</sub>, so the multipliers, and with them the forces, grow without bound at the "
     "direct singularity."
 )
-_ERRATA_HEAD = T("<b>Errata confirmed numerically</b> (evidence in the README and the test suite):")
+_ERRATA_HEAD = T("<b>Errata confirmed numerically</b> (evidence in docs/model.md and the test suite):")
 _ERRATA = (
     Phrase(
         "Eq. (15): the derivative of cos θ<sub>i</sub> is −sin θ<sub>i</sub> θ̇<sub>i</sub>; the paper prints +. "

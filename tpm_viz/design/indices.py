@@ -229,8 +229,8 @@ def _gauss_rule(task: Task, panels: int, order: int = GAUSS_ORDER) -> tuple[np.n
 def area_means(f: Callable[[np.ndarray], np.ndarray], task: Task, rtol: float = 1e-3) -> tuple[np.ndarray, int]:
     """Area means over ``task`` of the columns of ``f(points) -> (n, k)``, and the panels per side used.
 
-    Composite Gauss-Legendre (:data:`GAUSS_ORDER`² nodes per panel), panels per side 1, 2, 4, ... until every
-    column's mean changes by at most ``rtol`` of its value from one doubling to the next.
+    Composite Gauss-Legendre (:data:`GAUSS_ORDER` × :data:`GAUSS_ORDER` nodes per panel), panels per side 1, 2, 4,
+    ... until every column's mean changes by at most ``rtol`` of its value from one doubling to the next.
     """
     nodes, weights = _gauss_rule(task, 1)
     previous = weights @ f(nodes)

@@ -5,7 +5,7 @@
   loopback address: on a student's phone 127.0.0.1 is the phone itself); :func:`qr_text` / :func:`qr_data_uri`
   draw one of them as a QR code (``segno``) for the terminal and the lecturer's panel.
 - :class:`Handshakes` sees every HTTP request and websocket handshake
-(:func:`~tpm_viz.viserkit.adapter.new_server`): a
+  (:func:`~tpm_viz.viserkit.adapter.new_server`): a
   websocket whose ``Origin`` is not the host the page was served under is refused with 403 (the same-origin check
   Jupyter's server makes: any page open in the lecturer's browser could otherwise drive the mechanism on
   127.0.0.1); a client without ``Origin`` (not a browser) may connect. The page's response sets a

@@ -153,7 +153,7 @@ body:has([data-dock-rail-root]) [data-floating-window]:has([data-live]) {{ visib
 @media {_PHONE} {{ div:has(> div > [data-live]) {{ display: none !important; }} }}
 </style>"""
 """Presentation mode: large, dark type (the charts' titles and legends too; their axes are drawn on a canvas, sized by
-:meth:`~.teaching.charts.Charts.set_presentation`); the box of banner and forces shown only while the panel is
+:meth:`~.teaching.player.charts.Charts.set_presentation`); the box of banner and forces shown only while the panel is
 collapsed."""
 
 

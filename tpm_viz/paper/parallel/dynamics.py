@@ -6,7 +6,9 @@ Derivation: ``docs/parallel.md`` (eqs. P9-P15, the analogues of the paper's eqs.
 platform ``m_p`` translate, each parallelogram is two uniform rods of ``m_b/2``. Written with the rod's end
 velocities, the kinetic energy is a constant quadratic form in ``q̇`` (eq. P9), so ``∂K/∂q = 0``:
 
-(a) ``d`` from eq. (P3); (b) ``ḋ = J ṗ`` (eq. P4); (c) ``d̈`` (eq. P5);
+(a) ``d`` from eq. (P3);
+(b) ``ḋ = J ṗ`` (eq. P4);
+(c) ``d̈`` (eq. P5);
 (d) ``G_p λ = v - f_ext`` with ``G_p = [[2c_1, -2c_2], [2p_2, 2p_2]]``, ``v_1 = m_P p̈_1 + (m_b/6)(d̈_1 - d̈_2)``,
     ``v_2 = m_P p̈_2``, ``m_P = m_p + 2 m_b / 3`` (eqs. P11-P12);
 (e) ``τ_i = w_i + 2 λ_i c_i`` with ``w_1 = m_A d̈_1 + (m_b/6) p̈_1``, ``w_2 = m_A d̈_2 - (m_b/6) p̈_1``,

@@ -29,10 +29,10 @@ CONTROL_SETTINGS = {
     "rate": Setting("Controller rate (Hz)", Quantity("controller rate", "Hz", lo=100.0, hi=5000.0), 100.0, 1000.0),
     "noise": Setting("Position noise (µm)", Quantity("position noise", "µm", lo=0.0, hi=50.0), 1.0, 0.0),
 }
-"""The control lab's settings, by the name of the :class:`~.control.ControlView` attribute holding the slider."""
+"""The control lab's settings, by the name of the :class:`~.control.tab.ControlView` attribute holding the slider."""
 
 PLANNER_SETTINGS = {
     "force": Setting("Force limit F_max (N)", Quantity("F_max", "N", lo=20.0, hi=1000.0), 5.0, 200.0),
     "speed": Setting("Speed limit (m/s, 0 = none)", Quantity("speed limit", "m/s", lo=0.0, hi=5.0), 0.05, 0.0),
 }
-"""The planner's limits, by the name of the :class:`~.planner.PlannerView` attribute holding the slider."""
+"""The planner's limits, by the name of the :class:`~.planner.tab.PlannerView` attribute holding the slider."""

@@ -19,7 +19,7 @@ from __future__ import annotations
 import functools
 import weakref
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import viser
 
@@ -64,9 +64,9 @@ class Services:
     runs: RunHub
     plans: Worker
     """The planner's worker: the same fair queue (a re-plan takes its tab's turn like any other job)."""
-    lessons: tuple[Demo, ...] = DEMOS
+    lessons: tuple[Demo, ...] = field(default_factory=lambda: DEMOS)
     """The lessons of the *Demos* tab: the packaged ones, or a lecturer's (``tpm-viz serve --lessons DIR``)."""
-    problems: tuple[str, ...] = PROBLEMS
+    problems: tuple[str, ...] = field(default_factory=lambda: PROBLEMS)
     """One line per lesson file that was refused (``file:line: what is wrong``), shown in the tab."""
     later: Later | None = None
     """Where a tab's :data:`LATER` groups wait for a quiet moment (None: every tab is built whole at once)."""
