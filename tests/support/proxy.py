@@ -1,5 +1,7 @@
 """A small TCP proxy on 127.0.0.1 for network-drop tests: a browser talks to the app through it, and
-:meth:`TcpProxy.drop` cuts every connection and refuses new ones for a while (a wifi blip, a closed laptop lid).
+:meth:`TcpProxy.drop` cuts every connection and, for a while, refuses new ones (a wifi blip, a closed laptop lid: the
+other end answers "no") or black-holes them (a wifi that lost its way out: accepted, never answered).
+:attr:`TcpProxy.arrivals` times every connection attempt (``time.monotonic()``), drops included.
 
 The proxy runs its own asyncio loop in a daemon thread; :meth:`TcpProxy.close` stops it. Bounded: at most
 :data:`MAX_CONNECTIONS` at once. :class:`LoopbackProxy` and :func:`splice` are that skeleton, shared with
@@ -92,11 +94,21 @@ class TcpProxy(LoopbackProxy):
 
     def __init__(self, target: int) -> None:
         self.accepted = 0
+        self.arrivals: list[float] = []
+        """When each connection attempt arrived (``time.monotonic()``), refused and black-holed ones included."""
         self._down_until = 0.0
+        self._black_hole = False
+        self._held: set[asyncio.StreamWriter] = set()
         super().__init__(target, "tcp-proxy")
 
     async def _handle(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
-        if time.monotonic() < self._down_until or len(self._writers) >= MAX_CONNECTIONS:
+        now = time.monotonic()
+        if len(self.arrivals) < 100_000:
+            self.arrivals.append(now)
+        if now < self._down_until and self._black_hole and len(self._held) < MAX_CONNECTIONS:
+            await self._hold(reader, writer)
+            return
+        if now < self._down_until or len(self._writers) >= MAX_CONNECTIONS:
             writer.close()  # the network is down
             return
         self.accepted += 1
@@ -109,11 +121,28 @@ class TcpProxy(LoopbackProxy):
         await splice(reader, writer, up_reader, up_writer)
         self._writers -= {writer, up_writer}
 
-    def drop(self, seconds: float) -> None:
-        """Cut every connection now (reset, no closing handshake) and refuse new ones for ``seconds``."""
+    async def _hold(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        """A black-holed connection: whatever the client sends is swallowed, nothing ever comes back, until the
+        client gives up (or the proxy closes)."""
+        self._held.add(writer)
+        self._writers.add(writer)
+        try:
+            while await reader.read(65536):
+                pass
+        except (ConnectionError, OSError):
+            pass
+        finally:
+            self._held.discard(writer)
+            self._writers.discard(writer)
+            writer.close()
+
+    def drop(self, seconds: float, black_hole: bool = False) -> None:
+        """Cut every connection now (reset, no closing handshake) and, for ``seconds``, refuse new ones (closed at
+        once) or, with ``black_hole``, accept and never answer them (they hang until the client gives up)."""
 
         def cut() -> None:
             self._down_until = time.monotonic() + seconds
+            self._black_hole = black_hole
             for w in list(self._writers):
                 transport = w.transport
                 with contextlib.suppress(Exception):
@@ -121,3 +150,12 @@ class TcpProxy(LoopbackProxy):
             self._writers.clear()
 
         self._loop.call_soon_threadsafe(cut)
+
+    def restore(self) -> None:
+        """The network is back now (a drop ends early); black-holed connections stay silent until their client
+        gives up."""
+
+        def up() -> None:
+            self._down_until = 0.0
+
+        self._loop.call_soon_threadsafe(up)

@@ -32,9 +32,9 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 KIT = ROOT / "tpm_viz" / "viserkit"
 UPSTREAM = KIT / "upstream"
 PATCHES_MD = KIT / "PATCHES.md"
-NOT_SWITCHES = {"page", "internals"}
-"""``PATCHES.md`` entries that ``install`` cannot switch off: the page script (added by the handshake hook) and the
-reads of viser's private names (``core.py``)."""
+NOT_SWITCHES = {"page", "internals", "reconnect"}
+"""``PATCHES.md`` entries that ``install`` cannot switch off: the page script (added by the handshake hook), its way
+back after a network drop, and the reads of viser's private names (``core.py``)."""
 SECTIONS = ("## Observed", "## Expected", "## Reproduction", "## Suggested change", "## Workaround meanwhile")
 CHROMIUM = "/usr/bin/chromium"
 
@@ -97,7 +97,7 @@ def test_each_upstream_file_is_an_issue_ready_to_send(path):
 @pytest.mark.parametrize("path", sorted(UPSTREAM.glob("*.md")), ids=lambda p: p.stem)
 def test_each_upstream_script_still_shows_its_problem_on_the_installed_viser(path):
     """When this fails, viser fixed it: follow the entry's "Retire when" line in ``PATCHES.md``."""
-    if path.stem.endswith("-page"):
+    if path.stem.endswith(("-page", "-reconnect")):
         pytest.importorskip("playwright.sync_api")
         if not os.path.exists(CHROMIUM) and shutil.which("chromium") is None:
             pytest.skip("no Chromium for the page's script")

@@ -41,7 +41,7 @@ from tpm_viz.classroom.launches import TICKET_SECONDS, Tickets, ticket_of_query
 from tpm_viz.classroom.links import PENDING_SECONDS, PendingLinks, token_of_query
 from tpm_viz.classroom.network import PROXIED, HostRules, client_address, header_problem, host_name
 from tpm_viz.ui.keyboard import Keyboard
-from tpm_viz.viserkit.page import with_script
+from tpm_viz.viserkit.page import ALIVE_PATH, with_script
 
 __all__ = [
     "COOKIE",
@@ -219,7 +219,8 @@ def identity(remote: Any, headers: Any, keys: Keys = DEFAULT_KEYS) -> str | None
 
 class Handshakes:
     """The hook of :func:`~tpm_viz.viserkit.adapter.new_server`: refuse cross-origin websockets, give pages an
-    identity, and keep a share link's token for the tab the page opens (:data:`SHARE_COOKIE`)."""
+    identity, keep a share link's token for the tab the page opens (:data:`SHARE_COOKIE`), and answer the page
+    script's requests (its keys; ``GET /tpm-viz/alive`` of a disconnected page, :mod:`tpm_viz.viserkit.page`)."""
 
     def __init__(
         self,
@@ -282,6 +283,8 @@ class Handshakes:
             return refusal
         if (key := self.keyboard.answer(request.path, same_origin(headers))) is not None:
             return connection.respond(*key)  # a key of the page script (viserkit/page.py)
+        if request.path.partition("?")[0] == ALIVE_PATH:  # a disconnected page asking whether to reconnect
+            return connection.respond(http.HTTPStatus.OK, "ok\n")
         if headers.get("Upgrade", "").lower() == "websocket":
             if same_origin(headers):
                 return None

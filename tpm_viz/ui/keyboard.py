@@ -35,7 +35,7 @@ from tpm_viz.classroom.guard import guarded
 from tpm_viz.classroom.session import View
 from tpm_viz.core.errors import TpmVizError
 from tpm_viz.core.words import T
-from tpm_viz.viserkit.page import QUEUED, key_request
+from tpm_viz.viserkit.page import QUEUED, RECONNECT_NOW, key_request
 
 __all__ = ["BIG_STEP_MM", "KEY_BURST", "KEY_RATE", "MOVES", "STEP_MM", "Keyboard", "keyboard_of"]
 
@@ -75,14 +75,16 @@ SETTINGS = T("Settings")
 
 
 def _marker(nonce: str) -> str:
-    """The hidden element of a tab's panel: its nonce, and the words the page script gives the 3D view and the
-    close buttons (English here; in the tab's language on the wire, :mod:`.language`)."""
+    """The hidden element of a tab's panel: its nonce, and the words the page script gives the 3D view, the close
+    buttons and its *Reconnect now* button (English here; in the tab's language on the wire, :mod:`.language`)."""
     words = "".join(f'<span data-w="{key}">{html.escape(str(text))}</span>' for key, text in WORDS.items())
     words += "".join(f'<span data-en="{html.escape(str(text))}">{html.escape(str(text))}</span>' for text in VISER)
     return f'<div data-tpmviz-keys="{nonce}" hidden>{words}</div>'
 
 
-WORDS = {"view": LABEL, "close": CLOSE, "settings": SETTINGS}
+WORDS = {"view": LABEL, "close": CLOSE, "settings": SETTINGS, "reconnect": RECONNECT_NOW}
+"""The words of the hidden element, by key (``data-w``): the 3D view's name, viser's close and settings buttons, and
+the *Reconnect now* button the page script shows while the tab is disconnected (:mod:`tpm_viz.viserkit.page`)."""
 
 VISER = (
     CLOSE,

@@ -1,4 +1,5 @@
-// tpm-viz's own script in viser's page: keys, a live region, labels and focus (see tpm_viz/viserkit/page.py).
+// tpm-viz's own script in viser's page: keys, a live region, labels and focus, the way back after a network drop
+// (see tpm_viz/viserkit/page.py).
 // Its settings come from the JSON element #tpmviz-page-config the server puts before it (page.py's CONFIG): data,
 // never code. Checked by `node --check` and tests/viserkit/test_page_script.py.
 (() => {
@@ -20,6 +21,113 @@
   const NOTICE = CONFIG.notice;
   const TYPING = 'input:not([type="checkbox"]):not([type="radio"]), textarea, select, [contenteditable=""], ' +
     '[contenteditable="true"], [role="combobox"]';
+
+  // -- the way back after a network drop: viser's websocket retries replaced --------------------------------------
+  // viser's page posts "retry" to its websocket worker every second while disconnected, and each retry closes the
+  // attempt before it. Chromium counts an attempt closed before its handshake as a failed one and delays the next
+  // by rand(1-5 s) * 2^min(pending + failed / (succeeded + 1), 16) / 65536 (its per-process WebSocket throttle,
+  // remembered 2-4 minutes): after ~30 s of drop each attempt waits longer than a second and is closed before it
+  // starts, so the page stays dead long after the network is back. Here viser's "retry" messages are dropped; while
+  // disconnected the page asks RECONNECT.path (plain HTTP, not throttled) every RECONNECT.every ms, and at once on
+  // `online`, on becoming visible and on the button, and tells the worker to connect once the server answers: no
+  // websocket attempt fails while the network is down. A hidden page does not ask (it asks when shown again); one
+  // without focus does (viser's own retries stop without focus). Nothing is reloaded.
+  const RECONNECT = CONFIG.reconnect || null;
+  let link = null;  // viser's websocket worker: { worker, post } (post: its postMessage, unfiltered)
+  let down = false;  // disconnected: the worker said "closed" and not "connected" since
+  let tried = 0;  // performance.now() of the connect asked and not answered yet (0: none)
+  let probing = false;
+  let timer = 0;
+  let showing = 0;
+  let button = null;
+
+  function retry() {  // the worker closes any pending attempt and opens a new one
+    if (!link || !down) return;
+    tried = performance.now();
+    link.post({ type: "retry" });
+  }
+  function probe() {  // ask the server; connect if it answers (any HTTP answer: it is reachable)
+    clearTimeout(timer);
+    timer = 0;
+    if (!down || !link) return;
+    timer = setTimeout(probe, RECONNECT.every);
+    if (probing || (tried && performance.now() - tried < RECONNECT.stale)) return;
+    if (document.visibilityState === "hidden") return;  // a hidden tab waits until it is shown (as viser's #367)
+    probing = true;
+    const stop = typeof AbortController === "function" ? new AbortController() : null;
+    const limit = stop ? setTimeout(() => stop.abort(), RECONNECT.wait) : 0;
+    fetch(RECONNECT.path, { cache: "no-store", credentials: "same-origin", signal: stop ? stop.signal : undefined })
+      .then((answer) => { if (answer.body) answer.body.cancel().catch(() => {}); retry(); }, () => {})
+      .finally(() => { clearTimeout(limit); probing = false; });
+  }
+  function language() {  // the browser's first language among the button's (as the server picks a new tab's)
+    for (const tag of navigator.languages || [navigator.language || ""]) {
+      const primary = String(tag).toLowerCase().split("-")[0];
+      if (Object.prototype.hasOwnProperty.call(RECONNECT.words, primary)) return primary;
+    }
+    return "en";
+  }
+  function show(on) {
+    if (!button) return;
+    if (on) button.textContent = words("reconnect", RECONNECT.words[language()] || RECONNECT.words.en);
+    if (button.hidden === !on) return;
+    button.hidden = !on;
+    document.body.toggleAttribute("data-tpmviz-offline", on);
+  }
+  function connected() {
+    down = false;
+    tried = 0;
+    clearTimeout(timer);
+    clearTimeout(showing);
+    timer = showing = 0;
+    show(false);
+  }
+  function closed() {
+    down = true;
+    tried = 0;
+    if (!timer) probe();
+    if (!showing && !(button && !button.hidden)) {
+      showing = setTimeout(() => { showing = 0; if (down) show(true); }, RECONNECT.after);
+    }
+  }
+  function now() {  // the network is back, or the page is looked at again: ask at once
+    if (down) probe();
+  }
+  function watch(worker) {  // every worker viser makes; the websocket one is the one told "set_server"
+    const post = worker.postMessage.bind(worker);
+    worker.postMessage = (data, transfer) => {
+      const type = data && data.type;
+      if (type === "set_server") link = { worker, post };
+      else if (type === "retry" && link && link.worker === worker) return undefined;  // viser's: ours instead
+      else if (type === "close" && link && link.worker === worker) { link = null; connected(); }
+      return transfer === undefined ? post(data) : post(data, transfer);
+    };
+    worker.addEventListener("message", (ev) => {
+      if (!link || link.worker !== worker || !ev.data) return;
+      if (ev.data.type === "connected") connected();
+      else if (ev.data.type === "closed") closed();
+    });
+  }
+  if (RECONNECT && typeof window.Worker === "function") {  // before viser's bundle runs (after DOMContentLoaded)
+    const Base = window.Worker;
+    window.Worker = class extends Base {
+      constructor(url, options) {
+        super(url, options);
+        watch(this);
+      }
+    };
+    window.addEventListener("online", now);
+    document.addEventListener("visibilitychange", () => { if (document.visibilityState === "visible") now(); });
+  }
+  function reconnectButton(parent) {
+    if (!RECONNECT) return;
+    button = document.createElement("button");
+    button.type = "button";
+    button.id = "tpmviz-reconnect";
+    button.hidden = true;
+    button.addEventListener("click", () => { if (down) { retry(); probe(); } });
+    parent.appendChild(button);
+  }
 
   // -- presentation mode: the panel folds to its rail and back (viser's own buttons) ----------------------------
   function fold() {
@@ -244,13 +352,19 @@
       "body[data-tpmviz-tips=above] .mantine-Tooltip-tooltip { position: fixed !important; top: auto !important; " +
       "bottom: var(--tpmviz-tip-bottom) !important; left: " + GAP + "px !important; right: " + GAP + "px !important; " +
       "width: auto !important; max-width: none !important; }\n" +
-      "@media (max-width: 36em), (pointer: coarse) { " + NOTICE + " }";
+      "@media (max-width: 36em), (pointer: coarse) { " + NOTICE + " }\n" +
+      "#tpmviz-reconnect { position: fixed; z-index: 10000; top: 48px; left: 50%; transform: translateX(-50%); " +
+      "min-height: 44px; min-width: 44px; padding: 8px 20px; border: 0; border-radius: 22px; cursor: pointer; " +
+      "font: 600 16px/1.25 system-ui, sans-serif; color: #fff; background: #0f766e; " +
+      "box-shadow: 0 2px 10px rgba(0, 0, 0, 0.35); }\n" +
+      "#tpmviz-reconnect:hover { background: #115e59; }\n#tpmviz-reconnect[hidden] { display: none; }";
     document.head.appendChild(css);
     const title = document.createElement("h1");
     title.textContent = "tpm-viz";
     title.style.cssText = HIDDEN;
     const banner = document.createElement("header");  // a landmark: all of the page is in one (axe's "region")
     banner.appendChild(title);
+    reconnectButton(banner);
     document.body.prepend(banner);
   }
 

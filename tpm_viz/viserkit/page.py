@@ -24,7 +24,17 @@ into the script). The gzipped variant is unpacked, edited and packed once per pa
   keyboard focus too (a ``mouseenter`` on the field's wrappers, which is what viser's tooltip listens to);
 - folds and unfolds the panel with :data:`FOLD_KEY` in presentation mode (viser's own rail and collapse buttons,
   clicked), from anywhere but a text field;
-- keeps viser's software-WebGL notice to a one-line strip on a phone (:data:`NOTICE_CSS`).
+- keeps viser's software-WebGL notice to a one-line strip on a phone (:data:`NOTICE_CSS`);
+- brings the tab back promptly after a network drop (:data:`RECONNECT`): it takes over viser's websocket retries
+  (viser's page closes its pending attempt and opens a new one every second, and Chromium, which counts each such
+  attempt as a failed one and delays the next by up to 1-5 s once there are about 16 failures per success, ends up
+  closing every attempt before it starts: after a 30 s drop the page stayed dead for minutes). While the tab is
+  disconnected the script asks :data:`ALIVE_PATH` (a plain HTTP request, not throttled) every
+  :data:`RECONNECT_EVERY_MS` (a hidden page waits until it is shown; one without focus asks too), at once on the
+  browser's ``online`` event and when the page becomes visible again, and tells viser's worker to connect only once
+  the server answers; meanwhile it shows a *Reconnect now* button (``#tpmviz-reconnect``, in the tab's language: the
+  words the server put in the tab's hidden element, else the browser's first language among :data:`RECONNECT`'s)
+  that connects at once. No page reload: nothing typed is lost by it.
 
 The wire format of a key (:func:`key_request`) is in :mod:`.keys` (re-exported here).
 """
@@ -37,15 +47,19 @@ import threading
 from importlib import resources
 from typing import Any
 
+from tpm_viz.core.words import Lang, T, say
 from tpm_viz.viserkit.keys import KEY_PATH, KEYS, QUEUED, KeyRequest, key_request
 
 __all__ = [
+    "ALIVE_PATH",
     "CONFIG",
     "FOLD_KEY",
     "KEYS",
     "KEY_PATH",
     "NOTICE_CSS",
     "QUEUED",
+    "RECONNECT",
+    "RECONNECT_NOW",
     "SCRIPT",
     "KeyRequest",
     "config_json",
@@ -71,6 +85,32 @@ NOTICE_CSS = (
 """viser's "Software WebGL rendering detected" notice (a computer without a GPU) as a one-line strip, 24 px high, at
 the canvas's top-left corner: on a phone (a window at most 36em wide, or a coarse pointer) and in a touch tab."""
 
+ALIVE_PATH = "/tpm-viz/alive"
+"""What a disconnected page asks to learn that the server is reachable again (the handshake hook answers it, 200)."""
+RECONNECT_EVERY_MS = 2000
+"""How often a disconnected page asks :data:`ALIVE_PATH` [ms] (the issue asked for at most 2-3 s apart)."""
+RECONNECT_WAIT_MS = 1800
+"""How long one such request may take before it is given up [ms] (a black-holed network never answers)."""
+RECONNECT_STALE_MS = 6500
+"""How long a websocket attempt may stay unanswered before the page asks again [ms] (viser's worker closes an
+attempt that has not opened after 5 s, and says so)."""
+RECONNECT_AFTER_MS = 1000
+"""How long a tab is disconnected before its *Reconnect now* button shows [ms] (no flash on a brief blip)."""
+RECONNECT_NOW = T("Reconnect now")
+"""The button's words (the tab's hidden element carries them in the tab's language, :mod:`tpm_viz.ui.keyboard`)."""
+
+RECONNECT: dict[str, Any] = {
+    "path": ALIVE_PATH,
+    "every": RECONNECT_EVERY_MS,
+    "wait": RECONNECT_WAIT_MS,
+    "stale": RECONNECT_STALE_MS,
+    "after": RECONNECT_AFTER_MS,
+    "words": {lang.value: say(lang, RECONNECT_NOW) for lang in Lang},
+}
+"""The page's way back after a drop (``CONFIG["reconnect"]``; ``None`` there leaves viser's own retries alone). The
+button's words in every language: the script uses them when the tab's hidden element is not there (a tab that never
+connected), in the browser's first language among them (as the server picks a new tab's language)."""
+
 CONFIG: dict[str, Any] = {
     "path": KEY_PATH,
     "keys": list(KEYS),
@@ -78,6 +118,7 @@ CONFIG: dict[str, Any] = {
     "fold": FOLD_KEY,
     "gap": TIP_GAP,
     "notice": NOTICE_CSS,
+    "reconnect": RECONNECT,
 }
 """What the script is told (``page.js`` reads it as ``CONFIG``): its one input from Python, sent as JSON data in its
 own element, never written into the script's code."""
