@@ -19,6 +19,7 @@ from tpm_viz.cli.common import check_output, params_from_args
 from tpm_viz.core.csvio import read_text
 from tpm_viz.core.errors import InputError
 from tpm_viz.core.files import write_atomically
+from tpm_viz.media.clipopts import FORMATS, check_fps, parse_size
 from tpm_viz.paper.trajectories import parse_trajectory_csv
 
 __all__ = ["MAX_SAMPLES", "register", "run_from_args", "write_bytes"]
@@ -51,6 +52,12 @@ write_bytes = write_atomically
 """Write a clip, sidecar or report atomically: :func:`tpm_viz.core.files.write_atomically`, the CLI's one writer."""
 
 
+def _check_trajectory(name: str) -> None:
+    """``line``, ``circle`` or an existing file: a name that is none of them names the choices (one line)."""
+    if name not in ("line", "circle") and not os.path.lexists(name):
+        raise InputError(f"--trajectory {name!r}: no such file; give line, circle or a CSV file with columns t,p1,p2")
+
+
 def _suffix(path: str, allowed: tuple[str, ...]) -> str:
     ext = os.path.splitext(path)[1].lower().lstrip(".")
     if ext not in allowed:
@@ -59,12 +66,14 @@ def _suffix(path: str, allowed: tuple[str, ...]) -> str:
 
 
 def _cmd_clip(args) -> int:
-    from tpm_viz.media.clips import ClipRenderer, check_fps, parse_size  # matplotlib
-    from tpm_viz.media.videos import encode_clip  # Pillow, PyAV
-
-    fmt = _suffix(args.output, ("gif", "mp4"))
+    fmt = _suffix(args.output, FORMATS)  # the options first: a typo is refused before the heavy imports
     fps = check_fps(args.fps)
     size = parse_size(args.size)
+    _check_trajectory(args.trajectory)
+
+    from tpm_viz.media.clips import ClipRenderer  # matplotlib
+    from tpm_viz.media.videos import encode_clip  # Pillow, PyAV
+
     run = run_from_args(args)
     renderer = ClipRenderer(run, run.source.label, size)
     data = encode_clip(fmt, renderer.frame, len(renderer), fps)
@@ -104,13 +113,21 @@ def _report_date(text: str | None) -> datetime.date:
 
 
 def _cmd_report(args) -> int:
+    _suffix(args.output, ("html", "htm"))  # the options first: a typo is refused before the heavy imports
+    date = _report_date(args.date)
+    _check_trajectory(args.trajectory)
+
     from tpm_viz.media.report import report_html
     from tpm_viz.multibody import inverse_dynamics  # the Pinocchio model, the closed form's cross-check
 
-    _suffix(args.output, ("html", "htm"))
     run = run_from_args(args, reference=inverse_dynamics)
-    text = report_html(run, lang=args.lang, date=_report_date(args.date))
-    write_bytes(args.output, text.encode("utf-8"))
+    data = report_html(run, lang=args.lang, date=date).encode("utf-8")
+    write_bytes(args.output, data)
+    print(
+        f"tpm-viz report: {args.output}: {run.source.label}, {len(run.t)} samples over {run.t[-1]:.3f} s, "
+        f"{len(data) / 1024:.0f} KiB (opens offline)",
+        file=sys.stderr,
+    )
     return 0
 
 

@@ -30,6 +30,16 @@ from tpm_viz.core.params import Params
 from tpm_viz.core.words import Phrase
 from tpm_viz.drawing.labels import name_props, quiet_glyphs
 from tpm_viz.drawing.meshes import SLIDER_LENGTH, SLIDER_MARGIN, platform_half_size
+from tpm_viz.media.clipopts import (
+    DEFAULT_FPS,
+    DEFAULT_SIZE,
+    MAX_FPS,
+    MAX_SIZE,
+    MIN_SIZE,
+    SIZE_PRESETS,
+    check_fps,
+    parse_size,
+)
 from tpm_viz.paper.kinematics import mechanism_pose
 
 __all__ = [
@@ -50,13 +60,6 @@ __all__ = [
 
 MAX_FRAMES = 2001
 """Most frames of a clip (one per run sample)."""
-MIN_SIZE, MAX_SIZE = (320, 180), (1920, 1080)
-"""Smallest and largest frame ``(width, height)`` [px]."""
-DEFAULT_SIZE = (800, 450)
-SIZE_PRESETS = {"640×360": (640, 360), "800×450": (800, 450), "1280×720": (1280, 720), "1920×1080": (1920, 1080)}
-"""Frame sizes offered in the app [px]."""
-DEFAULT_FPS, MAX_FPS = 20, 50
-"""Frame rate [frames/s]: default and most (a GIF stores delays in 10 ms steps)."""
 BAR_COLOURS = ((31, 119, 180), (214, 39, 40))
 """Colours (RGB) of the force bars and curves of τ1 and τ2."""
 _ARROW = {True: "#16a34a", False: "#dc2626"}
@@ -87,38 +90,6 @@ class BarGeometry:
     px_per_newton: float
     rows: tuple[int, int]
     height: int
-
-
-def parse_size(text: str) -> tuple[int, int]:
-    """``"WxH"`` (also ``W×H``) [px] within :data:`MIN_SIZE`-:data:`MAX_SIZE`; one-line :class:`InputError`."""
-    parts = str(text).lower().replace("×", "x").split("x")
-    try:
-        width, height = (int(s.strip()) for s in parts)
-    except ValueError:
-        raise InputError(
-            Phrase("the size must be WIDTHxHEIGHT in pixels (e.g. 800x450), got {got}", got=repr(text))
-        ) from None
-    if not (MIN_SIZE[0] <= width <= MAX_SIZE[0] and MIN_SIZE[1] <= height <= MAX_SIZE[1]):
-        raise InputError(
-            Phrase(
-                "the size must be from {lo} to {hi} pixels, got {got}",
-                lo=f"{MIN_SIZE[0]}x{MIN_SIZE[1]}",
-                hi=f"{MAX_SIZE[0]}x{MAX_SIZE[1]}",
-                got=f"{width}x{height}",
-            )
-        )
-    return width, height
-
-
-def check_fps(fps: object) -> int:
-    """A whole number of frames per second from 1 to :data:`MAX_FPS`; one-line :class:`InputError`."""
-    if isinstance(fps, bool) or not isinstance(fps, int | float) or fps != int(fps) or not 1 <= fps <= MAX_FPS:
-        raise InputError(
-            Phrase(
-                "the frame rate must be a whole number from 1 to {hi} frames/s, got {got}", hi=MAX_FPS, got=repr(fps)
-            )
-        )
-    return int(fps)
 
 
 def _force_scale(tau: np.ndarray) -> float:
