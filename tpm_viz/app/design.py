@@ -6,7 +6,8 @@ design (an :class:`~tpm_viz.paper.arrangement.Arrangement` and its :class:`~tpm_
 
 - ``feasible``: every pose of the task is reachable, inside the stroke and clear of both singularities by the
   project's :data:`~tpm_viz.paper.status.WARN` thresholds (``min_i |cos θ_i| >= 0.2``, ``|det J_x| >= 0.2``),
-  checked on a grid of at most :data:`CHECK_STEP` that contains the edges and the axes;
+  checked on a grid of at most :data:`CHECK_STEP` that contains the edges and the axes, and no leg crosses the
+  other rail or the other leg in plan view at any pose (:func:`tpm_viz.app.clearance.collision`);
 - ``gci``: the global conditioning index, the area mean of ``1 / cond(J)`` (Gosselin & Angeles 1991);
 - ``cond_max``: the worst ``cond(J)`` over the task;
 - ``dyn_mean``, ``dyn_max``: the largest singular value of ``J⁻ᵀ M(p)`` [kg] (actuator force per unit platform
@@ -27,10 +28,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from tpm_viz.app.clearance import collision, joints
 from tpm_viz.app.paths import GeometricPath, PickSize, pick_and_place
 from tpm_viz.app.planner import DEFAULT_GRID, Limits, plan_path
 from tpm_viz.errors import InputError, TpmVizError
@@ -57,6 +59,7 @@ __all__ = [
     "pick_path",
     "pointwise",
     "reason",
+    "task_axes",
     "task_grid",
 ]
 
@@ -170,6 +173,9 @@ class Indices:
     footprint_y: float = math.nan
     why: str | Phrase = field(default="", compare=False)
     """Why it is infeasible: a phrase shown in each tab's language (``str()``: English, as the CSV writes it)."""
+    shortfall: float = field(default=0.0, compare=False)
+    """How far an infeasible design is from feasible, for an optimiser: 1 for parameters with no pose in the
+    stroke, the fraction of the check grid not regular for a task not covered, 0 otherwise."""
 
     def row(self) -> dict[str, float]:
         """``{column: value}`` in :data:`INDEX_COLUMNS` order (``feasible`` as 1.0 or 0.0)."""
@@ -182,12 +188,17 @@ def _linspace_with(lo: float, hi: float, n: int) -> np.ndarray:
     return np.unique(np.append(xs, 0.0)) if lo < 0.0 < hi else xs
 
 
-def task_grid(task: Task, step: float = CHECK_STEP) -> np.ndarray:
-    """Points ``(n, 2)`` [m] covering the task at most ``step`` apart (fewer for a large task), edges and axes
+def task_axes(task: Task, step: float = CHECK_STEP) -> tuple[np.ndarray, np.ndarray]:
+    """The check grid's sorted X and Y values [m]: at most ``step`` apart (fewer for a large task), edges and axes
     included."""
     nx = min(max(math.ceil(task.width / step) + 1, 9), MAX_CHECK_SIDE)
     ny = min(max(math.ceil(task.height / step) + 1, 9), MAX_CHECK_SIDE)
-    xs, ys = _linspace_with(task.x0, task.x1, nx), _linspace_with(task.y0, task.y1, ny)
+    return _linspace_with(task.x0, task.x1, nx), _linspace_with(task.y0, task.y1, ny)
+
+
+def task_grid(task: Task, step: float = CHECK_STEP) -> np.ndarray:
+    """Points ``(n, 2)`` [m] of :func:`task_axes`' grid."""
+    xs, ys = task_axes(task, step)
     return np.stack(np.meshgrid(xs, ys, indexing="ij"), -1).reshape(-1, 2)
 
 
@@ -266,27 +277,12 @@ def _refined_max(
     return top
 
 
-def _joints(arrangement: Arrangement, params: Params, p: np.ndarray, d: np.ndarray) -> tuple:
-    """Slider joints ``A_i`` and platform joints ``B_i`` ``(n, 2, 2)`` [m] (eq. 1 / ``docs/parallel.md`` P1)."""
-    n = len(p)
-    a_pts, b_pts = np.zeros((n, 2, 2)), np.repeat(p[:, None, :], 2, axis=1)
-    if arrangement is Arrangement.PARALLEL:
-        a_pts[:, 0, 0], a_pts[:, 1, 0] = d[:, 0] - params.a, params.a - d[:, 1]
-        b_pts[:, 0, 0] -= params.b
-        b_pts[:, 1, 0] += params.b
-    else:
-        a_pts[:, 0, 0], a_pts[:, 1, 1] = d[:, 0] - params.a, d[:, 1] - params.a
-        b_pts[:, 0, 0] -= params.b
-        b_pts[:, 1, 1] -= params.b
-    return a_pts, b_pts
-
-
 def footprint(arrangement: Arrangement, params: Params, grid: np.ndarray) -> tuple[float, float]:
     """Width and depth [m] of the bounding box of both rails (``A_i`` from ``d_i = 0`` to ``Δd``) and the leg
     centre lines ``A_i B_i`` over the poses ``grid``."""
     ends = np.array([[0.0, 0.0], [params.stroke, params.stroke]])
-    rails, _ = _joints(arrangement, params, np.zeros((2, 2)), ends)
-    a_pts, b_pts = _joints(arrangement, params, grid, arr.inverse_kinematics(arrangement, params, grid))
+    rails, _ = joints(arrangement, params, np.zeros((2, 2)), ends)
+    a_pts, b_pts = joints(arrangement, params, grid, arr.inverse_kinematics(arrangement, params, grid))
     pts = np.concatenate([rails.reshape(-1, 2), a_pts.reshape(-1, 2), b_pts.reshape(-1, 2)])
     size = pts.max(axis=0) - pts.min(axis=0)
     return float(size[0]), float(size[1])
@@ -338,44 +334,52 @@ def reason(why: object) -> str | Phrase:
     return why if isinstance(why, Phrase) else str(why)
 
 
-def _infeasible(why: object) -> Indices:
-    return Indices(False, why=reason(why))
+def _infeasible(why: object, shortfall: float = 0.0) -> Indices:
+    return Indices(False, why=reason(why), shortfall=shortfall)
 
 
-def evaluate(arrangement: Arrangement, params: Params, task: Task, settings: Settings = Settings()) -> Indices:
-    """Every index of one design over ``task`` (see the module docstring)."""
+def evaluate(
+    arrangement: Arrangement, params: Params, task: Task, settings: Settings = Settings(), cycle_only: bool = False
+) -> Indices:
+    """Every index of one design over ``task`` (see the module docstring); ``cycle_only``: feasibility, cycle
+    time, moving mass and footprint only, the other indices NaN (an optimiser's objective, half the work)."""
     arrangement = Arrangement.parse(arrangement)
     try:
         arr.validate(arrangement, params)
     except TpmVizError as exc:
-        return _infeasible(exc)
+        return _infeasible(exc, 1.0)
+    xs, ys = task_axes(task)
     grid = task_grid(task)
     status = arr.classify(arrangement, params, grid, settings.thresholds)
     bad = np.flatnonzero(status != PoseStatus.REGULAR)
     if bad.size:
         k = int(bad[np.argmax(status[bad])])
         status_k = STATUS_WORDS[PoseStatus(int(status[k]))]
-        return _infeasible(Phrase(_NOT_COVERED, x=grid[k, 0] * 1e3, y=grid[k, 1] * 1e3, status=status_k))
-    (gci, dyn_mean), _ = area_means(lambda p: pointwise(arrangement, params, p), task, settings.rtol)
-    values = pointwise(arrangement, params, grid)
-    cond_max = -1.0 / _refined_max(lambda p: -_inverse_condition(arrangement, params, p), task, grid, -values[:, 0])
-    dyn_max = _refined_max(lambda p: _dynamic(arrangement, params, p), task, grid, values[:, 1])
+        where = Phrase(_NOT_COVERED, x=grid[k, 0] * 1e3, y=grid[k, 1] * 1e3, status=status_k)
+        return _infeasible(where, bad.size / len(grid))
+    crossing = collision(arrangement, params, xs, ys)
+    if crossing is not None:
+        return _infeasible(crossing)
     path = pick_path(task)
-    peak = _peak_cubic(arrangement, params, path, REFERENCE_STROKE)
     try:
         plan = plan_path(params, path, Limits(settings.force_limit), settings.planner_grid, arrangement)
     except TpmVizError as exc:
         return _infeasible(Phrase(_NO_CYCLE, why=reason(exc)))
     width, depth = footprint(arrangement, params, grid)
-    return Indices(
-        True,
+    cycle = Indices(
+        True, cycle_time=2.0 * plan.duration, moving_mass=params.moving_mass, footprint_x=width, footprint_y=depth
+    )
+    if cycle_only:
+        return cycle
+    (gci, dyn_mean), _ = area_means(lambda p: pointwise(arrangement, params, p), task, settings.rtol)
+    values = pointwise(arrangement, params, grid)
+    cond_max = -1.0 / _refined_max(lambda p: -_inverse_condition(arrangement, params, p), task, grid, -values[:, 0])
+    dyn_max = _refined_max(lambda p: _dynamic(arrangement, params, p), task, grid, values[:, 1])
+    return replace(
+        cycle,
         gci=float(gci),
         cond_max=float(cond_max),
         dyn_mean=float(dyn_mean),
         dyn_max=float(dyn_max),
-        peak_force=peak,
-        cycle_time=2.0 * plan.duration,
-        moving_mass=params.moving_mass,
-        footprint_x=width,
-        footprint_y=depth,
+        peak_force=_peak_cubic(arrangement, params, path, REFERENCE_STROKE),
     )

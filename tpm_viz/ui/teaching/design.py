@@ -22,7 +22,7 @@ import viser
 
 from tpm_viz.app import transitions
 from tpm_viz.app.atlas import Row
-from tpm_viz.app.compare import Hold, compare
+from tpm_viz.app.compare import Hold
 from tpm_viz.app.design import Task
 from tpm_viz.app.readouts import reason
 from tpm_viz.classroom.guard import guarded
@@ -33,6 +33,8 @@ from tpm_viz.paper.arrangement import Arrangement
 from tpm_viz.params import Params
 from tpm_viz.ui.fields import Note, TypedBox
 from tpm_viz.ui.teaching import design_text as text
+from tpm_viz.ui.teaching.design_compare import in_turns
+from tpm_viz.ui.teaching.design_compare import start as start_comparison
 from tpm_viz.ui.teaching.design_map import CHUNK, INDICES, MAX_COUNT, SWEPT, Axis, MapSpec, best_cell, colours
 from tpm_viz.ui.teaching.design_map import values as map_values
 from tpm_viz.ui.teaching.design_scene import PENDING, DesignScene, comparison_designs
@@ -329,15 +331,16 @@ class DesignView:
         params, task, hold = self.view.session.state.params, self.task, Hold.parse(self.hold.value)
         self._compare_request += 1
         request = self._compare_request
-        self.compare_note = T("Comparing: each arrangement at these dimensions and at its own optimum (5-30 s)…")
+        self.compare_note = T(
+            "Comparing: each arrangement at these dimensions and at its own optimum, found by a global search "
+            "(about a minute; the other tabs keep working meanwhile)…"
+        )
         self.compare_status.content = say(self.view.lang, self.compare_note)
         self._show_area()
-        return lambda: self.worker.submit(
-            "design-compare",
-            lambda: compare(params, task, hold),
-            lambda rows, error: self._compared(request, hold, rows, error),
-            tab=self.view,
-        )
+        wanted = lambda: request == self._compare_request and not self.view.closed  # noqa: E731
+        evaluate = in_turns(self.worker, self.view, "design-compare", wanted)
+        done = lambda rows, error: self._compared(request, hold, rows, error)  # noqa: E731
+        return lambda: start_comparison(params, task, hold, evaluate, done)
 
     def _compared(self, request: int, hold: Hold, rows, error) -> None:
         with self.view.hub.lock:
