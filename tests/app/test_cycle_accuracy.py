@@ -80,6 +80,9 @@ def test_the_reference_solver_converges_and_agrees_with_the_planner_on_a_fine_gr
     best = 2 * times[2] - times[1]
     planner = evaluate(Arrangement.PERPENDICULAR, Params.paper(), TASK, Settings(planner_grid=2000), True)
     assert best < planner.cycle_time < best * (1 + 1e-3)  # the planner keeps the limits: never faster
+    docs = (ROOT / "docs" / "design.md").read_text(encoding="utf-8")
+    quoted = float(docs.split("the planner itself at 2000 points, which is ")[1].split(" ")[0])
+    assert quoted == pytest.approx(planner.cycle_time / best - 1, rel=0.05)
 
 
 @pytest.mark.slow  # about 30 s: five designs, five planner grids, the reference on 30,000 and 60,000 steps each

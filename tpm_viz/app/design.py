@@ -12,7 +12,8 @@ design (an :class:`~tpm_viz.paper.arrangement.Arrangement` and its :class:`~tpm_
 - ``cond_max``: the worst ``cond(J)`` over the task;
 - ``dyn_mean``, ``dyn_max``: the largest singular value of ``J⁻ᵀ M(p)`` [kg] (actuator force per unit platform
   acceleration at rest; its columns are the closed-form ``τ`` for ``ṗ = 0``, ``p̈ = e_k``), area mean and maximum;
-- ``peak_force`` [N]: the peak ``|τ_i|`` of the standard pick run by the paper's cubic law in
+- ``peak_force`` [N]: the peak ``|τ_i|`` of the standard pick (:func:`tpm_viz.app.pick.pick_path`, across the
+  task's width or, with ``Settings.pick = "y"``, along its height) run by the paper's cubic law in
   :data:`REFERENCE_STROKE` per stroke; ``cycle_time`` [s]: the time-optimal pick cycle (there and back) within
   ``|τ_i| <= force_limit``: twice the forward stroke of :func:`tpm_viz.app.planner.plan_path` (without friction
   the return stroke is the forward one reversed in time, as :func:`~tpm_viz.app.planner.plan_cycle` shows);
@@ -33,7 +34,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from tpm_viz.app.clearance import collision, joints
-from tpm_viz.app.paths import GeometricPath, PickSize, pick_and_place
+from tpm_viz.app.pick import PICK_CORNER, PICK_RISE, peak_cubic, pick_path
 from tpm_viz.app.planner import DEFAULT_GRID, Limits, plan_path
 from tpm_viz.errors import InputError, TpmVizError
 from tpm_viz.paper import arrangement as arr
@@ -84,10 +85,6 @@ GAUSS_ORDER = 8
 """Gauss-Legendre points per panel side."""
 MAX_PANELS = 32
 """Most panels per side before an area mean is declared unconverged."""
-PICK_RISE = 0.025
-"""Rise and fall of the standard pick [m] (25 mm)."""
-PICK_CORNER = 0.010
-"""Corner radius of the standard pick [m] (the planner's default)."""
 REFERENCE_STROKE = 0.2
 """Duration [s] of one stroke of the standard pick for ``peak_force`` (the paper's Fig. 4 line takes 0.2 s)."""
 DEFAULT_FORCE_LIMIT = 100.0
@@ -149,12 +146,18 @@ class Task:
 
 @dataclass(frozen=True)
 class Settings:
-    """How the indices are computed: force limit [N], thresholds, area-mean tolerance, planner grid points."""
+    """How the indices are computed: force limit [N], thresholds, area-mean tolerance, planner grid points, and the
+    direction of the standard pick (``"x"``: across the task's width; ``"y"``: along its height)."""
 
     force_limit: float = DEFAULT_FORCE_LIMIT
     thresholds: SingularityThresholds = WARN
     rtol: float = 1e-3
     planner_grid: int = DEFAULT_GRID
+    pick: str = "x"
+
+    def __post_init__(self) -> None:
+        if self.pick not in ("x", "y"):
+            raise InputError(f"the pick runs along x or y, got {str(self.pick)[:20]!r}")
 
 
 @dataclass(frozen=True)
@@ -288,41 +291,6 @@ def footprint(arrangement: Arrangement, params: Params, grid: np.ndarray) -> tup
     return float(size[0]), float(size[1])
 
 
-def pick_path(task: Task) -> GeometricPath:
-    """The standard pick: from ``(x0, y_c - h/2)`` up ``h``, across the task's width, down ``h`` (``h`` =
-    :data:`PICK_RISE`, or the task's height if smaller; corners :data:`PICK_CORNER` or less), centred in height."""
-    h = min(PICK_RISE, task.height)
-    r = min(PICK_CORNER, h, task.width / 2)
-    start = (task.x0, float(task.centre[1]) - h / 2)
-    return pick_and_place(start, PickSize(h, task.width, r))
-
-
-def _cubic_inverse(fraction: np.ndarray) -> np.ndarray:
-    """``u`` in ``[0, 1]`` with ``3u² - 2u³ = fraction`` (bisection to 1e-15: the law is increasing)."""
-    lo, hi = np.zeros_like(fraction), np.ones_like(fraction)
-    for _ in range(52):
-        mid = (lo + hi) / 2
-        below = 3 * mid**2 - 2 * mid**3 < fraction
-        lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
-    return (lo + hi) / 2
-
-
-def _peak_cubic(arrangement: Arrangement, params: Params, path: GeometricPath, duration: float, n: int = 1001) -> float:
-    """Peak ``|τ_i|`` [N] along ``path`` under the cubic law ``s = L (3u² - 2u³)``, ``u = t / duration``, at ``n``
-    even instants and at the junctions, both sides (the return stroke has the same peak: ``τ`` is even in ``ṗ``)."""
-    big = path.length
-    u = np.concatenate([np.linspace(0.0, 1.0, n), _cubic_inverse(path.junctions / big)])
-    s = np.concatenate([big * (3 * u[:n] ** 2 - 2 * u[:n] ** 3), path.junctions])  # junctions exactly
-    ds, dds = big * (6 * u - 6 * u**2) / duration, big * (6 - 12 * u) / duration**2
-    peak = 0.0
-    for side in ("left", "right"):
-        ps, pss = path.evaluate(s, 1), path.evaluate(s, 2, side)
-        dp, ddp = ps * ds[:, None], ps * dds[:, None] + pss * (ds**2)[:, None]
-        tau = arr.inverse_dynamics(arrangement, params, path.evaluate(s), dp, ddp)
-        peak = max(peak, float(np.max(np.abs(tau))))
-    return peak
-
-
 _NOT_COVERED = "the task is not covered: ({x:.1f}, {y:.1f}) mm is {status}"
 _NO_CYCLE = "no pick cycle within the force limit: {why}"
 
@@ -360,7 +328,7 @@ def evaluate(
     crossing = collision(arrangement, params, xs, ys)
     if crossing is not None:
         return _infeasible(crossing)
-    path = pick_path(task)
+    path = pick_path(task, settings.pick)
     try:
         plan = plan_path(params, path, Limits(settings.force_limit), settings.planner_grid, arrangement)
     except TpmVizError as exc:
@@ -381,5 +349,5 @@ def evaluate(
         cond_max=float(cond_max),
         dyn_mean=float(dyn_mean),
         dyn_max=float(dyn_max),
-        peak_force=_peak_cubic(arrangement, params, path, REFERENCE_STROKE),
+        peak_force=peak_cubic(arrangement, params, path, REFERENCE_STROKE),
     )
