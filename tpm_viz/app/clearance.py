@@ -134,8 +134,9 @@ def rail_problem(arrangement: Arrangement, params: Params) -> Phrase | None:
     """Why the two rails meet (None if they do not): both arrangements need ``Δd < a``."""
     if params.stroke < params.a:
         return None
-    template = _RAILS_OVERLAP if arrangement is Arrangement.PARALLEL else _RAILS_CROSS
-    return Phrase(template, stroke=params.stroke * 1e3, a=params.a * 1e3)
+    if arrangement is Arrangement.PARALLEL:
+        return Phrase(_RAILS_OVERLAP, stroke=params.stroke * 1e3, a=params.a * 1e3)
+    return Phrase(_RAILS_CROSS, stroke=params.stroke * 1e3, a=params.a * 1e3)
 
 
 def _phrase(pair: int, pose: np.ndarray) -> Phrase:

@@ -333,7 +333,7 @@ class DesignView:
         request = self._compare_request
         self.compare_note = T(
             "Comparing: each arrangement at these dimensions and at its own optimum, found by a global search "
-            "(one to three minutes; the other tabs keep working meanwhile)…"
+            "(a few minutes; the other tabs keep working meanwhile)…"
         )
         self.compare_status.content = say(self.view.lang, self.compare_note)
         self._show_area()
