@@ -102,5 +102,5 @@ def test_the_accuracy_table_of_the_docs_is_measured():
     assert len(printed) == len(GRIDS)
     for g, shown, value in zip(GRIDS, printed, measured, strict=True):
         assert shown == pytest.approx(value, rel=0.05), (g, shown, f"{value:.1e}")
-    prototype = docs.split("the paper's prototype: ")[1].split(" ")[0]  # the prototype's own error at 300 points
+    prototype = docs.split("the paper's prototype: ")[1].split()[0]  # the prototype's own error at 300 points
     assert float(prototype) == pytest.approx(errors[300][0], rel=0.05), f"{errors[300][0]:.1e}"

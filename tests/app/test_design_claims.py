@@ -52,6 +52,7 @@ def _parallel_covers(params: Params, task: Task) -> bool:
     return bool(low >= 0 and high <= params.stroke)
 
 
+@pytest.mark.slow  # about 20 s: 12,000 placements
 def test_the_parallel_prototype_covers_no_placement_of_the_turned_task():
     """docs/design.md: clear of the direct singularity p_2 >= 26.1 mm, and both d_i within the stroke need
     u >= a - b + 50 mm - Δd = 140 mm, p_2 <= 219.1 mm: 193 mm of p_2 for the task's 200. Every centre scanned
