@@ -59,6 +59,19 @@ def throughput(spec: list[str], workers: int, grid_points: int) -> tuple[float, 
     return time.perf_counter() - t0, len(grid), sum(bool(r["feasible"]) for r in rows)
 
 
+def handoff(batches: int = 2000) -> None:
+    """What running batches as fair-worker jobs adds: ``batches`` batches of 8 designs whose cost is free."""
+    worker = Worker(name="bench-handoff")
+    evaluate_with = in_turns(worker, object(), "bench", lambda: True)
+    points = [np.zeros(2)] * (8 * batches)
+    times = []
+    for _ in range(5):
+        t0 = time.perf_counter()
+        evaluate_with(lambda x: 0.0, points)
+        times.append((time.perf_counter() - t0) / batches)
+    print(f"fair-worker handoff: median {statistics.median(times) * 1e6:.0f} µs per batch of 8 designs")
+
+
 def optimiser(hold: Hold, repeat: int) -> None:
     """Wall time of ``compare`` (two searches, seed 0) run directly and through the fair worker, and its designs."""
     counted: list[int] = []
@@ -93,6 +106,7 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3, help="repeats of each optimiser timing")
     args = ap.parse_args()
     if args.optimiser:
+        handoff()
         for hold in (Hold.LINK, Hold.FOOTPRINT):
             optimiser(hold, args.repeat)
         return
