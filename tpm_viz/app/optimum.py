@@ -32,8 +32,8 @@ PENALTY = 1e3
 """Objective [s] of a design that breaks a constraint."""
 
 STRATEGY = "rand1bin"
-"""Differential evolution's strategy: mutation around random members, not the best one (``best1bin`` converged to
-a neighbouring basin 0.5 % slower in two of three seeds on the paper's ``--hold link`` comparison)."""
+"""Differential evolution's strategy: mutation around random members, not the best one (``best1bin``, SciPy's
+default, tended to settle in a neighbouring basin of the paper's ``--hold link`` comparison)."""
 
 Adjust = Callable[[dict[str, float]], dict[str, float]]
 Evaluate = Callable[[Callable[[np.ndarray], float], Sequence[np.ndarray]], Sequence[float]]
