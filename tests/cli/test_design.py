@@ -13,6 +13,7 @@ import re
 import pytest
 
 from tpm_viz.cli import main
+from tpm_viz.design import atlas
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 COLUMNS = (
@@ -67,6 +68,8 @@ def test_an_infeasible_design_is_a_row_of_empty_cells_never_nan(tmp_path, capsys
             "tcp://",
         ),
         (["compare", "--task=-0.1,0.1,-0.05,0.05", "--hold", "volume"], "invalid choice"),
+        (["compare", "--task=-0.1,0.1,-0.05,0.05", "--seed", "-1"], "--seed"),
+        (["compare", "--task=-0.1,0.1,-0.05,0.05", "--generations", "0"], "--generations"),
     ],
 )
 def test_bad_input_is_one_line_and_status_2(argv, match, tmp_path, monkeypatch, capsys):
@@ -80,7 +83,7 @@ def test_bad_input_is_one_line_and_status_2(argv, match, tmp_path, monkeypatch, 
 def test_atlas_marks_the_front_the_prototype_and_the_optimum(tmp_path, capsys):
     out = tmp_path / "atlas.csv"
     argv = ["atlas", "--vary", "l_a=0.18:0.34:3", "--vary", "stroke=0.2:0.4:3", "--task=-0.1,0.1,-0.05,0.05"]
-    argv += ["--grid", "60", "--workers", "1", "--footprint", "0.6,0.6", "--output", str(out)]
+    argv += ["--grid", "60", "--workers", "1", "--footprint", "0.6,0.6", "--generations", "3", "--output", str(out)]
     assert main(argv) == 0
     rows = _rows(out)
     assert list(rows[0])[: len(COLUMNS)] == COLUMNS and list(rows[0])[-2:] == ["pareto", "tag"]
@@ -100,12 +103,30 @@ def test_atlas_marks_the_front_the_prototype_and_the_optimum(tmp_path, capsys):
     assert "9/9 designs" in err and f"{len(feasible)} feasible" in err
 
 
+def test_atlas_starts_no_more_processes_than_chunks_of_designs(tmp_path, monkeypatch, capsys):
+    """``--workers 1000`` with 4 designs (one chunk of 8): no process pool at all (issue 35: it forked up to 1,024);
+    ``--help`` says so."""
+
+    def no_pool(*args, **kwargs):
+        raise AssertionError("a process pool was started for one chunk")
+
+    monkeypatch.setattr(atlas, "ProcessPoolExecutor", no_pool)
+    out = tmp_path / "a.csv"
+    argv = ["atlas", "--vary", "l_a=0.2:0.3:4", "--task=-0.1,0.1,-0.05,0.05", "--workers", "1000", "--no-optimum"]
+    assert main([*argv, "--grid", "60", "--output", str(out)]) == 0
+    assert len(_rows(out)) == 5  # four designs and the prototype
+    with pytest.raises(SystemExit):
+        main(["atlas", "--help"])
+    assert "never more than the cores or the chunks of 8 designs" in " ".join(capsys.readouterr().out.split())
+
+
 def table_lines(rows: list[dict[str, str]], hold: str) -> list[str]:
-    """The comparison table as docs/design.md prints it (mm, N, ms; '—' for no design)."""
+    """The comparison table as docs/design.md prints it (mm, N, ms; words for no design)."""
     out = []
     for r in rows:
         if r["feasible"] != "1":
-            out.append(f"| {hold} | {r['case']} | {r['arrangement']} | none found within the hold | | | | | | |")
+            words = "does not cover the task" if r["case"] == "given" else "none found within the hold"
+            out.append(f"| {hold} | {r['case']} | {r['arrangement']} | {words} | | | | | | |")
             continue
         f = {k: float(v) for k, v in r.items() if k not in ("case", "arrangement")}
         out.append(
@@ -117,11 +138,20 @@ def table_lines(rows: list[dict[str, str]], hold: str) -> list[str]:
     return out
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("hold", ["link", "footprint"])
-def test_the_comparison_table_in_the_docs_is_what_compare_prints(hold, tmp_path):
-    out = tmp_path / f"compare_{hold}.csv"
-    assert main(["compare", "--task=-0.1,0.1,-0.05,0.05", "--hold", hold, "--output", str(out)]) == 0
+COMPARISONS = {
+    "link": ["--task=-0.1,0.1,-0.05,0.05", "--hold", "link"],
+    "footprint": ["--task=-0.1,0.1,-0.05,0.05", "--hold", "footprint"],
+    "mass": ["--task=-0.1,0.1,-0.05,0.05", "--hold", "mass"],
+    "link, pick y": ["--task=-0.05,0.05,-0.1,0.1", "--pick", "y", "--hold", "link"],
+}
+"""The comparisons docs/design.md prints (label: the command's options)."""
+
+
+@pytest.mark.slow  # two to three minutes each: two global searches
+@pytest.mark.parametrize("label", list(COMPARISONS))
+def test_the_comparison_tables_in_the_docs_are_what_compare_prints(label, tmp_path):
+    out = tmp_path / "compare.csv"
+    assert main(["compare", *COMPARISONS[label], "--output", str(out)]) == 0
     rows = _rows(out)
     assert [(r["case"], r["arrangement"]) for r in rows] == [
         ("given", "perpendicular"),
@@ -129,7 +159,7 @@ def test_the_comparison_table_in_the_docs_is_what_compare_prints(hold, tmp_path)
         ("optimum", "perpendicular"),
         ("optimum", "parallel"),
     ]
-    lines = table_lines(rows, hold)
+    lines = table_lines(rows, label)
     docs = (ROOT / "docs" / "design.md").read_text()
     for line in lines:
         assert line in docs, line

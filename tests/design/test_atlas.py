@@ -1,14 +1,17 @@
-"""The atlas (tpm_viz/design/atlas.py): the grid, the process pool against one process, the Pareto front against a
-plain double loop, the optimiser within its bounds and limits and never worse than its start."""
+"""The atlas (tpm_viz/design/atlas.py): the grid, the process pool against one process and its size (never more
+processes than chunks or cores), the Pareto front against a plain double loop, the local and the global optimiser
+within their bounds and limits and never worse than their start."""
 
 from __future__ import annotations
 
 import math
+from typing import ClassVar
 
 import numpy as np
 import pytest
 
 from tpm_viz.core.params import Params
+from tpm_viz.design import atlas
 from tpm_viz.design.atlas import (
     Limits,
     Vary,
@@ -16,12 +19,13 @@ from tpm_viz.design.atlas import (
     columns_for,
     design_row,
     designs,
-    optimise,
     pareto,
+    pool_size,
     sweep,
     values_of,
 )
 from tpm_viz.design.indices import INDEX_COLUMNS, Settings, Task
+from tpm_viz.design.optimum import Search, optimise, search
 from tpm_viz.paper.arrangement import Arrangement
 
 TASK = Task(-0.1, 0.1, -0.05, 0.05)
@@ -136,3 +140,55 @@ def test_the_optimum_is_within_bounds_and_limits_and_no_slower_than_the_best_gri
     assert all(lo <= found[name] <= hi for name, (lo, hi) in bounds.items())
     allowed = [r for r in rows if limits.allows(r)]
     assert rows[k]["cycle_time"] == min(r["cycle_time"] for r in allowed)
+
+
+def test_the_global_search_from_the_best_grid_point_is_no_slower_and_within_bounds_and_limits():
+    grid = designs([Vary.parse("l_a=0.2:0.32:3"), Vary.parse("stroke=0.25:0.4:3")])
+    rows = sweep(Arrangement.PERPENDICULAR, Params.paper(), grid, TASK, FAST, workers=1)
+    limits = Limits(footprint_x=0.6, footprint_y=0.6)
+    k = best(rows, limits)
+    assert k is not None
+    bounds = {"l_a": (0.2, 0.32), "stroke": (0.25, 0.4)}
+    start = {"l_a": rows[k]["l_a"], "stroke": rows[k]["stroke"]}
+    how = Search(population=5, generations=5, polish=20)
+    found = search(
+        Arrangement.PERPENDICULAR, values_of(Params.paper()), bounds, TASK, FAST, limits, how=how, starts=[start]
+    )
+    assert found is not None and found["feasible"] and limits.allows(found)
+    assert found["cycle_time"] <= rows[k]["cycle_time"]
+    assert all(lo <= found[name] <= hi for name, (lo, hi) in bounds.items())
+
+
+class _Pool:
+    """A stand-in for ProcessPoolExecutor that records its size and maps in this process."""
+
+    sizes: ClassVar[list[int]] = []
+
+    def __init__(self, max_workers: int) -> None:
+        _Pool.sizes.append(max_workers)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        return None
+
+    def map(self, fn, jobs):
+        return map(fn, jobs)
+
+
+@pytest.mark.parametrize(
+    ("asked", "designs_n", "cores", "expected"), [(1000, 4, 2, 1), (1000, 20, 2, 2), (None, 20, 64, 3), (2, 40, 64, 2)]
+)
+def test_the_pool_has_no_more_processes_than_chunks_or_cores(monkeypatch, asked, designs_n, cores, expected):
+    """``--workers 1000`` with 4 designs forked up to 1,024 processes (issue 35): the pool is one per chunk of 8
+    designs and per core at most (one process: no pool at all)."""
+    monkeypatch.setattr(atlas, "cores", lambda: cores)
+    monkeypatch.setattr(atlas, "ProcessPoolExecutor", _Pool)
+    monkeypatch.setattr(atlas, "run_chunk", lambda job: [{"n": len(job[2])}] * len(job[2]))
+    _Pool.sizes = []
+    assert pool_size(asked, -(-designs_n // 8)) == expected
+    grid = [{"l_a": 0.26}] * designs_n
+    rows = sweep(Arrangement.PERPENDICULAR, Params.paper(), grid, TASK, FAST, workers=asked)
+    assert len(rows) == designs_n
+    assert _Pool.sizes == ([] if expected == 1 else [expected])

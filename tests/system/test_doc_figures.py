@@ -8,7 +8,9 @@
   above) fails. To refresh it, paste the command's output.
 - ``docs/fig4_line.png`` and ``docs/fig5_circle.png`` are ``tpm-viz figures``' output at its defaults (line
   T = 0.2 s, circle T = 0.5 s, 201 samples): the force panel is the same picture; the panel of the difference
-  below it plots round-off (1e-13 N) and may differ.
+  below it plots round-off (1e-13 N) and may differ;
+- the control page's figures (``docs/control.md``), each named RMS or maximum, are ``tpm-viz control``'s summary
+  lines (issue 35).
 
 Elsewhere: the design tables (``tests/cli/test_design.py``), the clip (``tests/cli/test_outputs_clip.py``), the
 stage screenshots (``tests/e2e/test_browser_stage.py``), the app's and the teaching demo's screenshots
@@ -27,6 +29,7 @@ import pytest
 from PIL import Image
 
 from tests.support.docs import ROOT, block_after
+from tpm_viz.cli import main
 
 MODEL = ROOT / "docs" / "model.md"
 FORCE_PANEL = 0.55
@@ -96,3 +99,34 @@ def test_the_papers_figures_are_the_figures_commands_output(tmp_path):
         top = int(made.shape[0] * FORCE_PANEL)
         differ = (np.abs(made[:top] - shown[:top]).max(axis=2) > 16).mean()
         assert differ < 0.002, f"docs/{name}: {differ:.1%} of the force panel's pixels differ from the command's"
+
+
+def _control(capsys, *options: str) -> tuple[float, float]:
+    """RMS and maximum tracking error [mm] of ``tpm-viz control --trajectory circle`` (its summary line)."""
+    assert main(["control", "--trajectory", "circle", *options, "--output", "-"]) in (0, None)
+    err = capsys.readouterr().err
+    found = re.search(r"RMS error ([\d.e+-]+) mm, max error ([\d.e+-]+) mm", err)
+    assert found, err
+    return float(found.group(1)), float(found.group(2))
+
+
+def test_the_control_figures_say_rms_or_maximum_and_are_the_commands(capsys):
+    """Issue 35: the control section mixed maxima with RMS figures; each is now named and is the summary line of
+    ``tpm-viz control`` at the stated settings (10 Hz, ζ = 1, 1 kHz unless said)."""
+    text = " ".join((ROOT / "docs" / "control.md").read_text(encoding="utf-8").split())
+    payload = {c: _control(capsys, "--controller", c, "--payload", "1") for c in ("pd", "pdff", "ctc")}
+    names = {"pd": "PD", "pdff": "PD + feedforward", "ctc": "computed torque"}
+    for c, (rms, top) in payload.items():
+        assert f"{rms:.2f} mm ({top:.3g} mm) with {names[c]}" in text, c
+    rms, top = _control(capsys, "--controller", "ctc")
+    assert f"RMS {rms:.2g} mm (maximum {top:.2g} mm), half that at 2 kHz" in text
+    fast = _control(capsys, "--controller", "ctc", "--rate", "2000")
+    assert 0.45 < fast[0] / rms < 0.55 and 0.45 < fast[1] / top < 0.55
+    mid = _control(capsys, "--controller", "ctc", "--feedforward-at", "mid")
+    assert f"{top / mid[1]:.2g} x for computed torque (to {mid[1] * 1e3:.2g} µm; RMS {mid[0] * 1e3:.2g} µm)" in text
+    pdff = _control(capsys, "--controller", "pdff")
+    pdff_mid = _control(capsys, "--controller", "pdff", "--feedforward-at", "mid")
+    assert (
+        f"{pdff[1] / pdff_mid[1]:.2g} x for PD + feedforward (to {pdff_mid[1] * 1e3:.2g} µm from {pdff[1]:.2g} mm; "
+        f"RMS {pdff_mid[0] * 1e3:.2g} µm)"
+    ) in text

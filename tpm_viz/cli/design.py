@@ -30,7 +30,7 @@ def _settings(args):
         raise InputError(f"--force-limit must be a positive number of newtons up to 1e9, got {force:g}")
     if not 10 <= args.grid <= 20_000:
         raise InputError(f"--grid must be a whole number of points from 10 to 20000, got {args.grid}")
-    return Settings(force_limit=force, planner_grid=args.grid)
+    return Settings(force_limit=force, planner_grid=args.grid, pick=args.pick)
 
 
 def _table(rows: list[dict], columns: list[str]) -> dict[str, np.ndarray]:
@@ -63,12 +63,22 @@ def _cmd_design(args) -> int:
     return 0
 
 
+def _search(args):
+    from tpm_viz.design.optimum import Search
+
+    if not 0 <= args.seed < 2**32:
+        raise InputError(f"--seed must be a whole number from 0 to 4294967295, got {args.seed}")
+    if not 1 <= args.generations <= 10_000:
+        raise InputError(f"--generations must be a whole number from 1 to 10000, got {args.generations}")
+    return Search(seed=args.seed, generations=args.generations)
+
+
 def _cmd_compare(args) -> int:
     from tpm_viz.design.compare import COMPARE_COLUMNS, Hold, compare
     from tpm_viz.design.indices import Task
 
     task = Task.parse(args.task)
-    rows = compare(params_from_args(args), task, Hold.parse(args.hold), _settings(args), args.evaluations)
+    rows = compare(params_from_args(args), task, Hold.parse(args.hold), _settings(args), _search(args))
     write_output(args.output, _table(rows, list(COMPARE_COLUMNS)))
     return 0
 
@@ -106,13 +116,15 @@ def _footprint_limit(text: str | None) -> tuple[float | None, float | None]:
 
 def _cmd_atlas(args) -> int:
     from tpm_viz.core.params import Params
-    from tpm_viz.design.atlas import Limits, Vary, best, columns_for, design_row, designs, optimise, pareto, sweep
+    from tpm_viz.design.atlas import Limits, Vary, best, columns_for, design_row, designs, pareto, sweep
     from tpm_viz.design.atlas import values_of as values
     from tpm_viz.design.indices import Task
+    from tpm_viz.design.optimum import search
     from tpm_viz.paper.arrangement import Arrangement
 
     task = Task.parse(args.task)
     settings = _settings(args)
+    how = _search(args)
     varies = [Vary.parse(text) for text in args.vary]
     grid = designs(varies)
     base = params_from_args(args)
@@ -140,8 +152,12 @@ def _cmd_atlas(args) -> int:
     if k is not None and not args.no_optimum:
         bounds = {v.name: (min(v.start, v.stop), max(v.start, v.stop)) for v in varies if v.count > 1}
         start = {name: float(rows[k][name]) for name in bounds}
-        found = optimise(arrangement, values(base), start, bounds, task, settings, limits) if bounds else rows[k]
-        rows.append({**found, "pareto": False, "tag": "optimum"})
+        found = (
+            search(arrangement, values(base), bounds, task, settings, limits, how=how, starts=[start])
+            if bounds
+            else None
+        )
+        rows.append({**(found or rows[k]), "pareto": False, "tag": "optimum"})
     feasible = sum(bool(r["feasible"]) for r in rows[: len(grid)])
     write_output(args.output, _table(rows, [*columns_for(v.name for v in varies), "pareto", "tag"]))
     summary = f"{len(grid)} designs, {feasible} feasible, {int(front.sum())} on the Pareto front"
@@ -162,6 +178,23 @@ def _common_design(p: argparse.ArgumentParser, grid: int = 300) -> None:
     )
     p.add_argument("--force-limit", type=float, default=100.0, metavar="N", help="|tau_i| <= N for the cycle time")
     p.add_argument("--grid", type=int, default=grid, metavar="K", help=f"planner grid points (default {grid})")
+    p.add_argument(
+        "--pick",
+        choices=("x", "y"),
+        default="x",
+        help="the standard pick runs across the task's width (x, default) or along its height (y)",
+    )
+
+
+def _common_search(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--seed", type=int, default=0, metavar="N", help="seed of the optimiser's search (default 0)")
+    p.add_argument(
+        "--generations",
+        type=int,
+        default=100,
+        metavar="K",
+        help="most generations of differential evolution (default 100; 15 designs per free variable each)",
+    )
 
 
 def register(sub, common) -> None:
@@ -182,7 +215,7 @@ def register(sub, common) -> None:
     )
     _common_design(co)
     co.add_argument("--hold", choices=("link", "footprint", "mass"), default="link")
-    co.add_argument("--evaluations", type=int, default=80, metavar="K", help="optimiser designs per arrangement")
+    _common_search(co)
     co.add_argument("--output", metavar="FILE", help="CSV out (default stdout)")
     co.set_defaults(func=_cmd_compare)
     at = sub.add_parser(
@@ -190,10 +223,16 @@ def register(sub, common) -> None:
     )
     at.add_argument("--arrangement", choices=ARRANGEMENTS, default="perpendicular")
     at.add_argument("--vary", action="append", required=True, metavar="NAME=START:STOP:COUNT")
-    _common_design(at, grid=100)  # cycle times within 1.3 % (docs/design.md), 10,000 designs in minutes
+    _common_design(at, grid=100)  # cycle times within 1.4 % (docs/design.md), 10,000 designs in minutes
     at.add_argument("--output", required=True, metavar="FILE")
-    at.add_argument("--workers", type=int, metavar="N", help="processes (default: every core)")
+    at.add_argument(
+        "--workers",
+        type=int,
+        metavar="N",
+        help="processes for the grid (default: every core; never more than the cores or the chunks of 8 designs)",
+    )
     at.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="run on this Dask distributed scheduler")
     at.add_argument("--footprint", metavar="X,Y", help="largest footprint [m] of the best design")
     at.add_argument("--no-optimum", action="store_true", help="skip the optimiser")
+    _common_search(at)
     at.set_defaults(func=_cmd_atlas)

@@ -6,8 +6,8 @@ and the best design under constraints by a real optimiser (``docs/design.md``).
 - :func:`design_row` evaluates one design (a plain function of plain data: it runs in a process pool or on a
   Dask worker alike); :func:`sweep` runs a grid on a process pool with a progress callback;
 - :func:`pareto`: the non-dominated feasible rows (GCI up, cycle time down, footprint area down);
-- :func:`best`: the fastest cycle among the rows within the footprint limits, then :func:`optimise`:
-  Nelder-Mead (:func:`scipy.optimize.minimize`) over the varied parameters within the grid's ranges, started there.
+- :func:`best`: the fastest cycle among the rows within the footprint limits (the optimiser, which improves on it,
+  is :mod:`tpm_viz.design.optimum`).
 """
 
 from __future__ import annotations
@@ -21,7 +21,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.optimize import minimize
 
 from tpm_viz.core.errors import InputError, TpmVizError
 from tpm_viz.core.params import Params
@@ -40,8 +39,8 @@ __all__ = [
     "columns_for",
     "design_row",
     "designs",
-    "optimise",
     "pareto",
+    "pool_size",
     "run_chunk",
     "sweep",
     "task_columns",
@@ -120,18 +119,24 @@ def columns_for(varies: Iterable[str] = ()) -> list[str]:
 
 
 def design_row(
-    arrangement: str, base: dict[str, float], overrides: dict[str, float], task: tuple, settings: Settings
+    arrangement: str,
+    base: dict[str, float],
+    overrides: dict[str, float],
+    task: tuple,
+    settings: Settings,
+    cycle_only: bool = False,
 ) -> Row:
     """One row: the parameters (``base`` updated by ``overrides``, SI) and the indices over ``task``
-    (``(x0, x1, y0, y1)`` [m]). A parameter set that is not valid is an infeasible row."""
+    (``(x0, x1, y0, y1)`` [m]; ``cycle_only`` as in :func:`~tpm_viz.design.indices.evaluate`). A parameter set that
+    is not valid is an infeasible row."""
     values = {**base, **overrides}
     row: Row = {"arrangement": Arrangement.parse(arrangement).value, **values}
     try:
-        indices = evaluate(Arrangement.parse(arrangement), Params(**values), Task(*task), settings)
+        indices = evaluate(Arrangement.parse(arrangement), Params(**values), Task(*task), settings, cycle_only)
     except TpmVizError as exc:  # a parameter set that is not valid, an area mean that does not converge
-        indices = Indices(False, why=reason(exc))
+        indices = Indices(False, why=reason(exc), shortfall=1.0)
     row.update(indices.row())
-    row["why"] = indices.why
+    row["why"], row["shortfall"] = indices.why, indices.shortfall
     return row
 
 
@@ -156,12 +161,13 @@ def sweep(
     progress: Callable[[int, int], None] | None = None,
     chunk: int = 8,
 ) -> list[Row]:
-    """Every design of ``grid`` (overrides of ``base``), in order, on ``workers`` processes (default: every core;
-    1: in this process). ``progress(done, total)`` is called as chunks finish."""
+    """Every design of ``grid`` (overrides of ``base``), in order, on :func:`pool_size` processes (default: every
+    core; never more than the chunks of ``chunk`` designs or the cores; 1: in this process). ``progress(done,
+    total)`` is called as chunks finish."""
     base_values = values_of(base)
     key = (task.x0, task.x1, task.y0, task.y1)
     jobs = [(Arrangement.parse(arrangement).value, base_values, list(c), key, settings) for c in chunks(grid, chunk)]
-    workers = (os.cpu_count() or 1) if workers is None else int(workers)
+    workers = pool_size(workers, len(jobs))
     out: list[list[Row]] = []
     done = 0
     if workers <= 1:
@@ -179,6 +185,20 @@ def sweep(
             if progress is not None:
                 progress(done, len(grid))
     return [row for rows in out for row in rows]
+
+
+def cores() -> int:
+    """The cores this process may run on (its CPU affinity where the system has one)."""
+    try:
+        return max(len(os.sched_getaffinity(0)), 1)
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def pool_size(workers: int | None, jobs: int) -> int:
+    """Processes for ``jobs`` chunks: ``workers`` (default: every core), at most one per chunk and per core."""
+    wanted = cores() if workers is None else int(workers)
+    return max(1, min(wanted, jobs, cores()))
 
 
 def values_of(params: Params) -> dict[str, float]:
@@ -212,6 +232,14 @@ class Limits:
     footprint_x: float | None = None
     footprint_y: float | None = None
 
+    def excess(self, row: Row) -> float:
+        """How far a feasible row's footprint exceeds the limits: the larger relative excess, at most 1."""
+        out = 0.0
+        for limit, key in ((self.footprint_x, "footprint_x"), (self.footprint_y, "footprint_y")):
+            if limit is not None:
+                out = max(out, float(row[key]) / limit - 1.0)
+        return min(out, 1.0)
+
     def allows(self, row: Row) -> bool:
         if not row["feasible"]:
             return False
@@ -227,74 +255,6 @@ def best(rows: Sequence[Row], limits: Limits = Limits()) -> int | None:
     return min(ok, key=lambda k: float(rows[k]["cycle_time"])) if ok else None
 
 
-PENALTY = 1e3
-"""Objective [s] of a design that breaks a constraint (Nelder-Mead moves away from it)."""
-
-
-def optimise(
-    arrangement: Arrangement,
-    base: dict[str, float],
-    start: dict[str, float],
-    bounds: dict[str, tuple[float, float]],
-    task: Task,
-    settings: Settings = Settings(),
-    limits: Limits = Limits(),
-    max_evaluations: int = 120,
-    adjust: Callable[[dict[str, float]], dict[str, float]] | None = None,
-) -> Row:
-    """The design with the shortest pick cycle near ``start`` (values of the names in ``bounds``, SI): Nelder-Mead on
-    the parameters scaled to ``[0, 1]`` by ``bounds``, at most ``max_evaluations`` designs, a constraint broken
-    costing :data:`PENALTY`. The names ``task_cx``, ``task_cy`` [m] move the task's centre (where the machine
-    stands relative to the work). ``adjust`` maps a candidate's parameter values to the design's (e.g. link mass
-    with its length). Returns the best row found, with the task's columns (the start's row if nothing is
-    better)."""
-    names = list(bounds)
-    lo = np.array([bounds[n][0] for n in names])
-    span = np.array([bounds[n][1] - bounds[n][0] for n in names])
-    span = np.where(span > 0, span, 1.0)
-    found: dict[tuple, Row] = {}
-
-    def row_at(x: np.ndarray) -> Row:
-        values = dict(zip(names, (lo + np.clip(x, 0.0, 1.0) * span).tolist(), strict=True))
-        key = tuple(np.round(x, 12))
-        if key not in found:
-            centre = task.centre
-            moved = task.centred_at(values.pop("task_cx", centre[0]), values.pop("task_cy", centre[1]))
-            merged = {**base, **values}
-            merged = adjust(merged) if adjust is not None else merged
-            found[key] = design_row(arrangement.value, merged, {}, (moved.x0, moved.x1, moved.y0, moved.y1), settings)
-            found[key].update(task_columns(moved))
-        return found[key]
-
-    def cost(x: np.ndarray) -> float:
-        row = row_at(x)
-        if not limits.allows(row):
-            return PENALTY
-        return float(row["cycle_time"])
-
-    x0 = (np.array([start[n] for n in names]) - lo) / span
-    result = minimize(
-        cost,
-        x0,
-        method="Nelder-Mead",
-        bounds=[(0.0, 1.0)] * len(names),
-        options={"maxfev": int(max_evaluations), "xatol": 1e-4, "fatol": 1e-5, "initial_simplex": _simplex(x0)},
-    )
-    winner = row_at(result.x)
-    origin = row_at(x0)
-    return winner if cost(result.x) <= cost(x0) else origin
-
-
 def task_columns(task: Task) -> dict[str, float]:
     """``task_x0, task_x1, task_y0, task_y1`` [m] of a row."""
     return {"task_x0": task.x0, "task_x1": task.x1, "task_y0": task.y0, "task_y1": task.y1}
-
-
-def _simplex(x0: np.ndarray, step: float = 0.1) -> np.ndarray:
-    """A start simplex of edges ``step`` (of the scaled range) inside ``[0, 1]``."""
-    pts = [x0]
-    for k in range(len(x0)):
-        e = x0.copy()
-        e[k] = x0[k] + step if x0[k] + step <= 1.0 else x0[k] - step
-        pts.append(e)
-    return np.array(pts)

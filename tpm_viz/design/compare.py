@@ -10,24 +10,21 @@ own home pose, :func:`tpm_viz.paper.arrangement.home`), the same platform offset
   given ``m_b / l_a`` per metre).
 
 Rows: each arrangement at the given dimensions (``case = given``), then at its own optimum (``case = optimum``):
-the shortest cycle of the standard pick at the force limit found by Nelder-Mead over ``a``, the stroke, ``l_a``
-(unless held) and where the machine stands, started from the best point of a small grid (:data:`SEARCH_GRID`)
-(:func:`tpm_viz.design.atlas.optimise`).
+the shortest cycle of the standard pick at the force limit over ``a``, the stroke, ``l_a`` (unless held) and where
+the machine stands, found by differential evolution polished by Nelder-Mead (:func:`tpm_viz.design.optimum.search`,
+the given design in its first population).
 """
 
 from __future__ import annotations
 
 import enum
-import itertools
-from collections.abc import Callable
-from dataclasses import replace
-
-import numpy as np
+from dataclasses import dataclass
 
 from tpm_viz.core.errors import InputError
 from tpm_viz.core.params import Params
-from tpm_viz.design.atlas import PARAMETER_COLUMNS, Limits, Row, design_row, optimise, task_columns, values_of
+from tpm_viz.design.atlas import PARAMETER_COLUMNS, Limits, Row, design_row, task_columns, values_of
 from tpm_viz.design.indices import INDEX_COLUMNS, Settings, Task
+from tpm_viz.design.optimum import Evaluate, Search, search
 from tpm_viz.paper import arrangement as arr
 from tpm_viz.paper.arrangement import Arrangement
 
@@ -44,9 +41,6 @@ COMPARE_COLUMNS = (
     "task_y1",
 )
 """Columns of ``tpm-viz compare`` (SI units)."""
-SEARCH_GRID = (3, 5)
-"""Values per free variable of the start grid of each optimum (``3^k`` designs; ``5^k`` when none of those is
-feasible within the limits)."""
 
 
 class Hold(enum.Enum):
@@ -90,35 +84,28 @@ def _bounds(arrangement: Arrangement, params: Params, hold: Hold) -> dict[str, t
     return out
 
 
-def _start(
-    arrangement: Arrangement,
-    base: dict[str, float],
-    bounds: dict[str, tuple[float, float]],
-    task: Task,
-    settings: Settings,
-    limits: Limits,
-    adjust: Callable[[dict[str, float]], dict[str, float]],
-    count: int,
-) -> dict[str, float] | None:
-    """The fastest feasible point of a ``count``-per-variable grid over ``bounds`` (None if none)."""
-    best: tuple[float, dict[str, float]] | None = None
-    axes = [np.linspace(lo, hi, count) for lo, hi in bounds.values()]
-    for combo in itertools.product(*axes):
-        values = dict(zip(bounds, map(float, combo), strict=True))
-        moved = task.centred_at(values.pop("task_cx"), values.pop("task_cy"))
-        merged = adjust({**base, **values})
-        row = design_row(arrangement.value, merged, {}, (moved.x0, moved.x1, moved.y0, moved.y1), settings)
-        if limits.allows(row) and (best is None or float(row["cycle_time"]) < best[0]):
-            best = (float(row["cycle_time"]), dict(zip(bounds, map(float, combo), strict=True)))
-    return None if best is None else best[1]
+@dataclass(frozen=True)
+class _LinkMass:
+    """Link mass following link length at ``density`` [kg/m] (picklable, unlike a closure)."""
+
+    density: float
+
+    def __call__(self, values: dict[str, float]) -> dict[str, float]:
+        return {**values, "m_b": self.density * values["l_a"]}
 
 
 def compare(
-    params: Params, task: Task, hold: Hold, settings: Settings = Settings(), max_evaluations: int = 80
+    params: Params,
+    task: Task,
+    hold: Hold,
+    settings: Settings = Settings(),
+    how: Search = Search(),
+    evaluate: Evaluate | None = None,
 ) -> list[Row]:
     """Four rows: each arrangement at ``params`` (task centred on its home), then each at its own optimum under
-    ``hold`` (see the module docstring). The search runs with a 100-point planner grid; every reported row is
-    evaluated with ``settings``."""
+    ``hold`` (see the module docstring; ``how``: the search's seed and budget; ``evaluate``: how its batches of
+    designs run, :func:`tpm_viz.design.optimum.search`). Every row is evaluated with ``settings``; an arrangement
+    with no feasible design within the hold has a row with ``feasible`` 0."""
     given = [_given(a, params, task, settings) for a in Arrangement]
     for row in given:
         row["case"] = "given"
@@ -130,28 +117,16 @@ def compare(
                 "--hold footprint needs the perpendicular design to cover the task at the given dimensions"
             )
         limits = Limits(float(ref["footprint_x"]), float(ref["footprint_y"]))
-    density = params.m_b / params.l_a
-
-    def adjust(values: dict[str, float]) -> dict[str, float]:
-        return {**values, "m_b": density * values["l_a"]} if hold is Hold.MASS else values
-
-    search = replace(settings, planner_grid=min(settings.planner_grid, 100))
+    adjust = _LinkMass(params.m_b / params.l_a) if hold is Hold.MASS else None
     base = values_of(params)
     rows = list(given)
-    for arrangement in Arrangement:
+    for arrangement, start in zip(Arrangement, given, strict=True):
         bounds = _bounds(arrangement, params, hold)
-        for count in SEARCH_GRID:
-            start = _start(arrangement, base, bounds, task, search, limits, adjust, count)
-            if start is not None:
-                break
-        if start is None:
-            row = {"arrangement": arrangement.value, "feasible": 0.0}
-        else:
-            found = optimise(arrangement, base, start, bounds, task, search, limits, max_evaluations, adjust)
-            placed = Task(*(float(found[k]) for k in ("task_x0", "task_x1", "task_y0", "task_y1")))
-            values = {k: float(found[k]) for k in base}
-            row = design_row(arrangement.value, values, {}, (placed.x0, placed.x1, placed.y0, placed.y1), settings)
-            row.update(task_columns(placed))
+        known = {name: float(start[name]) for name in bounds if name in start}
+        centre = (start["task_x0"] + start["task_x1"]) / 2, (start["task_y0"] + start["task_y1"]) / 2
+        known.update(task_cx=float(centre[0]), task_cy=float(centre[1]))
+        found = search(arrangement, base, bounds, task, settings, limits, adjust, how, [known], evaluate)
+        row = found if found is not None else {"arrangement": arrangement.value, "feasible": 0.0}
         row["case"] = "optimum"
         rows.append(row)
     return rows

@@ -6,12 +6,14 @@ design (an :class:`~tpm_viz.paper.arrangement.Arrangement` and its :class:`~tpm_
 
 - ``feasible``: every pose of the task is reachable, inside the stroke and clear of both singularities by the
   project's :data:`~tpm_viz.paper.status.WARN` thresholds (``min_i |cos θ_i| >= 0.2``, ``|det J_x| >= 0.2``),
-  checked on a grid of at most :data:`CHECK_STEP` that contains the edges and the axes;
+  checked on a grid of at most :data:`CHECK_STEP` that contains the edges and the axes, and no leg crosses the
+  other rail or the other leg in plan view at any pose (:func:`tpm_viz.design.clearance.collision`);
 - ``gci``: the global conditioning index, the area mean of ``1 / cond(J)`` (Gosselin & Angeles 1991);
 - ``cond_max``: the worst ``cond(J)`` over the task;
 - ``dyn_mean``, ``dyn_max``: the largest singular value of ``J⁻ᵀ M(p)`` [kg] (actuator force per unit platform
   acceleration at rest; its columns are the closed-form ``τ`` for ``ṗ = 0``, ``p̈ = e_k``), area mean and maximum;
-- ``peak_force`` [N]: the peak ``|τ_i|`` of the standard pick run by the paper's cubic law in
+- ``peak_force`` [N]: the peak ``|τ_i|`` of the standard pick (:func:`tpm_viz.design.pick.pick_path`, across the
+  task's width or, with ``Settings.pick = "y"``, along its height) run by the paper's cubic law in
   :data:`REFERENCE_STROKE` per stroke; ``cycle_time`` [s]: the time-optimal pick cycle (there and back) within
   ``|τ_i| <= force_limit``: twice the forward stroke of :func:`tpm_viz.app.planner.plan_path` (without friction
   the return stroke is the forward one reversed in time, as :func:`~tpm_viz.app.planner.plan_cycle` shows);
@@ -27,15 +29,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from tpm_viz.app.paths import GeometricPath, PickSize, pick_and_place
 from tpm_viz.app.planner import DEFAULT_GRID, Limits, plan_path
 from tpm_viz.core.errors import InputError, TpmVizError
 from tpm_viz.core.params import Params
 from tpm_viz.core.words import Phrase
+from tpm_viz.design.clearance import collision, joints
+from tpm_viz.design.pick import PICK_CORNER, PICK_RISE, peak_cubic, pick_path
 from tpm_viz.paper import arrangement as arr
 from tpm_viz.paper.arrangement import Arrangement
 from tpm_viz.paper.status import STATUS_WORDS, WARN, PoseStatus, SingularityThresholds
@@ -57,6 +60,7 @@ __all__ = [
     "pick_path",
     "pointwise",
     "reason",
+    "task_axes",
     "task_grid",
 ]
 
@@ -81,10 +85,6 @@ GAUSS_ORDER = 8
 """Gauss-Legendre points per panel side."""
 MAX_PANELS = 32
 """Most panels per side before an area mean is declared unconverged."""
-PICK_RISE = 0.025
-"""Rise and fall of the standard pick [m] (25 mm)."""
-PICK_CORNER = 0.010
-"""Corner radius of the standard pick [m] (the planner's default)."""
 REFERENCE_STROKE = 0.2
 """Duration [s] of one stroke of the standard pick for ``peak_force`` (the paper's Fig. 4 line takes 0.2 s)."""
 DEFAULT_FORCE_LIMIT = 100.0
@@ -146,12 +146,18 @@ class Task:
 
 @dataclass(frozen=True)
 class Settings:
-    """How the indices are computed: force limit [N], thresholds, area-mean tolerance, planner grid points."""
+    """How the indices are computed: force limit [N], thresholds, area-mean tolerance, planner grid points, and the
+    direction of the standard pick (``"x"``: across the task's width; ``"y"``: along its height)."""
 
     force_limit: float = DEFAULT_FORCE_LIMIT
     thresholds: SingularityThresholds = WARN
     rtol: float = 1e-3
     planner_grid: int = DEFAULT_GRID
+    pick: str = "x"
+
+    def __post_init__(self) -> None:
+        if self.pick not in ("x", "y"):
+            raise InputError(f"the pick runs along x or y, got {str(self.pick)[:20]!r}")
 
 
 @dataclass(frozen=True)
@@ -170,6 +176,9 @@ class Indices:
     footprint_y: float = math.nan
     why: str | Phrase = field(default="", compare=False)
     """Why it is infeasible: a phrase shown in each tab's language (``str()``: English, as the CSV writes it)."""
+    shortfall: float = field(default=0.0, compare=False)
+    """How far an infeasible design is from feasible, for an optimiser: 1 for parameters with no pose in the
+    stroke, the fraction of the check grid not regular for a task not covered, 0 otherwise."""
 
     def row(self) -> dict[str, float]:
         """``{column: value}`` in :data:`INDEX_COLUMNS` order (``feasible`` as 1.0 or 0.0)."""
@@ -182,12 +191,17 @@ def _linspace_with(lo: float, hi: float, n: int) -> np.ndarray:
     return np.unique(np.append(xs, 0.0)) if lo < 0.0 < hi else xs
 
 
-def task_grid(task: Task, step: float = CHECK_STEP) -> np.ndarray:
-    """Points ``(n, 2)`` [m] covering the task at most ``step`` apart (fewer for a large task), edges and axes
+def task_axes(task: Task, step: float = CHECK_STEP) -> tuple[np.ndarray, np.ndarray]:
+    """The check grid's sorted X and Y values [m]: at most ``step`` apart (fewer for a large task), edges and axes
     included."""
     nx = min(max(math.ceil(task.width / step) + 1, 9), MAX_CHECK_SIDE)
     ny = min(max(math.ceil(task.height / step) + 1, 9), MAX_CHECK_SIDE)
-    xs, ys = _linspace_with(task.x0, task.x1, nx), _linspace_with(task.y0, task.y1, ny)
+    return _linspace_with(task.x0, task.x1, nx), _linspace_with(task.y0, task.y1, ny)
+
+
+def task_grid(task: Task, step: float = CHECK_STEP) -> np.ndarray:
+    """Points ``(n, 2)`` [m] of :func:`task_axes`' grid."""
+    xs, ys = task_axes(task, step)
     return np.stack(np.meshgrid(xs, ys, indexing="ij"), -1).reshape(-1, 2)
 
 
@@ -266,65 +280,15 @@ def _refined_max(
     return top
 
 
-def _joints(arrangement: Arrangement, params: Params, p: np.ndarray, d: np.ndarray) -> tuple:
-    """Slider joints ``A_i`` and platform joints ``B_i`` ``(n, 2, 2)`` [m] (eq. 1 / ``docs/parallel.md`` P1)."""
-    n = len(p)
-    a_pts, b_pts = np.zeros((n, 2, 2)), np.repeat(p[:, None, :], 2, axis=1)
-    if arrangement is Arrangement.PARALLEL:
-        a_pts[:, 0, 0], a_pts[:, 1, 0] = d[:, 0] - params.a, params.a - d[:, 1]
-        b_pts[:, 0, 0] -= params.b
-        b_pts[:, 1, 0] += params.b
-    else:
-        a_pts[:, 0, 0], a_pts[:, 1, 1] = d[:, 0] - params.a, d[:, 1] - params.a
-        b_pts[:, 0, 0] -= params.b
-        b_pts[:, 1, 1] -= params.b
-    return a_pts, b_pts
-
-
 def footprint(arrangement: Arrangement, params: Params, grid: np.ndarray) -> tuple[float, float]:
     """Width and depth [m] of the bounding box of both rails (``A_i`` from ``d_i = 0`` to ``Δd``) and the leg
     centre lines ``A_i B_i`` over the poses ``grid``."""
     ends = np.array([[0.0, 0.0], [params.stroke, params.stroke]])
-    rails, _ = _joints(arrangement, params, np.zeros((2, 2)), ends)
-    a_pts, b_pts = _joints(arrangement, params, grid, arr.inverse_kinematics(arrangement, params, grid))
+    rails, _ = joints(arrangement, params, np.zeros((2, 2)), ends)
+    a_pts, b_pts = joints(arrangement, params, grid, arr.inverse_kinematics(arrangement, params, grid))
     pts = np.concatenate([rails.reshape(-1, 2), a_pts.reshape(-1, 2), b_pts.reshape(-1, 2)])
     size = pts.max(axis=0) - pts.min(axis=0)
     return float(size[0]), float(size[1])
-
-
-def pick_path(task: Task) -> GeometricPath:
-    """The standard pick: from ``(x0, y_c - h/2)`` up ``h``, across the task's width, down ``h`` (``h`` =
-    :data:`PICK_RISE`, or the task's height if smaller; corners :data:`PICK_CORNER` or less), centred in height."""
-    h = min(PICK_RISE, task.height)
-    r = min(PICK_CORNER, h, task.width / 2)
-    start = (task.x0, float(task.centre[1]) - h / 2)
-    return pick_and_place(start, PickSize(h, task.width, r))
-
-
-def _cubic_inverse(fraction: np.ndarray) -> np.ndarray:
-    """``u`` in ``[0, 1]`` with ``3u² - 2u³ = fraction`` (bisection to 1e-15: the law is increasing)."""
-    lo, hi = np.zeros_like(fraction), np.ones_like(fraction)
-    for _ in range(52):
-        mid = (lo + hi) / 2
-        below = 3 * mid**2 - 2 * mid**3 < fraction
-        lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
-    return (lo + hi) / 2
-
-
-def _peak_cubic(arrangement: Arrangement, params: Params, path: GeometricPath, duration: float, n: int = 1001) -> float:
-    """Peak ``|τ_i|`` [N] along ``path`` under the cubic law ``s = L (3u² - 2u³)``, ``u = t / duration``, at ``n``
-    even instants and at the junctions, both sides (the return stroke has the same peak: ``τ`` is even in ``ṗ``)."""
-    big = path.length
-    u = np.concatenate([np.linspace(0.0, 1.0, n), _cubic_inverse(path.junctions / big)])
-    s = np.concatenate([big * (3 * u[:n] ** 2 - 2 * u[:n] ** 3), path.junctions])  # junctions exactly
-    ds, dds = big * (6 * u - 6 * u**2) / duration, big * (6 - 12 * u) / duration**2
-    peak = 0.0
-    for side in ("left", "right"):
-        ps, pss = path.evaluate(s, 1), path.evaluate(s, 2, side)
-        dp, ddp = ps * ds[:, None], ps * dds[:, None] + pss * (ds**2)[:, None]
-        tau = arr.inverse_dynamics(arrangement, params, path.evaluate(s), dp, ddp)
-        peak = max(peak, float(np.max(np.abs(tau))))
-    return peak
 
 
 _NOT_COVERED = "the task is not covered: ({x:.1f}, {y:.1f}) mm is {status}"
@@ -338,44 +302,52 @@ def reason(why: object) -> str | Phrase:
     return why if isinstance(why, Phrase) else str(why)
 
 
-def _infeasible(why: object) -> Indices:
-    return Indices(False, why=reason(why))
+def _infeasible(why: object, shortfall: float = 0.0) -> Indices:
+    return Indices(False, why=reason(why), shortfall=shortfall)
 
 
-def evaluate(arrangement: Arrangement, params: Params, task: Task, settings: Settings = Settings()) -> Indices:
-    """Every index of one design over ``task`` (see the module docstring)."""
+def evaluate(
+    arrangement: Arrangement, params: Params, task: Task, settings: Settings = Settings(), cycle_only: bool = False
+) -> Indices:
+    """Every index of one design over ``task`` (see the module docstring); ``cycle_only``: feasibility, cycle
+    time, moving mass and footprint only, the other indices NaN (an optimiser's objective, half the work)."""
     arrangement = Arrangement.parse(arrangement)
     try:
         arr.validate(arrangement, params)
     except TpmVizError as exc:
-        return _infeasible(exc)
+        return _infeasible(exc, 1.0)
+    xs, ys = task_axes(task)
     grid = task_grid(task)
     status = arr.classify(arrangement, params, grid, settings.thresholds)
     bad = np.flatnonzero(status != PoseStatus.REGULAR)
     if bad.size:
         k = int(bad[np.argmax(status[bad])])
         status_k = STATUS_WORDS[PoseStatus(int(status[k]))]
-        return _infeasible(Phrase(_NOT_COVERED, x=grid[k, 0] * 1e3, y=grid[k, 1] * 1e3, status=status_k))
-    (gci, dyn_mean), _ = area_means(lambda p: pointwise(arrangement, params, p), task, settings.rtol)
-    values = pointwise(arrangement, params, grid)
-    cond_max = -1.0 / _refined_max(lambda p: -_inverse_condition(arrangement, params, p), task, grid, -values[:, 0])
-    dyn_max = _refined_max(lambda p: _dynamic(arrangement, params, p), task, grid, values[:, 1])
-    path = pick_path(task)
-    peak = _peak_cubic(arrangement, params, path, REFERENCE_STROKE)
+        where = Phrase(_NOT_COVERED, x=grid[k, 0] * 1e3, y=grid[k, 1] * 1e3, status=status_k)
+        return _infeasible(where, bad.size / len(grid))
+    crossing = collision(arrangement, params, xs, ys)
+    if crossing is not None:
+        return _infeasible(crossing)
+    path = pick_path(task, settings.pick)
     try:
         plan = plan_path(params, path, Limits(settings.force_limit), settings.planner_grid, arrangement)
     except TpmVizError as exc:
         return _infeasible(Phrase(_NO_CYCLE, why=reason(exc)))
     width, depth = footprint(arrangement, params, grid)
-    return Indices(
-        True,
+    cycle = Indices(
+        True, cycle_time=2.0 * plan.duration, moving_mass=params.moving_mass, footprint_x=width, footprint_y=depth
+    )
+    if cycle_only:
+        return cycle
+    (gci, dyn_mean), _ = area_means(lambda p: pointwise(arrangement, params, p), task, settings.rtol)
+    values = pointwise(arrangement, params, grid)
+    cond_max = -1.0 / _refined_max(lambda p: -_inverse_condition(arrangement, params, p), task, grid, -values[:, 0])
+    dyn_max = _refined_max(lambda p: _dynamic(arrangement, params, p), task, grid, values[:, 1])
+    return replace(
+        cycle,
         gci=float(gci),
         cond_max=float(cond_max),
         dyn_mean=float(dyn_mean),
         dyn_max=float(dyn_max),
-        peak_force=peak,
-        cycle_time=2.0 * plan.duration,
-        moving_mass=params.moving_mass,
-        footprint_x=width,
-        footprint_y=depth,
+        peak_force=peak_cubic(arrangement, params, path, REFERENCE_STROKE),
     )

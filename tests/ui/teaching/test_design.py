@@ -16,7 +16,9 @@ from tpm_viz import Params
 from tpm_viz.core.errors import TpmVizError
 from tpm_viz.core.words import Lang, T
 from tpm_viz.design.indices import Task, evaluate
+from tpm_viz.design.optimum import Search
 from tpm_viz.paper.arrangement import Arrangement
+from tpm_viz.ui.teaching.design import compare as design_compare
 from tpm_viz.ui.teaching.design import text
 from tpm_viz.ui.teaching.design.map import INFEASIBLE_COLOUR, Axis, MapSpec, best_cell, colours, prototype_at, ramp
 
@@ -172,12 +174,13 @@ def test_the_colours_best_cell_and_prototype_of_a_map():
         MapSpec(Arrangement.PERPENDICULAR, P, TASK, Axis("a", 0.4, 0.5, 2), Axis("a", 0.4, 0.5, 2))
 
 
-@pytest.mark.slow  # app.compare searches each arrangement's optimum (about 5 s)
-def test_the_comparison_table_and_drawings_hold_the_library_numbers(connect):
+@pytest.mark.slow  # a small search (the full one's optima are tests/cli/test_design.py's)
+def test_the_comparison_table_and_drawings_hold_the_library_numbers(connect, monkeypatch):
+    monkeypatch.setattr(design_compare, "SEARCH", Search(population=5, generations=3, polish=10))
     client, view = connect()
     dv = view.teaching.design
     client.click(dv.compare_button)  # hold the link length, the task of 100 x 100 mm
-    wait_for(lambda: len(dv.compared) == 4 and dv.table.content, timeout=120, what="the comparison and its table")
+    wait_for(lambda: len(dv.compared) == 4 and dv.table.content, timeout=900, what="the comparison and its table")
     table = dv.table.content
     for n, kind in enumerate(Arrangement):  # the given rows: the task centred on each home pose
         mid = math.sqrt(P.l_a**2 - (P.a - P.b - P.stroke / 2) ** 2)  # parallel home: p1 = 0, sliders at mid-stroke
@@ -195,6 +198,22 @@ def test_the_comparison_table_and_drawings_hold_the_library_numbers(connect):
         assert drawing.task.centre == pytest.approx([0.0, 0.0 if kind is Arrangement.PERPENDICULAR else mid])
     client.set_value(dv.case, "optimum")
     wait_for(lambda: dv.scene.drawings[Arrangement.PARALLEL].params != P, timeout=30, what="the optima drawn")
+
+
+def test_a_comparison_leaves_the_fair_worker_to_the_other_tabs_between_its_batches(connect):
+    """The comparison's search runs in its own thread and hands each batch of designs to the fair worker: another
+    tab's map is computed while the comparison is still searching (before issue 35 the whole comparison was one job,
+    and the map waited for it). Leaving the tab stops the search at its next batch."""
+    first, first_view = connect()
+    second, second_view = connect()
+    comparing = first_view.teaching.design
+    first.click(comparing.compare_button)
+    wait_for(lambda: comparing.compare_note is not None, timeout=30, what="the comparison started")
+    small = {**RANGES, "x_count": "2", "y_count": "2"}
+    mapped = _computed(second, second_view, small)
+    assert mapped.done == 4
+    with first_view.hub.lock:
+        assert comparing.compared == [] and comparing.compare_note is not None  # still searching
 
 
 def test_the_texts_of_the_tab_in_korean_hold_the_numbers_and_no_nan():

@@ -29,12 +29,14 @@ from tpm_viz.core.errors import BusyError, InputError, TpmVizError
 from tpm_viz.core.params import Params
 from tpm_viz.core.words import Phrase, T, say
 from tpm_viz.design.atlas import Row
-from tpm_viz.design.compare import Hold, compare
+from tpm_viz.design.compare import Hold
 from tpm_viz.design.indices import Task
 from tpm_viz.paper import arrangement as arr
 from tpm_viz.paper.arrangement import Arrangement
 from tpm_viz.ui.fields import Note, TypedBox
 from tpm_viz.ui.teaching.design import text
+from tpm_viz.ui.teaching.design.compare import in_turns
+from tpm_viz.ui.teaching.design.compare import start as start_comparison
 from tpm_viz.ui.teaching.design.map import CHUNK, INDICES, MAX_COUNT, SWEPT, Axis, MapSpec, best_cell, colours
 from tpm_viz.ui.teaching.design.map import values as map_values
 from tpm_viz.ui.teaching.design.scene import PENDING, DesignScene, comparison_designs
@@ -330,15 +332,16 @@ class DesignView:
         params, task, hold = self.view.session.state.params, self.task, Hold.parse(self.hold.value)
         self._compare_request += 1
         request = self._compare_request
-        self.compare_note = T("Comparing: each arrangement at these dimensions and at its own optimum (5-30 s)…")
+        self.compare_note = T(
+            "Comparing: each arrangement at these dimensions and at its own optimum, found by a global search "
+            "(a few minutes; the other tabs keep working meanwhile)…"
+        )
         self.compare_status.content = say(self.view.lang, self.compare_note)
         self._show_area()
-        return lambda: self.worker.submit(
-            "design-compare",
-            lambda: compare(params, task, hold),
-            lambda rows, error: self._compared(request, hold, rows, error),
-            tab=self.view,
-        )
+        wanted = lambda: request == self._compare_request and not self.view.closed  # noqa: E731
+        evaluate = in_turns(self.worker, self.view, "design-compare", wanted)
+        done = lambda rows, error: self._compared(request, hold, rows, error)  # noqa: E731
+        return lambda: start_comparison(params, task, hold, evaluate, done)
 
     def _compared(self, request: int, hold: Hold, rows, error) -> None:
         with self.view.hub.lock:
