@@ -18,7 +18,7 @@ from tpm_viz.app.runs import Source
 from tpm_viz.app.state import AppState
 from tpm_viz.classroom.records import Records
 from tpm_viz.classroom.sessionfile import Document, Saved
-from tpm_viz.classroom.store import Copy, Limits, SqliteStore, open_store
+from tpm_viz.classroom.store import SCHEMA, Copy, Limits, SqliteStore, open_store
 from tpm_viz.core.params import Params
 from tpm_viz.paper.trajectories import Trajectory
 from tpm_viz.ui.continuity import lecture_store as Store
@@ -110,7 +110,7 @@ def _stores(tmp_path: Path) -> dict[str, Path]:
     made["newer"] = tmp_path / "newer.sqlite3"
     shutil.copy(real, made["newer"])
     db = sqlite3.connect(made["newer"])
-    db.execute("PRAGMA user_version = 2")
+    db.execute(f"PRAGMA user_version = {SCHEMA + 1}")
     db.close()
     made["brackets"] = tmp_path / "brackets.sqlite3"
     made["brackets"].write_text("[" * 200_000)

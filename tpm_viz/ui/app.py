@@ -51,6 +51,7 @@ from tpm_viz.ui.phone import is_touch
 from tpm_viz.ui.room import Room
 from tpm_viz.ui.scene import MechanismScene, camera_pose
 from tpm_viz.ui.share import ShareDesk
+from tpm_viz.ui.teaching.exercises.desk import ExerciseDesk
 from tpm_viz.ui.teaching.tabs import Services
 from tpm_viz.viserkit.adapter import install, new_server
 from tpm_viz.viserkit.core import connection_request
@@ -146,6 +147,10 @@ class TpmApp:
         self.room = Room(self, classroom, store)
         """Classroom mode, tabs that come back, the session file (:mod:`.room`)."""
         self.room.start()
+        self.exercises = self.services.exercises = ExerciseDesk(self.hub, self.services, self._tabs, self.room.lecturer)
+        """Gradebook, students, results; ``.score_sink``: LTI's hook (:mod:`.teaching.exercises.desk`)."""
+        self.exercises.start(self.room.store)
+        self.room.lecturer_hooks.append(self.exercises.lecturer_added)
         self.guides = Guides(self.room.store)
         """Which browsers dismissed the first visit's guide (:mod:`.guide`)."""
         self.shares = ShareDesk(self.hub, lambda: self.room.store.store, lambda: self.room.urls)
@@ -171,11 +176,16 @@ class TpmApp:
             self.views[client.client_id] = view
         self.keyboard.join(view)
         self.room.connected(view, who)  # presenter or not; what it had before a drop
+        self.exercises.connected(view, who[0])  # the student's numbers and attempts (ui/teaching/exercises/)
         self.guides.greet(view, who[0])  # the first visit's guide, unless this browser dismissed it (ui/guide.py)
         self.shares.connected(view, connection_request(self.server, client.client_id))  # a link: its own copy
         view.scene.set_touch(is_touch(connection_request(self.server, client.client_id)))  # a phone (ui/phone.py)
         self._class_info()
         self.arrived.add(view)
+
+    def _tabs(self) -> list[ClientView]:
+        with self._views_lock:
+            return list(self.views.values())
 
     def _lang_of(self, client_id: int) -> Lang:
         """The language of a tab (English until its view is built)."""
@@ -262,6 +272,7 @@ class TpmApp:
         with self._views_lock:
             if self._class_info_timer is not None:
                 self._class_info_timer.cancel()
+        self.exercises.stop()
         self.room.stop()
         self.server.stop()
         self.hub.drag_pool.shutdown(wait=False, cancel_futures=True)

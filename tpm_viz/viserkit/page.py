@@ -10,7 +10,8 @@ viser's page is one HTML file (its client bundle inlined). :func:`with_script` a
   nothing;
 - keeps one ``aria-live="polite"`` region (``#tpmviz-live``) with the text of the pose banner (``[data-q=banner]``),
   written only when the banner's words change (its numbers masked: a warning whose cos θ moves by 0.001 is not
-  announced again; a new warning, or back to a regular pose, is);
+  announced again; a new warning, or back to a regular pose, is), and with the text of an element that carries a new
+  ``data-say`` stamp (an exercise's result, once per submission);
 - gives every input whose ``<label for>`` names no element an ``aria-label`` (viser's text fields, sliders' number
   boxes), names unnamed buttons by their ``title`` or icon, gives the 3D canvas a name and a place in the Tab order,
   and draws a visible focus outline; a ``MutationObserver`` keeps this up as viser rebuilds the panel;
@@ -149,7 +150,14 @@ SCRIPT = (
     document.body.appendChild(live);
     return live;
   }
+  const heard = new Set();
   function announce() {
+    for (const el of document.querySelectorAll("[data-say]")) {  // a result just in (an exercise's): said once
+      const stamp = el.getAttribute("data-say");
+      if (heard.has(stamp)) continue;
+      heard.add(stamp);
+      region().textContent = el.textContent.replace(/\s+/g, " ").trim();
+    }
     const banner = document.querySelector('[data-q="banner"]');
     if (!banner) return;
     const text = (banner.querySelector("b") || banner).textContent.replace(/\s+/g, " ").trim();
