@@ -141,6 +141,10 @@ class ExerciseDesk:
             self._sections[view] = ResultsSection(view.gui, self, view, self._book().class_seed)
         self._schedule()
 
+    def section(self, view: Any) -> ResultsSection | None:
+        """``view``'s *Exercise results* (None: not a lecturer's tab)."""
+        return self._sections.get(view)
+
     def _schedule(self) -> None:
         with self._lock:
             if self._timer is not None:

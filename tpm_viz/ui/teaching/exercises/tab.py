@@ -99,9 +99,10 @@ class ExercisesView:
         if self._box is None or index == self._box_lesson:
             return
         self._box_lesson = index
-        for cards in self.cards.values():
+        for key, cards in self.cards.items():
             for card in [c for c in cards if c.box]:
                 card.remove()
+            self.cards[key] = [c for c in cards if not c.box]
         exercises = self.lessons[index].exercises if 0 <= index < len(self.lessons) else ()
         with self._box:
             for exercise in exercises:
@@ -162,6 +163,8 @@ class ExercisesView:
                     mine = self.mine[key]
                     if mine.seed != seed:  # new numbers (a class seed, or back to their own): a fresh result line
                         mine.score = mine.feedback = mine.error = None
+                    elif len(attempts) < len(mine.attempts):  # read before an answer this tab was told of: kept
+                        attempts = mine.attempts
                     mine.seed, mine.prompt, mine.problem, mine.attempts = seed, prompt, problem, attempts
             self.draw()
             self.view.client.flush()
