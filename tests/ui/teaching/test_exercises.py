@@ -14,10 +14,12 @@ import pytest
 from tests.support.protocol import wait_for
 from tpm_viz.app.exercises.gains import RMS_LIMIT
 from tpm_viz.app.exercises.grading import reference, variant_of
+from tpm_viz.core.numbers import parse_quantity
 from tpm_viz.core.words import Lang
 from tpm_viz.multibody import inverse_dynamics
 from tpm_viz.multibody.control import ControlSetup, simulate
 from tpm_viz.paper.control import Gains
+from tpm_viz.ui.teaching.exercises.text import EXAMPLES
 
 FORCE = "force-at-pose"  # exam: [1.0, 0.7, 0.5], N
 POSE = "zero-force-pose"  # homework, pose in mm
@@ -175,3 +177,9 @@ def test_a_korean_tab_shows_the_prompt_and_the_result_in_korean(app, connect):
     assert "읽을 수 없음" in card.result.content and "시도 횟수를 쓰지 않았습니다" in card.result.content
     _answer(client, card, f"{_tau1(mine):.3f}")
     assert "점수 1.00: 정답" in card.result.content and "남은 시도 2번" in card.result.content
+
+
+def test_every_other_unit_a_card_suggests_is_read_in_the_exercise_s_unit():
+    for unit, text in EXAMPLES.items():
+        value = parse_quantity(text, unit=unit)
+        assert math.isfinite(value) and value != float(text.split()[0].rstrip("°"))  # converted, not as typed

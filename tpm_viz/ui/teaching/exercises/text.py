@@ -25,10 +25,16 @@ NO_EXERCISES = T("No exercises in these lessons.")
 NONE_YET = T("No graded answers yet.")
 OWN, CLASS = T("own"), T("class")
 HEADERS = (T("Student"), T("Exercise"), T("Variant"), T("Attempts"), T("Best"), T("Last answer"))
+EXAMPLES = {"mm": "0.15 m", "m": "150 mm", "N": "0.2 kN", "kN": "200 N", "deg": "0.52 rad", "rad": "30°"}
+EXAMPLES |= {"Hz": "62.8 rad/s", "s": "500 ms", "mm/s": "0.1 m/s", "m/s": "100 mm/s"}
+"""An answer in another unit of the quantity, by the exercise's unit (:func:`tpm_viz.core.numbers.parse_quantity`)."""
 SHOWN_ANSWERS = 5
 """A card lists the student's last this many answers."""
 _BOX = "font-size:0.85em;line-height:1.45;color:#1e293b"
 _RED, _GREEN, _SLATE = "#991b1b", "#166534", "#334155"
+_NOWRAP = ' style="text-align:left;padding:1px 3px;white-space:nowrap;vertical-align:top"'
+_WRAP = ' style="text-align:left;padding:1px 3px;overflow-wrap:anywhere;vertical-align:top"'
+"""Table cells: a label, a number or a word on one line; an exercise id and an answer may break anywhere."""
 
 
 @dataclass
@@ -64,8 +70,11 @@ def how_phrase(exercise: Exercise) -> Phrase:
         return T("Answer with the number of an option.")
     if not exercise.unit:
         return T("Answer with a number.")
+    example = EXAMPLES.get(exercise.unit)
+    if example is None:
+        return Phrase("Answer in {unit}.", unit=exercise.unit)
     return Phrase(
-        "Answer in {unit}; another unit of the same quantity is read too (0.15 m, 15 cm).", unit=exercise.unit
+        "Answer in {unit}; another unit of its quantity is read too ({example}).", unit=exercise.unit, example=example
     )
 
 
@@ -149,7 +158,7 @@ def table_html(lines: Sequence[Summary], total: int, status: Phrase, lang: Lang)
     head = f'<div data-q="results-status" style="color:{_SLATE}">{html.escape(say(lang, status))}</div>'
     if not lines:
         return f'<div data-q="results" style="{_BOX}">{head}<div>{html.escape(say(lang, NONE_YET))}</div></div>'
-    cells = "".join(f'<th style="text-align:left;padding:1px 4px">{html.escape(say(lang, h))}</th>' for h in HEADERS)
+    cells = "".join(f"<th{_NOWRAP}>{html.escape(say(lang, h))}</th>" for h in HEADERS)
     rows = []
     for line in lines:
         values = (
@@ -160,10 +169,13 @@ def table_html(lines: Sequence[Summary], total: int, status: Phrase, lang: Lang)
             num(line.best, ".2f"),
             line.answer,
         )
-        rows.append("<tr>" + "".join(f'<td style="padding:1px 4px">{html.escape(v)}</td>' for v in values) + "</tr>")
+        tds = (f"<td{_WRAP if k in (1, 5) else _NOWRAP}>{html.escape(v)}</td>" for k, v in enumerate(values))
+        rows.append("<tr>" + "".join(tds) + "</tr>")
     more = ""
     if total > len(lines):
         note = Phrase("The latest {shown} of {total} lines; the CSV has them all.", shown=len(lines), total=total)
         more = f"<div>{html.escape(say(lang, note))}</div>"
-    table = f'<table style="border-collapse:collapse;font-variant-numeric:tabular-nums"><tr>{cells}</tr>'
+    table = (
+        f'<table style="border-collapse:collapse;font-size:0.92em;font-variant-numeric:tabular-nums"><tr>{cells}</tr>'
+    )
     return f'<div data-q="results" style="{_BOX};overflow-x:auto">{head}{table}{"".join(rows)}</table>{more}</div>'
