@@ -14,7 +14,9 @@ under its text in *Demos*; both show the same state (:class:`~.text.Mine` per ex
 
 from __future__ import annotations
 
+import functools
 import itertools
+import weakref
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -42,6 +44,13 @@ TAB = T("Exercises")
 State = dict[str, tuple[int, Phrase | None, Phrase | None, tuple[Any, ...]]]
 """What :meth:`~.desk.ExerciseDesk.states` reads for a student: exercise id -> (seed, prompt, problem, attempts)."""
 _STAMPS = itertools.count(1)
+
+
+def _call_if_alive(method: weakref.WeakMethod[Callable[[], None]]) -> None:
+    """A deferred call that does not keep its tab alive."""
+    call = method()
+    if call is not None:
+        call()
 
 
 def _why(error: Exception | None) -> Phrase:
@@ -85,6 +94,8 @@ class ExercisesView:
                 with gui.add_folder(demo.title, expand_by_default=True):
                     for exercise in demo.exercises:
                         self._card(gui, exercise.id)
+        if any(mine.prompt is None and mine.problem is None for mine in self.mine.values()):
+            self.refresh()  # asked for now: not at the quiet moment it waits for
 
     def lesson_box(self, gui: TabGui) -> None:
         """The folder under the lesson's text in *Demos* (inside that tab's context): the lesson's exercises."""
@@ -137,9 +148,14 @@ class ExercisesView:
 
     # -- who and what ----------------------------------------------------------------------------------------------
     def identify(self, identity: str) -> None:
-        """The student is ``identity``: read their numbers and attempts (:meth:`refresh`)."""
+        """The student is ``identity``: read their numbers and attempts (:meth:`refresh`) at the next quiet moment
+        (:class:`~tpm_viz.classroom.later.Later`: a class reconnecting at once gets its mechanisms back first)."""
         self.identity = identity
-        self.refresh()
+        later = getattr(self.services, "later", None)
+        if later is None:
+            self.refresh()
+        else:
+            later.add(functools.partial(_call_if_alive, weakref.WeakMethod(self.refresh)))
 
     def refresh(self) -> None:
         """Read the student's prompts and attempts again, in the fair worker, then draw them."""
