@@ -138,7 +138,8 @@ class Gradebook:
         if item is None:
             raise InputError(Phrase("unknown exercise {id}", id=repr(str(exercise_id)[:70])))
         exercise = item.exercise
-        seed = self.seed(identity, exercise_id)
+        fixed = self._class_seed  # read once: the lecturer may fix or unfix it while this answer is graded
+        seed = fixed if fixed is not None else student_seed(self.key, identity, exercise_id)
         try:
             done = self.rows.of(identity, exercise_id, seed)
         except sqlite3.Error as exc:  # a store that cannot be read now (locked, closed): said, nothing graded
@@ -153,7 +154,7 @@ class Gradebook:
             return Submitted(exercise_id, seed, graded, None, done)
         result = Result(identity, exercise_id, seed, len(done) + 1, str(text), graded.score, self.clock())
         try:
-            row = self.rows.add(result, self._class_seed is not None, self.bounds)
+            row = self.rows.add(result, fixed is not None, self.bounds)
         except ResultsRefused as exc:
             return Submitted(exercise_id, seed, None, _phrase(exc), done)
         except sqlite3.Error as exc:  # a full disk, a locked file: not kept, so not counted (the student is told)

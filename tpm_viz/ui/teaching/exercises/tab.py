@@ -15,6 +15,7 @@ under its text in *Demos*; both show the same state (:class:`~.text.Mine` per ex
 from __future__ import annotations
 
 import functools
+import html
 import itertools
 import weakref
 from collections.abc import Callable, Sequence
@@ -125,7 +126,7 @@ class ExercisesView:
         if self.number is None:
             return ""
         line = say(self.view.lang, Phrase("You are Student {number} in the lecturer's table.", number=self.number))
-        return f'<div data-q="exercise-whoami" style="font-size:0.85em;color:#334155">{line}</div>'
+        return f'<div data-q="exercise-whoami" style="font-size:0.85em;color:#334155">{html.escape(line)}</div>'
 
     # -- drawing ---------------------------------------------------------------------------------------------------
     def draw(self, key: str | None = None) -> None:
