@@ -26,10 +26,8 @@ __all__ = ["classroom_app"]  # the fixture, imported
 
 IDENT = "direct-singularity-diagonal"
 WIDE, PHONE = {"width": 1366, "height": 768}, {"width": 390, "height": 844}
-WORDS = {  # what each page shows, in its language
-    "en": {"Teach": "Teach", "Exercises": "Exercises", "Download results (CSV)": "Download results (CSV)"},
-    "ko": {k: catalogue(Lang.KO)[k] for k in ("Teach", "Exercises", "Download results (CSV)")},
-}
+SHOWN = ("Teach", "Exercises", "Demos", "Download results (CSV)")
+WORDS = {"en": {k: k for k in SHOWN}, "ko": {k: catalogue(Lang.KO)[k] for k in SHOWN}}  # as each page shows them
 SCORE = {"en": "Score 1.00: correct", "ko": "점수 1.00: 정답"}
 STUDENT = {"en": "Student 1", "ko": "학생 1"}
 
@@ -75,6 +73,10 @@ def test_a_student_answers_and_the_lecturer_s_table_and_csv_show_it(classroom_ap
             wait_for(lambda: SCORE[lang] in student.locator("#tpmviz-live").text_content(), what="read out")
             result.scroll_into_view_if_needed()
             student.screenshot(path=os.path.join(shots, "student-1366x768.png"))
+            open_tab(student, words["Demos"], group=words["Teach"])  # the same result under the lesson's text
+            wait_for(lambda: SCORE[lang] in result.inner_text(), what="the score under the lesson's text")
+            result.scroll_into_view_if_needed()
+            student.screenshot(path=os.path.join(shots, "student-demos-1366x768.png"))
             student.set_viewport_size(PHONE)
             open_tab(student, words["Exercises"], group=words["Teach"])
             result.scroll_into_view_if_needed()

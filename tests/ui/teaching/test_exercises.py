@@ -26,12 +26,14 @@ POSE = "zero-force-pose"  # homework, pose in mm
 GAINS = "tune-ctc"  # homework, gains (heavy)
 
 
-def _ready(view, ident: str, box: bool = False):
+def _ready(client, view, ident: str, box: bool = False):
     """``(mine, card)`` of exercise ``ident`` once its prompt has the student's numbers (``box``: the card under the
-    lesson's text in *Demos*, else the *Exercises* tab's, which is built now)."""
+    lesson's text in *Demos*, else the *Exercises* tab's, built now, its lesson chosen in the *Lesson* dropdown)."""
     exercises = view.teaching.exercises
     if not box:
         view.teaching.open("teach")
+        title = next(d.title for d in exercises.lessons if any(e.id == ident for e in d.exercises))
+        client.set_value(exercises.choice, title)
     mine = wait_for(lambda: exercises.mine[ident] if exercises.mine[ident].prompt is not None else None, what="prompt")
     card = wait_for(lambda: next((c for c in exercises.cards[ident] if c.box == box), None), what="the card")
     return mine, card
@@ -60,7 +62,7 @@ def _kept(app, view):
 
 def test_a_right_answer_typed_as_anywhere_scores_one_and_is_kept(app, connect):
     client, view = connect()
-    mine, card = _ready(view, FORCE)
+    mine, card = _ready(client, view, FORCE)
     tau = _tau1(mine)
     typed = f"{tau / 1000:.6f} kN".replace(".", ",").replace("-", "−")  # kN, a decimal comma, the Unicode minus
     _answer(client, card, typed, enter=True)
@@ -73,7 +75,7 @@ def test_a_right_answer_typed_as_anywhere_scores_one_and_is_kept(app, connect):
 
 def test_a_format_error_says_what_to_change_and_uses_no_attempt(app, connect):
     client, view = connect()
-    mine, card = _ready(view, FORCE)
+    mine, card = _ready(client, view, FORCE)
     for text in ("12 kg", "ten newtons", ""):
         _answer(client, card, text)
         assert mine.error is not None and not mine.refused
@@ -84,7 +86,7 @@ def test_a_format_error_says_what_to_change_and_uses_no_attempt(app, connect):
 
 def test_the_ladder_scores_later_attempts_less_then_no_attempts_are_left(app, connect):
     client, view = connect()
-    mine, card = _ready(view, FORCE)
+    mine, card = _ready(client, view, FORCE)
     ladder = mine.exercise.attempts.ladder
     right = f"{_tau1(mine):.3f}"
     _answer(client, card, "0")
@@ -101,7 +103,7 @@ def test_the_ladder_scores_later_attempts_less_then_no_attempts_are_left(app, co
 
 def test_use_current_pose_writes_the_platform_s_position_and_that_pose_is_graded(app, connect):
     client, view = connect()
-    mine, card = _ready(view, POSE)
+    mine, card = _ready(client, view, POSE)
     v = variant_of(mine.exercise, mine.seed)
     p1, p2 = reference(mine.exercise, v)  # a pose that rests actuator 1: checked with Pinocchio below
     client.enter(view.panel.p, {"p1": f"{p1:.2f}", "p2": f"{p2:.2f}"})  # the platform moved as a student would
@@ -119,7 +121,7 @@ def test_use_current_pose_writes_the_platform_s_position_and_that_pose_is_graded
 
 def test_a_gains_answer_is_graded_in_the_fair_worker_with_a_grading_state(app, connect, monkeypatch):
     client, view = connect()
-    mine, card = _ready(view, GAINS)
+    mine, card = _ready(client, view, GAINS)
     book, threads = app.exercises.book, []
     submit = book.submit
 
@@ -153,7 +155,7 @@ def test_a_gains_answer_is_graded_in_the_fair_worker_with_a_grading_state(app, c
 def test_the_lesson_s_exercises_sit_under_its_text_and_follow_the_lesson(app, connect):
     client, view = connect()
     exercises = view.teaching.exercises
-    mine, box = _ready(view, "direct-singularity-diagonal", box=True)
+    mine, box = _ready(client, view, "direct-singularity-diagonal", box=True)
     assert {c.id for cards in exercises.cards.values() for c in cards if c.box} == {"direct-singularity-diagonal"}
     for _ in range(3):  # Next, Next, Next: lesson 4
         index = view.teaching.demos.index
@@ -161,8 +163,8 @@ def test_the_lesson_s_exercises_sit_under_its_text_and_follow_the_lesson(app, co
         wait_for(lambda index=index: view.teaching.demos.index == index + 1, what="the next lesson")
     wait_for(lambda: {c.id for cs in exercises.cards.values() for c in cs if c.box} == {FORCE, POSE}, what="lesson 4")
     assert box.gone  # the first lesson's card went with it
-    mine, card = _ready(view, FORCE, box=True)
-    _, tab_card = _ready(view, FORCE)
+    mine, card = _ready(client, view, FORCE, box=True)
+    _, tab_card = _ready(client, view, FORCE)
     _answer(client, card, f"{_tau1(mine):.3f}")
     wait_for(lambda: tab_card.result.content == card.result.content, what="both cards of the exercise")
     assert "Score 1.00" in tab_card.result.content
@@ -170,7 +172,7 @@ def test_the_lesson_s_exercises_sit_under_its_text_and_follow_the_lesson(app, co
 
 def test_a_korean_tab_shows_the_prompt_and_the_result_in_korean(app, connect):
     client, view = connect()
-    mine, card = _ready(view, FORCE)
+    mine, card = _ready(client, view, FORCE)
     view.words.set(Lang.KO)
     wait_for(lambda: mine.exercise.prompt.ko.split("{")[0] in card.prompt.content, what="the Korean prompt")
     _answer(client, card, "1 kg")

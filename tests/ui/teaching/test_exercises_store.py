@@ -62,13 +62,19 @@ def _visit(app, cookie: str, source: str | None = None):
     view = wait_for(lambda: next((v for v in app.views.values() if v not in before), None), what="the new tab")
     views_of(app, len(before) + 1)
     view.teaching.open("teach")
+    title = next(d.title for d in view.teaching.exercises.lessons if any(e.id == FORCE for e in d.exercises))
+    _press(page, view.teaching.exercises.choice, title)  # the Exercises tab shows the lesson of force-at-pose
     return page, view
 
 
 def _card(view, ident: str = FORCE):
+    """``(mine, card)``: the exercise once its prompt has the student's numbers, and its card in the *Exercises* tab
+    (None if its lesson is not the one shown there)."""
     exercises = view.teaching.exercises
     wait_for(lambda: exercises.mine[ident].prompt is not None, what="the prompt")
-    return exercises.mine[ident], next(c for c in exercises.cards[ident] if not c.box)
+    if ident == FORCE:
+        wait_for(lambda: any(not c.box for c in exercises.cards[ident]), what="the card in the Exercises tab")
+    return exercises.mine[ident], next((c for c in exercises.cards[ident] if not c.box), None)
 
 
 def _answer(page: Page, card, text: str) -> None:
@@ -173,6 +179,7 @@ def test_a_student_never_sees_the_results_only_the_presenter_does(classroom_app)
     sv = next(v for v in views_of(app, 2) if v is not lv)
     assert app.exercises.section(lv) is not None and app.exercises.section(sv) is None
     sv.teaching.open("teach")
+    _press(student, sv.teaching.exercises.choice, by_id(FORCE).lesson.title)
     mine, card = _card(sv)
     _answer(student, card, "0")
     section = app.exercises.section(lv)

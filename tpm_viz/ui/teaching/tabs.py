@@ -174,8 +174,8 @@ class Teaching:
             with tabs.add_tab("Player", icon=viser.Icon.PLAYER_PLAY):
                 self._player.build(gui)
                 self._takeouts.append(takeout_for(self.view, worker, self._player, "player", gui))
-            with tabs.add_tab(TAB.template, icon=viser.Icon.CHECKLIST):
-                self.exercises.build(gui)
+            with tabs.add_tab(TAB.template, icon=viser.Icon.CHECKLIST) as tab:
+                self.exercises.build(gui, tab)
         if group == "lab":
             with tabs.add_tab("Control", icon=viser.Icon.ADJUSTMENTS):
                 self._control.build(gui)

@@ -14,6 +14,7 @@ under its text in *Demos*; both show the same state (:class:`~.text.Mine` per ex
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import html
 import itertools
@@ -40,6 +41,8 @@ INTRO = T(
     "app (units, decimal commas) and press Submit or Enter. An answer that cannot be read uses no attempt."
 )
 BOX = T("Exercises of this lesson")
+LESSON = T("Lesson")
+NONE = T("(no exercises)")
 TAB = T("Exercises")
 """The tab's name (in *Teach*)."""
 State = dict[str, tuple[int, Phrase | None, Phrase | None, tuple[Any, ...]]]
@@ -81,22 +84,58 @@ class ExercisesView:
         """The student's number in the lecturer's table (``Student 7``), once known."""
         self._box: Worded | None = None
         self._box_lesson: int | None = None
+        self._gui: TabGui | None = None
+        self._tab: Any = None
+        self._shelf: Worded | None = None
+        self._tab_lesson: str | None = None
+        self.choice: Any = None
+        """The *Exercises* tab's *Lesson* dropdown (once the tab is built)."""
         self.whoami: Worded | None = None
 
     # -- building --------------------------------------------------------------------------------------------------
-    def build(self, gui: TabGui) -> None:
-        """The *Exercises* tab's widgets (inside the tab's context, under the hub's lock)."""
-        gui.add_markdown(INTRO.template)
+    def build(self, gui: TabGui, tab: Worded) -> None:
+        """The *Exercises* tab's widgets (inside ``tab``'s context, under the hub's lock): the lesson to show (first,
+        so that the tab's first control is in view), then its exercises."""
+        self._gui, self._tab = gui, tab
+        titles = tuple(d.title for d in self.lessons if d.exercises)
+        shown = self.lessons[self._lesson()].title if 0 <= self._lesson() < len(self.lessons) else ""
+        self.choice = gui.add_dropdown(
+            LESSON.template, titles or (NONE.template,), initial_value=shown if shown in titles else None
+        )
+        self.choice.disabled = not titles
+        gui.add_markdown(INTRO.template if titles else NO_EXERCISES.template)
         self.whoami = gui.add_html(self._whoami())
-        if not self.mine:
-            gui.add_markdown(NO_EXERCISES.template)
-        for demo in self.lessons:
-            if demo.exercises:
-                with gui.add_folder(demo.title, expand_by_default=True):
-                    for exercise in demo.exercises:
-                        self._card(gui, exercise.id)
+        self._fill_tab(inside=True)
+        self.choice.on_update(self._on_lesson)
         if any(mine.prompt is None and mine.problem is None for mine in self.mine.values()):
             self.refresh()  # asked for now: not at the quiet moment it waits for
+
+    def _fill_tab(self, inside: bool = False) -> None:
+        """The chosen lesson's exercises, in a folder of its name (the last element of the tab; ``inside``: called
+        in the tab's context already)."""
+        title = self.choice.value
+        if title == self._tab_lesson or self._gui is None or self._tab is None:
+            return
+        self._tab_lesson = title
+        self._drop(box=False)
+        if self._shelf is not None:
+            self._shelf.remove()
+        demo = next((d for d in self.lessons if d.title == title), None)
+        self._shelf = None
+        if demo is not None and demo.exercises:
+            with contextlib.nullcontext() if inside else self._tab:
+                self._shelf = self._gui.add_folder(demo.title, expand_by_default=True)
+            with self._shelf:
+                for exercise in demo.exercises:
+                    self._card(self._gui, exercise.id)
+
+    @guarded(on_error=_failed)
+    def _on_lesson(self, event: Any) -> None:
+        if not self._user(event):
+            return
+        with self.view.hub.lock:
+            self._fill_tab()
+            self.view.client.flush()
 
     def lesson_box(self, gui: TabGui) -> None:
         """The folder under the lesson's text in *Demos* (inside that tab's context): the lesson's exercises."""
@@ -111,16 +150,20 @@ class ExercisesView:
         if self._box is None or index == self._box_lesson:
             return
         self._box_lesson = index
-        for key, cards in self.cards.items():
-            for card in [c for c in cards if c.box]:
-                card.remove()
-            self.cards[key] = [c for c in cards if not c.box]
+        self._drop(box=True)
         exercises = self.lessons[index].exercises if 0 <= index < len(self.lessons) else ()
         with self._box:
             for exercise in exercises:
                 self._card(self.view.gui, exercise.id)
                 self.cards[exercise.id][-1].box = True
         self._box.visible = bool(exercises)
+
+    def _drop(self, box: bool) -> None:
+        """Take out the cards under the lesson's text (``box``) or those of the *Exercises* tab."""
+        for key, cards in self.cards.items():
+            for card in [c for c in cards if c.box == box]:
+                card.remove()
+            self.cards[key] = [c for c in cards if c.box != box and not c.gone]
 
     def _whoami(self) -> str:
         if self.number is None:

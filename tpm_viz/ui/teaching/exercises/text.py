@@ -31,6 +31,7 @@ EXAMPLES |= {"Hz": "62.8 rad/s", "s": "500 ms", "mm/s": "0.1 m/s", "m/s": "100 m
 SHOWN_ANSWERS = 5
 """A card lists the student's last this many answers."""
 _BOX = "font-size:0.85em;line-height:1.45;color:#1e293b"
+_HEAD = _BOX + ";padding-bottom:6px"  # room for the focused answer box's outline under it
 _RED, _GREEN, _SLATE = "#991b1b", "#166534", "#334155"
 _NOWRAP = ' style="text-align:left;padding:1px 3px;white-space:nowrap;vertical-align:top"'
 _WRAP = ' style="text-align:left;padding:1px 3px;overflow-wrap:anywhere;vertical-align:top"'
@@ -92,7 +93,7 @@ def prompt_html(mine: Mine, lang: Lang) -> str:
     body = mine.problem or mine.prompt or WAITING
     how = f"{say(lang, how_phrase(ex))} {say(lang, rule_phrase(ex.attempts))}"
     return (
-        f'<div data-q="exercise-prompt" data-x="{html.escape(ex.id)}" lang="{lang.value}" style="{_BOX}">'
+        f'<div data-q="exercise-prompt" data-x="{html.escape(ex.id)}" lang="{lang.value}" style="{_HEAD}">'
         f"<b>{html.escape(ex.title.get(lang))}</b>"
         f'<p style="margin:2px 0 4px 0">{html.escape(say(lang, body))}</p>'
         f'<div style="color:{_SLATE};font-size:0.9em">{html.escape(how)}</div></div>'
