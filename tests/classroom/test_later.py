@@ -4,6 +4,7 @@ logged without stopping the next job."""
 from __future__ import annotations
 
 import gc
+import pathlib
 import sys
 import threading
 import weakref
@@ -95,3 +96,16 @@ def test_tune_for_serving_sets_the_collector_and_the_switch_interval():
         gc.unfreeze()
         gc.set_threshold(*thresholds)
         sys.setswitchinterval(switch)
+
+
+def test_the_runtime_settings_have_one_owner():
+    """Only ``classroom/runtime.py`` sets the GIL switch interval and the collector's thresholds (issue 36: two places
+    set the interval to two values)."""
+    package = pathlib.Path(runtime.__file__).resolve().parents[1]
+    setters = ("setswitchinterval(", "set_threshold(", "gc.freeze(")
+    owners = {
+        str(path.relative_to(package))
+        for path in package.rglob("*.py")
+        if any(call in path.read_text(encoding="utf-8") for call in setters)
+    }
+    assert owners == {"classroom/runtime.py"}

@@ -11,6 +11,7 @@ GROUP_OF = {
     "Demos": "Teach",
     "Player": "Teach",
     "Equations": "Teach",
+    "Exercises": "Teach",
     "Control": "Lab",
     "Planner": "Lab",
     "Design": "Lab",

@@ -17,7 +17,8 @@ import pytest
 
 from tests.support.protocol import wait_for
 from tpm_viz import Params, forward_kinematics_both, inverse_kinematics
-from tpm_viz.ui.app import is_loopback, main
+from tpm_viz.classroom.network import is_loopback
+from tpm_viz.ui.app import main
 from tpm_viz.ui.scene import COLORS
 from tpm_viz.viserkit.probe import share_tunnel
 

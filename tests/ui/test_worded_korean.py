@@ -35,7 +35,7 @@ NAMES = {
     "id", "ok", "url", "http", "https", "utf", "readme", "tpm-viz", "english", "enter", "shift", "esc", "ctrl",
     "webgl", "gpu",
     # units
-    "mm", "hz", "kg", "rad", "deg", "µm", "mib", "kib", "ms",
+    "mm", "hz", "khz", "kg", "rad", "deg", "µm", "mib", "kib", "ms",
     # mathematical symbols and functions
     "sin", "cos", "tan", "atan", "diag", "det", "cond", "max", "min", "log", "exp", "sqrt", "ref", "ext", "eq",
     "eqs", "fig", "figs", "dt", "nan", "inf",

@@ -40,6 +40,7 @@ __all__ = [
     "client_address",
     "header_problem",
     "host_name",
+    "is_loopback",
     "parse_allowed_host",
     "parse_trusted_proxy",
 ]
@@ -66,6 +67,18 @@ _NAME = re.compile(r"^(?=.{1,253}$)[a-z0-9_](?:[a-z0-9_-]{0,62})(?:\.[a-z0-9_](?
 _HOST = re.compile(r"^(\[[0-9a-f:.]+\]|[a-z0-9_.-]+)(?::([0-9]{1,5}))?$")
 _FOR = re.compile(r'(?:^|;)\s*for\s*=\s*("[^"]*"|[^;,\s]*)', re.I)
 _MAX_HOPS = 32
+
+
+def is_loopback(host: str) -> bool:
+    """Whether ``host`` (an address, ``[::1]`` or ``localhost``) is this machine only (IPv4-mapped IPv6 included)."""
+    if host.strip("[]").lower() == "localhost":
+        return True
+    try:
+        address = ipaddress.ip_address(host.strip("[]"))
+    except ValueError:  # "proxied 127.0.0.1", "unknown": not a plain address
+        return False
+    mapped = getattr(address, "ipv4_mapped", None)
+    return address.is_loopback or (mapped is not None and mapped.is_loopback)
 
 
 def _address(text: str) -> ipaddress.IPv4Address | ipaddress.IPv6Address | None:

@@ -3,7 +3,8 @@
 One server process serves every tab from many threads under one interpreter lock (the GIL): the websocket loop,
 viser's callback pool, the heavy-job worker (:mod:`.jobs`), the deferred builds (:mod:`.later`). Two process-wide
 settings decide how long a tab waits while another thread computes; :func:`tune_for_serving` sets both, once, in
-the serving process (:func:`tpm_viz.ui.app.main`; the in-process benchmarks call it to measure what is served).
+the serving process (:func:`tpm_viz.ui.app.main`; the in-process benchmarks call it to measure what is served). This
+module is their one owner: nothing else in tpm-viz sets them (``tests/classroom/test_later.py`` checks).
 """
 
 from __future__ import annotations

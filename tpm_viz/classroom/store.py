@@ -1,7 +1,9 @@
 """The classroom store: records behind a small interface (:class:`Store`), kept in SQLite (:class:`SqliteStore`).
 
 Records: the lecture (one row, never evicted), one row per remembered browser (its tabs that left, with the source
-address they came from) and the uploaded trajectories once each by SHA-256 of their bytes (:meth:`Store.put_blob`).
+address they came from), the uploaded trajectories once each by SHA-256 of their bytes (:meth:`Store.put_blob`), and
+(schema 2) the exercise results, written through one transaction per graded answer (:attr:`Store.results`,
+:mod:`.resultsdb`).
 A record's body is JSON text; one that cannot be read is skipped (:attr:`Contents.skipped`), the rest load.
 Schema 2 adds the LTI tool's tables (``lti_*``), read and written by :mod:`tpm_viz.lti.ledger` (docs/lti.md §9).
 
@@ -29,6 +31,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
 
+from tpm_viz.classroom.resultsdb import TABLES as RESULT_TABLES
+from tpm_viz.classroom.resultsdb import ResultRows
 from tpm_viz.core.errors import InputError
 from tpm_viz.core.files import DEFAULT_DEPTH, loads_json
 
@@ -45,8 +49,9 @@ __all__ = [
     "open_store",
 ]
 
-SCHEMA = 2
-"""Schema version (``PRAGMA user_version``); a store of a higher one is moved aside, never half-read."""
+SCHEMA = 3
+"""Schema version (``PRAGMA user_version``); a store of a higher one is moved aside, never half-read. 1: the lecture,
+browsers, blobs, imports; 2: and the LTI tables (``tpm_viz.lti``); 3: and the exercise results (:mod:`.resultsdb`)."""
 _HEADER = b"SQLite format 3\x00"
 _TABLES = (
     "CREATE TABLE IF NOT EXISTS lecture (id INTEGER PRIMARY KEY CHECK (id = 1), body TEXT NOT NULL, saved REAL)",
@@ -67,7 +72,7 @@ _LTI_TABLES = (  # schema 2: the LTI tool's records (tpm_viz/lti/ledger.py, docs
     "CREATE TABLE IF NOT EXISTS lti_grades (grade TEXT PRIMARY KEY, best REAL NOT NULL, stamp TEXT NOT NULL)",
 )
 _HEX64 = re.compile(r"[0-9a-f]{64}")
-MIGRATIONS: dict[int, tuple[str, ...]] = {0: _TABLES, 1: _LTI_TABLES}
+MIGRATIONS: dict[int, tuple[str, ...]] = {0: _TABLES, 1: _LTI_TABLES, 2: RESULT_TABLES}
 """Statements that take a store of schema ``n`` to ``n + 1`` (0: a new, empty database)."""
 
 
@@ -109,6 +114,10 @@ class Contents:
 
 class Store(Protocol):
     """The records of one classroom (thread-safe)."""
+
+    @property
+    def results(self) -> ResultRows:
+        """The exercise results (:mod:`.resultsdb`): one graded answer per transaction, never by :meth:`save`."""
 
     def load(self) -> Contents:
         """Every record that can be read."""
@@ -201,6 +210,7 @@ class SqliteStore:
             if check is None or check[0] != "ok":
                 raise StoreUnreadable("damaged")
             self._migrate()
+            self._results = ResultRows(self._db, self._lock, self._transaction)
         except BaseException:
             self._db.close()
             raise
@@ -218,6 +228,10 @@ class SqliteStore:
 
     def _transaction(self) -> Any:
         return _Transaction(self._db)
+
+    @property
+    def results(self) -> ResultRows:
+        return self._results
 
     # -- records ------------------------------------------------------------------------------------------------
     def load(self) -> Contents:

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from tpm_viz.ui.classroom import Classroom, is_loopback_address, qr_text, student_urls
+from tpm_viz.classroom.network import is_loopback
+from tpm_viz.ui.classroom import Classroom, qr_text, student_urls
 
 __all__ = ["announce", "nobody", "serving"]
 
@@ -33,7 +34,7 @@ def announce(app: Any, room: Classroom, bound: str) -> None:
         print("No network address found: connect this computer to the room's network and restart.", flush=True)
     for url in urls:
         print(f"Students open: {url}", flush=True)
-    if is_loopback_address(bound):
+    if is_loopback(bound):
         print(f"(bound to {bound} only: students cannot connect; serve with --host 0.0.0.0)", flush=True)
     if urls:
         print(qr_text(urls[0]), end="", flush=True)

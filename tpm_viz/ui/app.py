@@ -14,7 +14,6 @@ guarded (:mod:`.guard`): one bad tab never stops the server.
 
 from __future__ import annotations
 
-import ipaddress
 import logging
 import signal
 import sys
@@ -35,7 +34,7 @@ from tpm_viz.classroom.access import Access
 from tpm_viz.classroom.guard import guarded, log, log_fault, report
 from tpm_viz.classroom.identity import Keys
 from tpm_viz.classroom.launches import Plug, Tickets
-from tpm_viz.classroom.network import HostRules, Network
+from tpm_viz.classroom.network import HostRules, Network, is_loopback
 from tpm_viz.classroom.runtime import tune_for_serving
 from tpm_viz.classroom.session import Hub
 from tpm_viz.core.errors import InputError, TpmVizError
@@ -54,6 +53,7 @@ from tpm_viz.ui.phone import is_touch
 from tpm_viz.ui.room import Room
 from tpm_viz.ui.scene import MechanismScene, camera_pose
 from tpm_viz.ui.share import ShareDesk
+from tpm_viz.ui.teaching.exercises.desk import ExerciseDesk
 from tpm_viz.ui.teaching.tabs import Services
 from tpm_viz.viserkit.adapter import install, new_server
 from tpm_viz.viserkit.core import connection_request
@@ -66,23 +66,6 @@ BRAND = (13, 148, 136)
 CLASS_INFO_DELAY = 0.3
 """A change of the class (tabs joining, leaving, switching) is shown in every tab's classroom line after this many
 seconds per 30 tabs (at least this), once for all the changes meanwhile [s]."""
-
-
-def is_loopback(host: str) -> bool:
-    """Whether ``host`` only accepts connections from this machine."""
-    if host == "localhost":
-        return True
-    try:
-        return ipaddress.ip_address(host).is_loopback
-    except ValueError:
-        return False
-
-
-GIL_SWITCH_INTERVAL = 0.0005
-"""How long [s] a thread may keep the GIL while another waits for it (Python's default: 5 ms). The event loop that
-reads and writes every tab's socket gives the GIL away at each system call, and got it back only after a drag commit
-in the pool had run for up to 5 ms more: in a lecture hall, hundreds of times a second (``bench_load.py --mode
-hall``)."""
 
 
 def build_server(
@@ -102,7 +85,6 @@ def build_server(
     Raises :class:`~tpm_viz.viserkit.core.IncompatibleViserError` (one line) if the installed viser is not the tested
     one.
     """
-    sys.setswitchinterval(GIL_SWITCH_INTERVAL)
     handshakes = Handshakes(hosts or HostRules(addresses=local_addresses, bound=host), keys, tickets=tickets)
     server = new_server(handshake=handshakes, host=host, port=port, label="tpm-viz", verbose=False)  # same-origin
     keyboard_of(server, handshakes.keyboard)  # the page script's keys reach this server's tabs (ui/keyboard.py)
@@ -163,6 +145,10 @@ class TpmApp:
         self.room = Room(self, classroom, store)
         """Classroom mode, tabs that come back, the session file (:mod:`.room`)."""
         self.room.start()
+        self.exercises = self.services.exercises = ExerciseDesk(self.hub, self.services, self._tabs, self.room.lecturer)
+        """Gradebook, students, results; ``.score_sink``: LTI's hook (:mod:`.teaching.exercises.desk`)."""
+        self.exercises.start(self.room.store)
+        self.room.lecturer_hooks.append(self.exercises.lecturer_added)
         self.guides = Guides(self.room.store)
         """Which browsers dismissed the first visit's guide (:mod:`.guide`)."""
         self.shares = ShareDesk(self.hub, lambda: self.room.store.store, lambda: self.room.urls)
@@ -191,11 +177,16 @@ class TpmApp:
         self.room.connected(view, who)  # presenter or not; what it had before a drop
         if self.launched is not None:
             self.launched.connected(view, launch, fresh)  # an LMS launch: presenter or student, its lesson
+        self.exercises.connected(view, who[0])  # the student's numbers and attempts (ui/teaching/exercises/)
         self.guides.greet(view, who[0])  # the first visit's guide, unless this browser dismissed it (ui/guide.py)
         self.shares.connected(view, connection_request(self.server, client.client_id))  # a link: its own copy
         view.scene.set_touch(is_touch(connection_request(self.server, client.client_id)))  # a phone (ui/phone.py)
         self._class_info()
         self.arrived.add(view)
+
+    def _tabs(self) -> list[ClientView]:
+        with self._views_lock:
+            return list(self.views.values())
 
     def _lang_of(self, client_id: int) -> Lang:
         """The language of a tab (English until its view is built)."""
@@ -284,6 +275,7 @@ class TpmApp:
         with self._views_lock:
             if self._class_info_timer is not None:
                 self._class_info_timer.cancel()
+        self.exercises.stop()
         self.room.stop()
         if self.lti is not None:
             self.lti.stop()

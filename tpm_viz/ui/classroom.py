@@ -23,7 +23,6 @@ from __future__ import annotations
 import contextlib
 import http
 import io
-import ipaddress
 import logging
 import secrets
 import socket
@@ -39,7 +38,7 @@ import segno
 from tpm_viz.classroom.identity import Keys, hashed
 from tpm_viz.classroom.launches import TICKET_SECONDS, Tickets, ticket_of_query
 from tpm_viz.classroom.links import PENDING_SECONDS, PendingLinks, token_of_query
-from tpm_viz.classroom.network import PROXIED, HostRules, client_address, header_problem, host_name
+from tpm_viz.classroom.network import PROXIED, HostRules, client_address, header_problem, host_name, is_loopback
 from tpm_viz.ui.keyboard import Keyboard
 from tpm_viz.viserkit.page import ALIVE_PATH, with_script
 
@@ -51,7 +50,6 @@ __all__ = [
     "Classroom",
     "Handshakes",
     "identity",
-    "is_loopback_address",
     "launch_nonce",
     "local_addresses",
     "qr_data_uri",
@@ -76,18 +74,6 @@ PENDING = PendingLinks()
 """The share tokens of pages whose tab has not connected yet (this process's; :class:`Handshakes` fills it)."""
 
 
-def is_loopback_address(host: str) -> bool:
-    """Whether ``host`` (an address or ``localhost``) is this machine only."""
-    if host.strip("[]").lower() == "localhost":
-        return True
-    try:
-        address = ipaddress.ip_address(host.strip("[]"))
-    except ValueError:
-        return False
-    mapped = getattr(address, "ipv4_mapped", None)
-    return address.is_loopback or (mapped is not None and mapped.is_loopback)
-
-
 def local_addresses() -> list[str]:
     """This machine's non-loopback IPv4 addresses (the one of the default route first); no packet is sent."""
     found: list[str] = []
@@ -102,15 +88,15 @@ def local_addresses() -> list[str]:
             found.append(str(info[4][0]))
     except OSError:
         pass
-    return list(dict.fromkeys(a for a in found if not is_loopback_address(a) and a != "0.0.0.0"))
+    return list(dict.fromkeys(a for a in found if not is_loopback(a) and a != "0.0.0.0"))
 
 
 def student_urls(host: str, port: int, addresses: Iterable[str]) -> list[str]:
     """The URLs students type: every given address of this machine when bound to all of them, else the host."""
     if host in ("0.0.0.0", "::", ""):
-        hosts = [a for a in addresses if not is_loopback_address(a)]
+        hosts = [a for a in addresses if not is_loopback(a)]
     else:
-        hosts = [] if is_loopback_address(host) else [host]
+        hosts = [] if is_loopback(host) else [host]
     return [f"http://{f'[{h}]' if ':' in h else h}:{port}/" for h in hosts]
 
 
@@ -134,9 +120,9 @@ class Classroom:
     (default: loopback; :mod:`tpm_viz.viserkit.admission`)."""
 
     addresses: Callable[[], list[str]] = local_addresses
-    presenter_address: Callable[[str], bool] = is_loopback_address
+    presenter_address: Callable[[str], bool] = is_loopback
     token: str = field(default_factory=lambda: secrets.token_urlsafe(9))
-    lecturer_address: Callable[[str], bool] = is_loopback_address
+    lecturer_address: Callable[[str], bool] = is_loopback
 
 
 def same_origin(headers: Any) -> bool:

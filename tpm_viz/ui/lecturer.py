@@ -16,8 +16,9 @@ import viser
 
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES
 from tpm_viz.classroom.guard import guarded
+from tpm_viz.classroom.network import is_loopback
 from tpm_viz.core.words import T
-from tpm_viz.ui.classroom import is_loopback_address, qr_data_uri
+from tpm_viz.ui.classroom import qr_data_uri
 from tpm_viz.ui.worded import TabGui
 
 __all__ = ["Lecture", "LecturerPanel", "join_html"]
@@ -50,7 +51,7 @@ def join_html(urls: list[str]) -> str:
             "(students use the same wifi), then restart the app.</p>"
         )
     links = "".join(f"<div style='font-size:1.1em'><b>{html.escape(u)}</b></div>" for u in urls)
-    if all(is_loopback_address(urlsplit(u).hostname or "") for u in urls):
+    if all(is_loopback(urlsplit(u).hostname or "") for u in urls):
         links += f"<p style='color:#b91c1c'><b>{LOOPBACK_ONLY.template}</b></p>"
     image = f"<img alt='QR code of {html.escape(urls[0])}' src='{qr_data_uri(urls[0])}' style='width:180px'>"
     return f"<div>Students open (same network):{links}{image}</div>"

@@ -58,6 +58,8 @@ class Room:
         """The tabs :meth:`connected` has finished with (tests wait for it)."""
         self._back: weakref.WeakKeyDictionary[Any, dict[str, Any]] = weakref.WeakKeyDictionary()
         """Tabs that are back (built by :meth:`build`) -> the record they left, until :meth:`connected`."""
+        self.lecturer_hooks: list[Callable[[Any, LecturerPanel], None]] = []
+        """Called with each tab given a *Lecturer* folder and the folder (under the hub's lock): more in it."""
 
     # -- start and stop ---------------------------------------------------------------------------------------------
     def start(self) -> None:
@@ -220,6 +222,8 @@ class Room:
         panel = LecturerPanel(view.gui, self, view, self.urls, presenter=self.app.access.enabled)
         panel.show_notice(self.notice)
         self._lecturers[view] = panel
+        for hook in self.lecturer_hooks:
+            hook(view, panel)
 
     def hand_to_class(self, view: Any, open_: bool) -> None:
         """The presenter lets the class change the shared mechanism, or takes it back."""

@@ -26,11 +26,12 @@ import viser
 from tpm_viz.app.readouts import reason
 from tpm_viz.classroom.guard import guarded, log
 from tpm_viz.classroom.links import decode_link, encode_link, share_url
+from tpm_viz.classroom.network import is_loopback
 from tpm_viz.classroom.session import Hub
 from tpm_viz.classroom.sessionfile import Saved
 from tpm_viz.core.errors import TpmVizError
 from tpm_viz.core.words import Phrase, T
-from tpm_viz.ui.classroom import PENDING, is_loopback_address, qr_data_uri, shared_token
+from tpm_viz.ui.classroom import PENDING, qr_data_uri, shared_token
 from tpm_viz.ui.continuity import restore, saved_of
 from tpm_viz.ui.fields import Note
 from tpm_viz.ui.worded import TabGui
@@ -52,7 +53,7 @@ def origin_of(headers: Any, urls: list[str] | None = None) -> str:
     except ValueError:
         parts, hostname = urlsplit(""), None
     if parts.scheme in ("http", "https") and hostname:
-        if urls and is_loopback_address(hostname):
+        if urls and is_loopback(hostname):
             return urls[0].rstrip("/")
         return f"{parts.scheme}://{parts.netloc}"
     host = None if headers is None else headers.get("Host")

@@ -25,7 +25,6 @@ and dropped outright if it does not answer the close. Every refusal and drop is 
 
 from __future__ import annotations
 
-import ipaddress
 import threading
 from collections.abc import Callable
 from typing import Any
@@ -33,7 +32,7 @@ from typing import Any
 from tpm_viz.classroom.guard import log_fault
 from tpm_viz.core.words import Phrase, T, preferred, say
 
-__all__ = ["Admission", "is_loopback"]
+__all__ = ["Admission"]
 
 _CLOSE_GRACE = 2.0
 """Seconds a refused connection has to answer the close handshake before it is dropped."""
@@ -42,16 +41,6 @@ _CROWDED = T(
     "This server takes at most {n} tabs from one network address. Close a tab you do not need; a class behind one "
     "router: ask the lecturer to start the app with --tabs-per-address."
 )
-
-
-def is_loopback(address: str) -> bool:
-    """Whether ``address`` (as the handshake read it) is this machine: the lecturer's default rule."""
-    try:
-        found = ipaddress.ip_address(str(address).strip("[]"))
-    except ValueError:  # "proxied 127.0.0.1", "unknown": not a plain address, never the lecturer's
-        return False
-    mapped = getattr(found, "ipv4_mapped", None)
-    return found.is_loopback or (mapped is not None and mapped.is_loopback)
 
 
 class Admission:

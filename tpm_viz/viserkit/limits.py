@@ -41,7 +41,8 @@ from typing import Any
 import viser
 
 from tpm_viz.classroom.guard import FAULTS, log_fault, report
-from tpm_viz.viserkit.admission import Admission, is_loopback
+from tpm_viz.classroom.network import is_loopback
+from tpm_viz.viserkit.admission import Admission
 from tpm_viz.viserkit.core import thread_pool
 from tpm_viz.viserkit.doors import ServerDoor
 from tpm_viz.viserkit.gate import Gate

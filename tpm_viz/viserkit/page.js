@@ -194,7 +194,14 @@
     document.body.appendChild(live);
     return live;
   }
+  const heard = new Set();
   function announce() {
+    for (const el of document.querySelectorAll("[data-say]")) {  // a result just in (an exercise's): said once
+      const stamp = el.getAttribute("data-say");
+      if (heard.has(stamp)) continue;
+      heard.add(stamp);
+      region().textContent = el.textContent.replace(/\s+/g, " ").trim();
+    }
     const banner = document.querySelector('[data-q="banner"]');
     if (!banner) return;
     const text = (banner.querySelector("b") || banner).textContent.replace(/\s+/g, " ").trim();

@@ -12,7 +12,8 @@ into the script). The gzipped variant is unpacked, edited and packed once per pa
   nothing;
 - keeps one ``aria-live="polite"`` region (``#tpmviz-live``) with the text of the pose banner (``[data-q=banner]``),
   written only when the banner's words change (its numbers masked: a warning whose cos θ moves by 0.001 is not
-  announced again; a new warning, or back to a regular pose, is);
+  announced again; a new warning, or back to a regular pose, is), and with the text of an element that carries a new
+  ``data-say`` stamp (an exercise's result, once per submission);
 - gives every input whose ``<label for>`` names no element an ``aria-label`` (viser's text fields, sliders' number
   boxes), names unnamed buttons by their ``title`` or icon, gives the 3D canvas a name and a place in the Tab order,
   and draws a visible focus outline; a ``MutationObserver`` keeps this up as viser rebuilds the panel;

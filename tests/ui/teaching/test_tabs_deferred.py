@@ -17,6 +17,8 @@ from tpm_viz.classroom.sessionfile import Saved
 from tpm_viz.ui.teaching.tabs import LATER
 
 _ID = re.compile(r"[0-9a-f]{8}-?[0-9a-f]{4}-?[0-9a-f]{4}-?[0-9a-f]{4}-?[0-9a-f]{12}|data-tpmviz-keys=[^>]*")
+_OWN_NUMBERS = re.compile(r"(?s)(data-q=\"exercise-prompt\".*)")
+"""An exercise's prompt: each student's own numbers (a tab without a browser's cookie is a student of its own)."""
 
 
 class GuiClient(ProtocolClient):
@@ -69,7 +71,8 @@ class GuiClient(ProtocolClient):
             return tuple(reversed(out))
 
         def text(props: dict) -> str:
-            return _ID.sub("<id>", str(props.get("content", props.get("_markdown", ""))))
+            content = _ID.sub("<id>", str(props.get("content", props.get("_markdown", ""))))
+            return _OWN_NUMBERS.sub(lambda m: re.sub(r"[-−+]?\d[\d.,]*", "#", m.group(1)), content)
 
         rows = [
             (
@@ -128,7 +131,7 @@ def test_a_deferred_tab_once_opened_is_the_tab_an_eager_build_gives(app):
         paths = {p for p, *_ in lazy_tree}
         assert {("Teach", "Player"), ("Teach", "Equations"), ("Lab", "Control"), ("Lab", "Planner")} <= paths
         groups = {tabs for *_, tabs in lazy_tree if tabs}
-        assert ("Demos", "Player", "Equations") in groups and ("Control", "Planner", "Design") in groups
+        assert ("Demos", "Player", "Exercises", "Equations") in groups and ("Control", "Planner", "Design") in groups
     finally:
         app.services.later = later
         for client in opened:

@@ -7,11 +7,12 @@ map cache, trajectory runs).
 lock) and :meth:`Teaching.close`; :meth:`Teaching.switched` when the tab moves to another session.
 
 A tab is built in two steps, so that a class reconnecting at once gets its mechanisms back first
-(``benchmarks/bench_reconnect.py``): *Explorer* and *Demos* with the panel, the tabs of :data:`LATER` (*Player* and
-the panel's *Equations* in *Teach*; *Control*, *Planner* and *Design* in *Lab*) by :meth:`Teaching.open`, which the
-tab hands to the hub's :class:`~tpm_viz.classroom.later.Later` (run once no tab has arrived for a moment) and which
-runs at once for anyone who asks for one of those views (:attr:`Teaching.player`, ...). Each group's tabs are
-appended in their usual order, after the ones built first: the tab looks the same either way.
+(``benchmarks/bench_reconnect.py``): *Explorer* and *Demos* with the panel, the tabs of :data:`LATER` (*Player*,
+*Exercises* and the panel's *Equations* in *Teach*; *Control*, *Planner* and *Design* in *Lab*) by
+:meth:`Teaching.open`, which the tab hands to the hub's :class:`~tpm_viz.classroom.later.Later` (run once no tab has
+arrived for a moment) and which runs at once for anyone who asks for one of those views (:attr:`Teaching.player`,
+...). Each group's tabs are appended in their usual order, after the ones built first: the tab looks the same either
+way. The lesson's exercises under its text in *Demos* are built with it (:mod:`.exercises`).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ import functools
 import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import viser
 
@@ -31,6 +33,7 @@ from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.classroom.worker import Worker
 from tpm_viz.ui.teaching.control.tab import ControlView
 from tpm_viz.ui.teaching.design.tab import DesignView
+from tpm_viz.ui.teaching.exercises.tab import TAB, ExercisesView
 from tpm_viz.ui.teaching.explorer import ExplorerView, MapService
 from tpm_viz.ui.teaching.lessons import DemosView
 from tpm_viz.ui.teaching.planner.tab import PlannerView
@@ -70,6 +73,9 @@ class Services:
     """One line per lesson file that was refused (``file:line: what is wrong``), shown in the tab."""
     later: Later | None = None
     """Where a tab's :data:`LATER` groups wait for a quiet moment (None: every tab is built whole at once)."""
+    exercises: Any = None
+    """The app's exercises (:class:`~tpm_viz.ui.teaching.exercises.desk.ExerciseDesk`), set by the app (None: the
+    exercises show their prompts' place only)."""
 
     @classmethod
     def create(cls, hub: Hub, lessons: Sequence[Demo] = DEMOS, problems: Sequence[str] = PROBLEMS) -> Services:
@@ -96,6 +102,8 @@ class Teaching:
         self._control = ControlView(view, self.services.worker, self.services.runs)
         self._planner = PlannerView(view, self.services.plans)
         self._design = DesignView(view, self.services.worker)  # the Design studio (ui/teaching/design/tab.py)
+        self.exercises = ExercisesView(view, services, services.lessons, lambda: self.demos.index)
+        """The exercises: under the lesson's text in *Demos*, and the *Exercises* tab (ui/teaching/exercises/)."""
         self._takeouts: list[TakeOut] = []  # Record clip and Download report of the player, control and planner
         self._tabs: dict[str, Tabs] = {}  # the tab groups of LATER's groups, to build them in
         self.waiting: set[str] = set()
@@ -141,9 +149,9 @@ class Teaching:
     # -- building --------------------------------------------------------------------------------------------
     def build_tabs(self, group: str, tabs: Tabs) -> None:
         """Add this layer's tabs of ``group`` (a key of :data:`~tpm_viz.ui.panels.GROUPS`) to its tab group:
-        *Explorer* (the maps) in *explore*; *Demos* and *Player* in *teach* (before the panel's *Equations*);
-        *Control*, *Planner* and *Design* in *lab*. The tabs of :data:`LATER` are left to :meth:`open` when the
-        services defer them (:attr:`Services.later`)."""
+        *Explorer* (the maps) in *explore*; *Demos*, *Player* and *Exercises* in *teach* (before the panel's
+        *Equations*); *Control*, *Planner* and *Design* in *lab*. The tabs of :data:`LATER` are left to :meth:`open`
+        when the services defer them (:attr:`Services.later`)."""
         gui = self.view.gui
         if group == "explore":
             with tabs.add_tab("Explorer", icon=viser.Icon.MAP):
@@ -151,6 +159,7 @@ class Teaching:
         if group == "teach":
             with tabs.add_tab("Demos", icon=viser.Icon.SCHOOL):
                 self.demos.build(gui)
+                self.exercises.lesson_box(gui)  # the lesson's exercises, under its text
         if group in LATER:
             self._tabs[group] = tabs
             if self.services.later is None:
@@ -165,6 +174,8 @@ class Teaching:
             with tabs.add_tab("Player", icon=viser.Icon.PLAYER_PLAY):
                 self._player.build(gui)
                 self._takeouts.append(takeout_for(self.view, worker, self._player, "player", gui))
+            with tabs.add_tab(TAB.template, icon=viser.Icon.CHECKLIST) as tab:
+                self.exercises.build(gui, tab)
         if group == "lab":
             with tabs.add_tab("Control", icon=viser.Icon.ADJUSTMENTS):
                 self._control.build(gui)
@@ -240,6 +251,7 @@ class Teaching:
             self._player.render(frame)
         self.explorer.render(frame)
         self.demos.render(frame)
+        self.exercises.render(frame)
         if self.built("lab"):
             self._control.render(frame)
             self._planner.render(frame)
@@ -263,6 +275,9 @@ class Teaching:
         if self.built("teach"):
             self._player.refresh()
         self.demos.retell()
+        self.exercises.retell()
+        if self.services.exercises is not None:
+            self.services.exercises.retell(self.view)
         if self.built("lab"):
             self._control.retell()
             self._planner.retell()
