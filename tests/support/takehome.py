@@ -71,7 +71,7 @@ def open_offline(browser: Any, url: str, viewport: tuple[int, int] = (1366, 768)
 
 def ready(page: Any, view: bool = True) -> None:
     """Wait until the page's calculator and panel are ready; hide its 3D view unless ``view``."""
-    page.wait_for_function("window.tpm && window.tpmPage && window.tpmPage.calcReady === true", timeout=60_000)
+    page.wait_for_function("window.tpm && window.tpmPage && window.tpmPage.calcReady === true", timeout=120_000)
     if not view:
         page.evaluate("document.getElementById('tpm-view').style.display = 'none'")
 
@@ -92,14 +92,14 @@ def pause(page: Any) -> None:
     """Pause viser's player (it plays and loops on load) and wait until its button says so."""
     button = player(page).locator("button").first
     icon = button.locator("svg")
-    icon.wait_for(timeout=60_000)
+    icon.wait_for(timeout=120_000)
     if "player-pause" in (icon.get_attribute("class") or ""):
         click_center(page, button)
     page.wait_for_function(
         """() => { const svg = document.getElementById('tpm-view').contentDocument
                 .querySelector('.mantine-Paper-root button svg');
                 return svg && svg.getAttribute('class').includes('player-play'); }""",
-        timeout=30_000,
+        timeout=60_000,
     )
 
 
@@ -113,7 +113,7 @@ def seek(page: Any, fraction: float) -> int:
         """(f) => { const calc = tpmPage.calc; const t = calc.playerTime(); const T = tpmPage.data.frames.t.at(-1);
                 return t !== null && Math.abs(t / T - f) < 0.05 && calc.state().frame === calc.frameAt(t); }""",
         arg=fraction,
-        timeout=30_000,
+        timeout=60_000,
     )
     return int(page.evaluate("tpmPage.calc.state().frame"))
 
@@ -248,3 +248,14 @@ def choice_answers(entry: dict) -> list[str]:
         "x",
         "",
     ]
+
+
+PIECES = [*"0123456789" * 3, *".,;, -+eE()[]_", "\u2212", "\u00a0", "\u2009", "\u3000", "\t", "mm", "m", "cm", "um"]
+PIECES += ["µm", "N", "kN", "deg", "°", "rad", "Hz", "rad/s", "s", "m/s", "m/s²", "s2", "inf", "nan", "x", "١", "３"]
+PIECES += ["²", "'", '"', "\\", "\x1c", "\ufeff", "é", "kg", "/", "E+3", "e-2"]
+"""What random answers are made of: digits, separators, signs, spaces of every kind, units, Unicode digits."""
+
+
+def random_answers(rng: np.random.Generator, count: int) -> list[str]:
+    """``count`` random answers of 1 to 9 pieces (:data:`PIECES`): mostly format errors, some numbers."""
+    return ["".join(rng.choice(PIECES, int(rng.integers(1, 10)))) for _ in range(count)]

@@ -12,6 +12,7 @@ from __future__ import annotations
 import functools
 import http.server
 import json
+import re
 import threading
 import urllib.parse
 import zipfile
@@ -36,6 +37,7 @@ from tests.support.takehome import (
     platform_at,
     pose_answers,
     project,
+    random_answers,
     ready,
     seek,
     violations,
@@ -74,17 +76,11 @@ def pages(tmp_path_factory) -> dict[str, Path]:
     return built
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def chromium():
+    """A fresh headless Chromium per test (a browser that has drawn several lessons in software slows down)."""
     with launched_chromium() as browser:
         yield browser
-
-
-def grade_in_page(page, ident: str, texts: list[str], attempts: list[int]) -> list[dict]:
-    return page.evaluate(
-        "([id, texts, attempts]) => texts.flatMap((t) => attempts.map((k) => tpmPage.grade(id, t, k)))",
-        [ident, texts, attempts],
-    )
 
 
 def corpus(entry: dict, seed: int) -> list[str]:
@@ -108,10 +104,11 @@ def check_grading(page, seed: int, lang: str) -> int:
         if not entry["graded"]:
             continue
         attempts = [1] if entry["ladder"] is not None and len(entry["ladder"]) == 1 else [1, 2]
-        texts = corpus(entry, seed)
-        got = grade_in_page(page, entry["id"], texts, attempts)
-        want = [cli_grade(entry["id"], seed, text, k, lang) for text in texts for k in attempts]
-        for (text, k), g, w in zip([(t, k) for t in texts for k in attempts], got, want, strict=True):
+        asked = [(text, k) for text in corpus(entry, seed) for k in attempts]
+        asked += [(text, 1) for text in random_answers(np.random.default_rng([seed, len(entry["id"])]), 40)]
+        got = page.evaluate("([id, asked]) => asked.map(([t, k]) => tpmPage.grade(id, t, k))", [entry["id"], asked])
+        want = [cli_grade(entry["id"], seed, text, k, lang) for text, k in asked]
+        for (text, k), g, w in zip(asked, got, want, strict=True):
             assert g == w, f"{entry['id']} answer {text!r} attempt {k}: page {g} but tpm-viz exercise grade {w}"
         kinds = {("format" if w["format_error"] else w["score"]) for w in want}
         assert "format" in kinds and 1.0 in kinds and len(kinds) >= 3, (entry["id"], kinds)  # a corpus that bites
@@ -156,8 +153,15 @@ def test_each_lesson_page_works_offline_draws_follows_the_slider_and_grades_as_t
         panel = page.inner_text("#tpm-calculator")
         assert "NaN" not in panel and "undefined" not in panel
         assert page.inner_text("#tpm-score") == f"Score: 0 / {sum(e['graded'] for e in data['exercises'])}"
-        for entry in data["exercises"]:
-            assert page.get_attribute(f"#ex-{entry['id']}", "data-seed") == "0"
+        for entry in data["exercises"]:  # the seed's prompts; a gains exercise says it needs the app
+            card = f"#ex-{entry['id']}"
+            assert page.get_attribute(card, "data-seed") == "0"
+            assert (
+                page.text_content(f"{card} .tpm-prompt")
+                == cli_json("exercise", "show", entry["id"], "--seed", "0")["prompt"]
+            )
+            assert page.locator(f"{card} .tpm-needs-app").count() == (0 if entry["graded"] else 1)
+            assert page.locator(f"{card} .tpm-check").count() == (1 if entry["graded"] else 0)
         assert check_grading(page, 0, "en") > 50
         assert opened.errors == []
         assert opened.requests == [path.as_uri()]  # the page itself, nothing else
@@ -279,7 +283,7 @@ def test_the_korean_page_grades_in_korean_and_fits_a_phone(pages, chromium):
         assert page.get_attribute("html", "lang") == "ko"
         for entry in page.evaluate("tpmPage.data.exercises"):
             shown = cli_json("exercise", "show", entry["id"], "--seed", "3", "--lang", "ko")
-            assert page.inner_text(f"#ex-{entry['id']} .tpm-prompt") == shown["prompt"]
+            assert page.text_content(f"#ex-{entry['id']} .tpm-prompt") == shown["prompt"]
             assert page.get_attribute(f"#ex-{entry['id']}", "data-seed") == "3"
         assert check_grading(page, 3, "ko") > 50
         assert page.evaluate("document.documentElement.scrollWidth") <= 390  # nothing wider than the phone
@@ -349,6 +353,8 @@ def test_the_scorm_package_finds_the_lms_api_reports_its_score_and_finishes(page
         page.wait_for_function("calls.some((c) => c[0] === 'LMSFinish')", timeout=30_000)
         calls = page.evaluate("calls")
         assert calls[-1] == ["LMSFinish", ""] and sum(c[0] == "LMSFinish" for c in calls) == 1
+        assert calls[-2][:2] == ["LMSSetValue", "cmi.core.session_time"]
+        assert re.fullmatch(r"\d{4}:\d{2}:\d{2}\.\d{2}", calls[-2][2])  # SCORM 1.2's CMITimespan
         suspended = store["cmi.suspend_data"]
         assert all(r.startswith(base) for r in opened.requests) and opened.errors == []
         opened.context.close()
@@ -375,6 +381,6 @@ def open_lms(chromium, base: str, fragment: str):
     page = context.new_page()
     page.on("pageerror", lambda exc: errors.append(str(exc)))
     page.goto(base + "lms.html" + (f"#{fragment}" if fragment else ""))
-    page.wait_for_function("calls.some((c) => c[0] === 'LMSCommit')", timeout=60_000)
+    page.wait_for_function("calls.some((c) => c[0] === 'LMSCommit')", timeout=120_000)
     ready(page.frame(name="sco"), view=False)
     return Opened(context, page, requests, errors)

@@ -33,7 +33,6 @@
   const moving = frames.t.length > 1;
   const panel = document.getElementById("tpm-calculator");
   const follow = document.getElementById("tpm-follow");
-  const view = document.getElementById("tpm-view");
   const q = (key) => panel.querySelector('[data-q="' + key + '"]');
   let shownFrame = 0;
   let lastTime = null;
@@ -140,7 +139,8 @@
   function playerTime() {
     // the time [s] of viser's player in the 3D view (its slider), or null (not drawn yet, or not readable)
     try {
-      const doc = view.contentDocument;
+      const view = document.getElementById("tpm-view"); // after this script in the page: looked up when asked
+      const doc = view && view.contentDocument;
       const slider = doc && doc.querySelector('[role="slider"]');
       if (!slider) return null;
       const t = Number(slider.getAttribute("aria-valuenow"));
@@ -178,6 +178,10 @@
   window.tpmReady.then(function () {
     show(0);
     for (const key of Object.keys(FIELDS)) {
+      // a field in the student's hands leaves the player at once: the player never writes under their cursor
+      q(key).addEventListener("focus", function () {
+        if (follow) follow.checked = false;
+      });
       q(key).addEventListener("input", function () {
         if (follow) follow.checked = false;
         compute();

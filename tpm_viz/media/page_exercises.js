@@ -68,7 +68,10 @@
   function showScore() {
     const s = score();
     const text = W("Score: {x} / {y}", { x: number(s.x), y: s.y });
-    for (const id of ["tpm-score", "tpm-score-line"]) document.getElementById(id).textContent = text;
+    for (const id of ["tpm-score", "tpm-score-line"]) {
+      const element = document.getElementById(id);
+      if (element) element.textContent = s.y > 0 ? text : ""; // a lesson without graded exercises shows no score
+    }
     for (const ex of graded) {
       const card = document.getElementById("ex-" + ex.id);
       const used = scoresOf(ex.id).length;

@@ -136,22 +136,28 @@ def _side(content: PageContent, words: dict[str, str]) -> str:
         f'<section id="tpm-lesson"><h2>{words["the_lesson"]}</h2>\n'
         f'<p class="tpm-text">{html.escape(content.text)}</p>\n{legend_html(lang)}</section>\n'
         f"{calculator_html(len(content.frames['t']) > 1, lang)}"
-        f'<section id="tpm-exercises"><h2>{words["exercises"]}</h2>\n'
-        f'<p class="tpm-score-line" id="tpm-score-line"></p>\n<p class="tpm-note">{words["kept"]}</p>\n'
-        f"{cards}</section>\n</aside>\n"
+        + (
+            f'<section id="tpm-exercises"><h2>{words["exercises"]}</h2>\n'
+            f'<p class="tpm-score-line" id="tpm-score-line"></p>\n<p class="tpm-note">{words["kept"]}</p>\n'
+            f"{cards}</section>\n"
+            if content.exercises
+            else ""
+        )
+        + "</aside>\n"
     )
 
 
 def lesson_page(content: PageContent) -> str:
-    """The whole page as HTML text (module docstring)."""
+    """The whole page as HTML text (module docstring). The panel and its scripts come first in the document, the 3D
+    view last (drawn on the left, or above on a phone): the panel is ready before viser's client starts, which takes
+    seconds on a slow machine."""
     words = static_words(content.title, content.number, content.seed, content.lang)
     view = html.escape(content.viser_html, quote=True)
     scripts = [grader_script(content.lang), *(read_script(name) for name in SCRIPTS)]
     return (
         f"{_head(content, words)}<body>\n"
-        f'<div class="tpm-page" data-lesson="{content.number}" data-seed="{content.seed}">\n'
-        f'<main class="tpm-view"><iframe id="tpm-view" title="{words["view"]}" srcdoc="{view}"></iframe></main>\n'
-        f"{_side(content, words)}</div>\n"
+        f'<div class="tpm-page" data-lesson="{content.number}" data-seed="{content.seed}">\n{_side(content, words)}'
         f'<script type="application/json" id="tpm-page-data">{safe_json(_data(content))}</script>\n'
-        f"{content.calculator}" + "".join(_script(text) for text in scripts) + "</body>\n</html>\n"
+        f"{content.calculator}" + "".join(_script(text) for text in scripts) + '<main class="tpm-view">'
+        f'<iframe id="tpm-view" title="{words["view"]}" srcdoc="{view}"></iframe></main>\n</div>\n</body>\n</html>\n'
     )

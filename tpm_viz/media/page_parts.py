@@ -62,8 +62,21 @@ def legend_html(lang: Lang) -> str:
     return f'<p class="tpm-legend">{chips}{path}</p>\n'
 
 
+_NAMES = {
+    "p1": "p1 (mm)",
+    "p2": "p2 (mm)",
+    "dp1": "ṗ1 (m/s)",
+    "dp2": "ṗ2 (m/s)",
+    "ddp1": "p̈1 (m/s²)",
+    "ddp2": "p̈2 (m/s²)",
+}
+
+
 def _field(key: str) -> str:
-    return f'<input data-q="{key}" type="text" inputmode="decimal" autocomplete="off" spellcheck="false" size="8">'
+    return (
+        f'<input data-q="{key}" aria-label="{_NAMES[key]}" type="text" inputmode="decimal" autocomplete="off" '
+        'spellcheck="false" size="8">'
+    )
 
 
 def _row(label: str, keys: tuple[str, ...], unit: str) -> str:

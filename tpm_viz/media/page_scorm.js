@@ -5,8 +5,9 @@
  * Inside one: LMSInitialize(""); the stored attempts come back from cmi.suspend_data when this browser has none; then
  * after every graded attempt (and once at the start) cmi.core.score.raw = round(100 x / y) with score.min 0 and
  * score.max 100, cmi.core.lesson_status (the rule below), cmi.suspend_data (the attempts, when they fit in SCORM
- * 1.2's 4096 characters) and cmi.core.exit ("suspend" while incomplete), then LMSCommit(""); LMSFinish("") once when
- * the page is left (pagehide, beforeunload or unload, whichever comes first).
+ * 1.2's 4096 characters) and cmi.core.exit ("suspend" while incomplete), then LMSCommit(""); when the page is left
+ * (pagehide, beforeunload or unload, whichever comes first), once: the report, cmi.core.session_time (the time since
+ * LMSInitialize) and LMSFinish("").
  *
  * lesson_status: "incomplete" until every exercise the page grades has at least one graded attempt; then "passed" if
  * score.raw reaches the mastery score (the LMS's cmi.student_data.mastery_score if it gives one, else the page's
@@ -58,6 +59,7 @@
   }
 
   if (call("LMSInitialize", "") !== "true") return;
+  const started = Date.now();
   let finished = false;
   const mastery = (function () {
     const given = call("LMSGetValue", "cmi.student_data.mastery_score").trim();
@@ -93,10 +95,19 @@
     call("LMSCommit", "");
   };
 
+  function timespan(seconds) {
+    // SCORM 1.2's CMITimespan, HHHH:MM:SS.SS
+    const h = Math.floor(seconds / 3600);
+    const m = Math.floor((seconds % 3600) / 60);
+    const s = (seconds % 60).toFixed(2).padStart(5, "0");
+    return String(Math.min(h, 9999)).padStart(4, "0") + ":" + String(m).padStart(2, "0") + ":" + s;
+  }
+
   function finish() {
     if (finished) return;
     page.report(page.score());
     finished = true;
+    call("LMSSetValue", "cmi.core.session_time", timespan((Date.now() - started) / 1000));
     call("LMSFinish", "");
   }
 
