@@ -63,6 +63,10 @@ PATHS: dict[tuple[str, str], str] = {
     ("exercise show", "--lessons"): "lessons",
     ("exercise grade", "--lessons"): "lessons",
     ("exercise selftest", "--lessons"): "lessons",
+    ("page", "--output"): "output",
+    ("page", "--scorm"): "output",
+    ("page", "--lessons"): "lessons",
+    ("docs", "--output"): "folder",
 }
 """Every path option by its role: read, written, a folder written into, or ``serve``'s (run in a subprocess)."""
 
@@ -84,12 +88,14 @@ BASE: dict[str, list[str]] = {
     "serve": ["--host", "127.0.0.1", "--port", "0"],
     "lti keygen": [],
     "exercise list": [],
+    "page": ["--lesson", "2"],
+    "docs": [],
 }
 """Arguments that make each command parse (the attacked option is added, or replaces the same option here)."""
 
 REPLACES = {("trajectory", "--input"): "--kind"}
 """Base options the attacked one cannot go with."""
-SUFFIX = {"--sidecar": ".json", "clip": ".gif", "report": ".html", "export": ".xml"}
+SUFFIX = {"--sidecar": ".json", "--scorm": ".zip", "clip": ".gif", "report": ".html", "export": ".xml", "page": ".html"}
 KINDS = ("fifo", "device", "symlink", "folder")
 SECONDS = 120.0
 """Longest an attack may take in this process (a loaded machine imports matplotlib and Pinocchio slowly)."""
@@ -221,7 +227,9 @@ def test_a_file_option_refuses_a_node_and_leaves_it_as_it_is(command, option, ro
 
 
 @pytest.mark.parametrize("kind", ("fifo", "device", "symlink"))  # a folder is what it takes
-@pytest.mark.parametrize(("command", "option"), [("figures", "--output-dir"), ("lti keygen", "--output")])
+@pytest.mark.parametrize(
+    ("command", "option"), [("figures", "--output-dir"), ("lti keygen", "--output"), ("docs", "--output")]
+)
 def test_an_output_folder_that_is_a_node_is_refused(command, option, kind, tmp_path, capsys):
     _attack(command, option, "folder", kind, tmp_path, capsys)
 

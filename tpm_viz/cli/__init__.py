@@ -11,7 +11,8 @@ One module per family of subcommands, each with a ``register(subparsers, common)
 - :mod:`.export`: ``export`` (the model as MJCF or URDF);
 - :mod:`.outputs`: ``clip`` (an animated GIF or MP4 of a run) and ``report`` (a self-contained HTML lab report);
 - :mod:`.design`: ``design``, ``compare``, ``atlas`` (design indices over a task, the two arrangements, sweeps);
-- :mod:`.exercise`: ``exercise`` (the lessons' exercises: list, show a variant, grade an answer, selftest).
+- :mod:`.exercise`: ``exercise`` (the lessons' exercises: list, show a variant, grade an answer, selftest);
+- :mod:`.page`: ``page`` (a lesson to take home: one offline HTML page, or a SCORM 1.2 package);
 - :mod:`.docs`: ``docs`` (the docs site, built and served on 127.0.0.1).
 
 Import rule (checked by ``tests/test_layering.py``): the command line may import every layer and nothing imports
@@ -23,7 +24,7 @@ from __future__ import annotations
 import csv
 import sys
 
-from tpm_viz.cli import control, design, docs, exercise, export, lti, multibody, outputs, paper, plan, serve
+from tpm_viz.cli import control, design, docs, exercise, export, lti, multibody, outputs, page, paper, plan, serve
 from tpm_viz.cli.common import Parser, check_outputs, common_parent, one_line, params_from_args
 from tpm_viz.core.errors import TpmVizError
 
@@ -35,7 +36,7 @@ def build_parser() -> Parser:
     parser = Parser(prog="tpm-viz", description=(__doc__ or "").splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
     common = common_parent()
-    for family in (paper, serve, lti, multibody, control, plan, export, outputs, design, exercise, docs):
+    for family in (paper, serve, lti, multibody, control, plan, export, outputs, design, exercise, page, docs):
         family.register(sub, common)
     return parser
 

@@ -161,7 +161,7 @@ def check_output(output: str | None, input_path: str | None) -> None:
         raise InputError(f"--output {output!r} is the input file; write to another file (the input is kept)")
 
 
-OUTPUT_OPTIONS = ("output", "sidecar")
+OUTPUT_OPTIONS = ("output", "sidecar", "scorm")
 """The options that name a file a subcommand writes (``figures --output-dir`` and ``export --format c`` name a
 folder: their files go through the same writer)."""
 

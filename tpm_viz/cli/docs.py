@@ -77,6 +77,11 @@ def serve_folder(folder: Path, port: int) -> http.server.ThreadingHTTPServer:
 
 def _cmd_docs(args: argparse.Namespace) -> int:
     output = args.output if args.output is not None else SOURCES / "_build" / "html"
+    _check_installed(SOURCES)  # nothing is made when the site cannot be built
+    try:  # a folder, made if missing; never a file, a FIFO or a device named as one
+        output.mkdir(parents=True, exist_ok=True)
+    except (FileExistsError, NotADirectoryError) as exc:
+        raise InputError(f"cannot write into --output {str(output)!r}: {exc.strerror} (give a folder)") from None
     status = build(output, args.strict)
     if status != 0:
         print(f"tpm-viz: error: the docs build failed (sphinx exit status {status}): see above", file=sys.stderr)

@@ -6,7 +6,8 @@
 - one tab: :mod:`.client` (its callbacks), :mod:`.panels`, :mod:`.fields`, :mod:`.widgets` (typed number boxes, chart
   axes, camera framing, the shapes of a drawing), :mod:`.scene` and :mod:`.tabscene` (the 3D view), :mod:`.look`
   (layout, presentation mode, camera), :mod:`.worded` (the tab's GUI in its language) and :mod:`.language` (its
-  selector), :mod:`.notebook` (Jupyter), and :mod:`.teaching` (the teaching tabs).
+  selector), :mod:`.notebook` (Jupyter), :mod:`.takehome` (a lesson recorded for the offline page), and
+  :mod:`.teaching` (the teaching tabs).
 
 The shared state every tab draws (sessions, snapshot, drags, pacing, access, worker) is :mod:`tpm_viz.classroom`.
 """
