@@ -8,7 +8,9 @@ Accepted (``docs/csv.md`` lists the same rules for CSV cells):
   1.0, never a thousand;
 - digit groups separated by spaces (normal, no-break or thin spaces) in the integer part: ``1 000`` and
   ``12 345,5``, but only groups of exactly three digits after the first (``1 00`` is refused);
-- the field's own unit after the number when ``unit`` is given: ``5 mm`` in a field in mm.
+- the field's own unit after the number when ``unit`` is given: ``5 mm`` in a field in mm; with
+  :func:`parse_quantity`, that unit with any other SI prefix too (one rule for every unit the app accepts: ``5 kN``
+  in a field in N is 5000, ``0.15 m`` in a field in mm is 150, ``20 µm`` in mm is 0.02, ``1 kHz`` in Hz is 1000).
 
 Refused with :class:`~tpm_viz.core.errors.InputError`: empty text, text that is not a number, a number with both ``.``
 and ``,`` or with several commas (``1,234.5``, ``1.234,5``, ``1,000,000``: thousands separators are ambiguous;
@@ -36,12 +38,16 @@ from tpm_viz.core.words import Phrase, T
 __all__ = [
     "DASH",
     "MAX_TEXT",
+    "PREFIXED",
+    "PREFIXES",
     "QUOTE",
     "UNITS",
     "fixed",
     "parse_number",
+    "parse_quantity",
     "plausibility",
     "plausibility_note",
+    "prefix_factor",
     "shorten",
     "unit_factor",
 ]
@@ -87,6 +93,68 @@ _MINUS = str.maketrans({"\u2212": "-", "\uff0d": "-", "\ufe63": "-"})
 _SPACES = "\u0020\u00a0\u202f\u2009\u2007"
 _GROUPED = re.compile(rf"[+-]?\d{{1,3}}(?:[{_SPACES}]\d{{3}})+(?:[.,]\d*)?(?:[eE][+-]?\d+)?")
 _NUMBERISH = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+
+
+PREFIXES: dict[str, float] = {
+    "G": 1e9,
+    "M": 1e6,
+    "k": 1e3,
+    "c": 1e-2,
+    "m": 1e-3,
+    "µ": 1e-6,
+    "μ": 1e-6,
+    "u": 1e-6,
+    "n": 1e-9,
+}
+"""SI prefixes a typed unit may carry (case matters: ``M`` mega, ``m`` milli; micro as ``µ``, the Greek ``μ`` or
+``u``): k, M, m and µ on every unit of :data:`PREFIXED`, and G, c, n for completeness (``15 cm`` in a field in mm)."""
+PREFIXED = ("m/s²", "m/s^2", "m/s", "Hz", "rad", "m", "s", "N", "g")
+"""The base units whose SI prefixes are accepted in a field of any of them (``%``, ``°`` and plain numbers take
+none)."""
+
+
+def _bases(unit: str) -> list[tuple[float, str]]:
+    """The ways ``unit`` is a prefix and a base of :data:`PREFIXED`: ``(prefix value, base)`` (``mm``: milli-metre;
+    ``m``: metre; ``ms``: millisecond, never metre-second)."""
+    out = [(1.0, unit)] if unit in PREFIXED else []
+    out += [(v, unit[len(p) :]) for p, v in PREFIXES.items() if unit.startswith(p) and unit[len(p) :] in PREFIXED]
+    return out
+
+
+def prefix_factor(typed: str, unit: str) -> float | None:
+    """How many ``unit`` one ``typed`` is when both are the same base unit with SI prefixes (``kN`` in ``N``: 1000;
+    ``m`` in ``mm``: 1000; ``µm`` in ``mm``: 0.001; the same unit: 1), else None (another quantity, or no unit of
+    :data:`PREFIXED`)."""
+    if typed == unit:
+        return 1.0
+    for field_value, field_base in _bases(unit):
+        for typed_value, typed_base in _bases(typed):
+            if typed_base == field_base:
+                return typed_value / field_value
+    return None
+
+
+def parse_quantity(text: object, name: str | Phrase = "value", unit: str = "") -> float:
+    """The number ``text`` spells in the field's ``unit``: :func:`parse_number`, and the unit typed after the number
+    with any SI prefix of :data:`PREFIXES` (``5 kN`` is 5000 in a field in N, ``0.15 m`` is 150 in a field in mm,
+    ``20 µm`` is 0.02 there); a one-line InputError otherwise (a result beyond a float: too large)."""
+    if isinstance(text, str) and unit and _bases(unit):
+        s = text.strip().translate(_MINUS)
+        for typed in sorted({p + base for _, base in _bases(unit) for p in ("", *PREFIXES)}, key=len, reverse=True):
+            head = s[: -len(typed)].rstrip() if s.endswith(typed) else ""
+            if typed != unit and head and (head[-1].isdigit() or head[-1] in ".,"):
+                factor = prefix_factor(typed, unit)
+                if factor is None:
+                    continue
+                value = parse_number(head, name, unit) * factor
+                if not math.isfinite(value):
+                    raise InputError(
+                        Phrase(
+                            "{label}: {text} is too large (beyond ±1.8e308)", label=_label(name, unit), text=shorten(s)
+                        )
+                    )
+                return value
+    return parse_number(text, name, unit)
 
 
 DASH = "—"
