@@ -295,6 +295,9 @@ class Look:
                 self.live_html = self.view.gui.add_html("")
                 # the panel's style sheets are unmounted with it when it collapses: this box carries its own
                 self.live_style = self.view.gui.add_html("")
+                # the panel's *Frame the mechanism*, one tap away with the panel folded too
+                frame = self.view.gui.add_button("Frame the mechanism", icon=viser.Icon.FOCUS_CENTERED, color="gray")
+                frame.on_click(self.view.on_frame)
             self.live.float(x=LIVE_GAP, y=-LIVE_GAP, width=LIVE_WIDTH)
         if self.live is not None:
             self.live.visible = on

@@ -219,6 +219,7 @@ class Panel:
         with self.guide:
             gui.add_html(GUIDE_HTML)
             self.guide_done = gui.add_button("Got it", icon=viser.Icon.CHECK, hint="Not shown again in this browser")
+        self.frame_camera = gui.add_button("Frame the mechanism", icon=viser.Icon.FOCUS_CENTERED, color="gray")
         self.dashboard = gui.add_html("")
         self.message = gui.add_markdown("")
         self.restore = gui.add_button(
@@ -282,7 +283,6 @@ class Panel:
             )
             self.class_info = gui.add_markdown("")
             self.show_toggles = {k: gui.add_checkbox(label, True) for k, label in SHOW_LABELS.items()}
-            self.frame_camera = gui.add_button("Snapshot the mechanism", icon=viser.Icon.FOCUS_CENTERED)
             self.presentation = gui.add_checkbox(
                 "Presentation mode", False, hint="Large type, thick lines and a wider panel: for a projector"
             )

@@ -24,6 +24,9 @@ viser's page is one HTML file (its client bundle inlined). :func:`with_script` a
   clicked), from anywhere but a text field;
 - keeps viser's software-WebGL notice to a one-line strip on a phone (:data:`NOTICE_CSS`).
 
+A second, separate script goes in with it: :data:`~tpm_viz.viserkit.seen.SEEN_SCRIPT` (a coarse pointer, the tab
+of the panel that is open).
+
 The wire format of a key (:func:`key_request`) is in :mod:`.keys` (re-exported here).
 """
 
@@ -35,6 +38,7 @@ import threading
 from typing import Any
 
 from tpm_viz.viserkit.keys import KEY_PATH, KEYS, QUEUED, KeyRequest, key_request
+from tpm_viz.viserkit.seen import SEEN_SCRIPT
 
 __all__ = [
     "FOLD_KEY",
@@ -345,7 +349,7 @@ SCRIPT = (
 )
 """The page script (see the module docstring)."""
 
-_TAG = f"<script>{SCRIPT}</script>".encode()
+_TAG = f"<script>{SCRIPT}</script><script>{SEEN_SCRIPT}</script>".encode()  # what the page sees: viserkit/seen.py
 _CACHE: dict[bytes, bytes] = {}
 _CACHE_LOCK = threading.Lock()
 _CACHE_SIZE = 4

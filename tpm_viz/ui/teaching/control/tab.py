@@ -318,6 +318,10 @@ class ControlView:
                 return  # the echo of a value written by playback
             self.player.seek(float(self.time.value))
 
+    def opened(self) -> None:
+        """The page shows the Control tab (under the hub's lock): its run's paths and ghost in front."""
+        bring(self.view, CONTROL, redraw=True)
+
     def _typed_time(self) -> None:
         """A typed time, settled and written into the slider (under the hub's lock): the run at that time."""
         bring(self.view, CONTROL)

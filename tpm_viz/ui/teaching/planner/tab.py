@@ -226,6 +226,12 @@ class PlannerView:
             "/planner/path", segments(s.p, TRACE_Z, 400), PATH_COLOUR, thickness=2.5, thickness_units="screen"
         )
         show(self._path, front(self.view, PLAN) == PLAN)
+        if not was_playing and "planner" in getattr(self.view.teaching, "open_tabs", ()):
+            try:  # the Planner is open: the mechanism shows the new plan's start and its forces
+                if self.player.at(self.view.session.state) is None:
+                    self.player.seek(0.0)
+            except TpmVizError:
+                pass  # a student on the shared mechanism: the path is shown, the mechanism is the lecturer's
         if was_playing:
             try:
                 self.player.play(SPEEDS.get(self.play_speed.value, 0.1), bool(self.loop.value))
@@ -260,6 +266,16 @@ class PlannerView:
             self.path.value = "waypoints"
             self.waypoints.value = text
         self.request()
+
+    def opened(self) -> None:
+        """The page shows the Planner tab (under the hub's lock): its path in front, and the mechanism at the plan's
+        start (its forces: the dynamic load of the plan) unless it already shows the plan. Raises the refusal when
+        this tab may not move the mechanism (a student on the shared one): the path is shown all the same."""
+        bring(self.view, PLAN, redraw=True)
+        motion = self.player.motion
+        if isinstance(motion, PlanMotion) and motion.params == self.view.session.state.params:
+            if self.player.at(self.view.session.state) is None:
+                self.player.seek(0.0)
 
     # -- playback ------------------------------------------------------------------------------------------
     @guarded(on_error=_internal_error)

@@ -239,6 +239,10 @@ class PlayerView:
             t = read_number(self.time.value, T("time t"), lo=0.0, hi=1e4)
             self.runs.seek(self.session, t, origin=self.view)
 
+    def opened(self) -> None:
+        """The page shows the Player tab (under the hub's lock): its path and trace in front."""
+        bring(self.view, PLAYER, redraw=True)
+
     def _typed_time(self) -> None:
         """A typed time, settled and written into the slider (under the hub's lock): the run at that time."""
         bring(self.view, PLAYER)
