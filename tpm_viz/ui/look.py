@@ -41,7 +41,7 @@ from tpm_viz.ui.language import KEEP_ALL
 from tpm_viz.ui.panels import FOLDED
 from tpm_viz.ui.scene import camera_pose
 from tpm_viz.ui.widgets.framing import LIVE_BAND, frame_box
-from tpm_viz.viserkit.core import point_camera
+from tpm_viz.viserkit.core import point_camera, widget_uuid
 
 __all__ = [
     "BUTTON_TOUCH",
@@ -57,6 +57,7 @@ __all__ = [
     "Look",
     "dock_panel",
     "frame_camera",
+    "frame_row_css",
     "mechanism_box",
 ]
 
@@ -157,6 +158,23 @@ body:has([data-dock-rail-root]) [data-floating-window]:has([data-live]) {{ visib
 collapsed."""
 
 
+def frame_row_css(language: Any, button: Any) -> str:
+    """The panel's first row: the *Language* selector (``language``) and *Frame the mechanism* (``button``, the next
+    control) side by side, 45 % and 55 % of the width (the root of the panel is a block: a float), so that the button
+    costs no height above the tabs. Empty for a GUI without a page (a test's stand-in)."""
+    try:
+        selector, uuid = widget_uuid(language), widget_uuid(button)
+    except AttributeError:
+        return ""
+    row = f'div:has(> div > div > p > label[for="{selector}"])'
+    wrapper = f'div:has(> button[id="{uuid}"])'
+    return (
+        f"<style>{row} {{ float: left; width: 45%; }}"
+        f" {wrapper} {{ margin-left: calc(45% + 4px) !important; }} {wrapper} ~ * {{ clear: both; }}"
+        f" {wrapper} > button {{ width: 100%; }}</style>"
+    )
+
+
 def mechanism_box(params: Params) -> tuple[np.ndarray, np.ndarray]:
     """Lower and upper corners [m] of the box around the mechanism: the base plate up to the top of the pins."""
     lo, hi = meshes.base_extent(params)
@@ -206,7 +224,8 @@ class Look:
         self._asks: list[threading.Timer] = []
         self._nudge = 1.0
         gui = view.gui
-        self.style = gui.add_html(PHONE_CSS)
+        self.row = frame_row_css(view.words.selector, view.panel.frame_camera)
+        self.style = gui.add_html(PHONE_CSS + self.row)
         self.live: Any = None  # the box of banner and forces (a viser panel), made when first needed
         self.live_html: Any = None
         self.live_style: Any = None
@@ -283,7 +302,7 @@ class Look:
             return
         self.presentation = on
         client = self.view.client
-        self.style.content = PHONE_CSS + (PRESENTATION_CSS if on else "")
+        self.style.content = PHONE_CSS + self.row + (PRESENTATION_CSS if on else "")
         dock_panel(client.gui, PRESENTATION_WIDTH if on else PANEL_WIDTH)
         if on:  # the controls fold to the rail for the audience; one click on the rail brings them back
             client.gui.main_panel.minimize()

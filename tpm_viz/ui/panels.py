@@ -214,12 +214,12 @@ class Panel:
         self._written: dict[int, object] = {}
         self._dashboard_at = 0.0
         stroke_mm = state.params.stroke * 1e3
+        self.frame_camera = gui.add_button("Frame the mechanism", icon=viser.Icon.FOCUS_CENTERED, color="gray")
         self.guide = gui.add_folder("Start here", visible=False)
         """The first visit's guide (what to drag, the colours, the singularities): shown by :mod:`.guide`."""
         with self.guide:
             gui.add_html(GUIDE_HTML)
             self.guide_done = gui.add_button("Got it", icon=viser.Icon.CHECK, hint="Not shown again in this browser")
-        self.frame_camera = gui.add_button("Frame the mechanism", icon=viser.Icon.FOCUS_CENTERED, color="gray")
         self.dashboard = gui.add_html("")
         self.message = gui.add_markdown("")
         self.restore = gui.add_button(

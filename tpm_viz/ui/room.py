@@ -20,7 +20,7 @@ from tpm_viz.classroom.guard import guarded, log
 from tpm_viz.classroom.sessionfile import Document, Saved
 from tpm_viz.core.errors import TpmVizError
 from tpm_viz.core.words import Lang, T, say
-from tpm_viz.ui.classroom import Classroom, identity, student_urls
+from tpm_viz.ui.classroom import Classroom, identity, is_loopback_address, student_urls
 from tpm_viz.ui.continuity import LectureStore, lecture_store, reload, restore, saved_of
 from tpm_viz.ui.lecturer import LecturerPanel
 from tpm_viz.viserkit.core import connection_request
@@ -215,7 +215,8 @@ class Room:
         self.app.hub.membership_changed()
 
     def _add_lecturer(self, view: Any) -> None:
-        panel = LecturerPanel(view.gui, self, view, self.urls, presenter=self.app.access.enabled)
+        bound = is_loopback_address(str(self.app.server.get_host()))  # --classroom on 127.0.0.1: nobody can join
+        panel = LecturerPanel(view.gui, self, view, self.urls, presenter=self.app.access.enabled, loopback=bound)
         panel.show_notice(self.notice)
         self._lecturers[view] = panel
 

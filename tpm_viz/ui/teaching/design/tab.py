@@ -209,7 +209,7 @@ class DesignView:
         self._request += 1
         request = self._request
         self.pick_box.group.limit(1.0, float(max(x.count, y.count)))
-        self._show_area()
+        self._show_area(on_map=True)
         self._redraw()
         return lambda: self._next(request, spec, 0)
 
@@ -367,16 +367,22 @@ class DesignView:
         self.scene.draw_comparison(designs, labels)
 
     # -- the area and the camera ---------------------------------------------------------------------------
-    def _show_area(self) -> None:
-        """Show the Design area (the camera goes there the first time) with the comparison."""
+    def _show_area(self, on_map: bool = False) -> None:
+        """Show the Design area with the comparison; the camera goes there the first time (to the map, framed
+        large, when a map is being computed: ``on_map``)."""
         first = self.scene.show()
         self._draw_comparison()
-        if first:
+        if on_map:
+            self.scene.look_map()
+        elif first:
             self.scene.look()
 
     def _look(self) -> None:
         self._show_area()
-        self.scene.look()
+        if self.spec is not None:
+            self.scene.look_map()
+        else:
+            self.scene.look()
 
     def _back(self) -> None:
         self.scene.hide()

@@ -227,9 +227,8 @@ class PlannerView:
         )
         show(self._path, front(self.view, PLAN) == PLAN)
         if not was_playing and "planner" in getattr(self.view.teaching, "open_tabs", ()):
-            try:  # the Planner is open: the mechanism shows the new plan's start and its forces
-                if self.player.at(self.view.session.state) is None:
-                    self.player.seek(0.0)
+            try:  # the Planner is open: its plan, not another run, on the mechanism
+                self._replace_other_run()
             except TpmVizError:
                 pass  # a student on the shared mechanism: the path is shown, the mechanism is the lecturer's
         if was_playing:
@@ -268,14 +267,20 @@ class PlannerView:
         self.request()
 
     def opened(self) -> None:
-        """The page shows the Planner tab (under the hub's lock): its path in front, and the mechanism at the plan's
-        start (its forces: the dynamic load of the plan) unless it already shows the plan. Raises the refusal when
-        this tab may not move the mechanism (a student on the shared one): the path is shown all the same."""
+        """The page shows the Planner tab (under the hub's lock): its path in front, and, when the mechanism shows
+        another run (the Control lab's, the Player's: their dynamic load), the plan's start and its forces instead
+        (a pose placed by hand stays). Raises the refusal when this tab may not move the mechanism (a student on the
+        shared one): the path is shown all the same."""
         bring(self.view, PLAN, redraw=True)
-        motion = self.player.motion
-        if isinstance(motion, PlanMotion) and motion.params == self.view.session.state.params:
-            if self.player.at(self.view.session.state) is None:
-                self.player.seek(0.0)
+        self._replace_other_run()
+
+    def _replace_other_run(self) -> None:
+        """The plan's start in place of another run's sample on the mechanism (see :meth:`opened`)."""
+        motion, state = self.player.motion, self.view.session.state
+        if not isinstance(motion, PlanMotion) or motion.params != state.params:
+            return
+        if state.trajectory.kind != "none" and self.player.at(state) is None:
+            self.player.seek(0.0)
 
     # -- playback ------------------------------------------------------------------------------------------
     @guarded(on_error=_internal_error)
