@@ -31,7 +31,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
 
 from tpm_viz.core.errors import InputError, TpmVizError
-from tpm_viz.core.numbers import parse_quantity, plausibility
+from tpm_viz.core.numbers import fixed, parse_quantity, plausibility
 from tpm_viz.core.words import Phrase
 
 __all__ = [
@@ -69,7 +69,9 @@ def _compact(value: float) -> str:
 class Quantity:
     """What one typed field holds: ``name`` (in messages), its UI ``unit``, ``scale`` (SI value of one UI unit,
     e.g. 1e-3 for mm), the accepted range ``[lo, hi]`` in UI units and the ``resolution`` below which a value is
-    shown as 0 (UI units: rounding noise such as ``-3e-14 mm`` of a computed pose is not a number to show)."""
+    shown as 0 (UI units: rounding noise such as ``-3e-14 mm`` of a computed pose is not a number to show);
+    ``places``: the decimals the app writes (the readout's: one for the Move tab's millimetres), None: six significant
+    digits."""
 
     name: str
     unit: str = ""
@@ -77,6 +79,7 @@ class Quantity:
     lo: float = -math.inf
     hi: float = math.inf
     resolution: float = 1e-9
+    places: int | None = None
 
     def number(self, text: object) -> float:
         """The number ``text`` spells in the field's unit (the unit may be typed, with any SI prefix: ``0.15 m`` is
@@ -121,8 +124,11 @@ class Quantity:
         return si
 
     def text(self, si: float) -> str:
-        """The field's text for the SI value ``si`` (UI unit, six significant digits, 0 below the resolution)."""
+        """The field's text for the SI value ``si`` (UI unit; :attr:`places` decimals, else six significant digits;
+        0 below the resolution; never ``-0``)."""
         value = si / self.scale
+        if self.places is not None:
+            return fixed(value, f".{self.places}f")
         return _compact(0.0 if abs(value) < self.resolution else value)
 
     def shown(self, si: float) -> str:
