@@ -104,6 +104,7 @@ INSET = 16
 content) and 5 px to spare, so "N" never touches the panel's edge."""
 PHONE_CSS = f"""<style>
 div:has(> [data-q="banner"]) {{ padding-right: {INSET}px; }}
+label wbr {{ display: none; }}
 @media {_PHONE} {{
   [data-guide] > div > span {{ max-width: 100%; overflow-wrap: anywhere; }}
   {_SHEET_CSS} {{ width: 100% !important; left: 0 !important; right: 0 !important; }}
@@ -125,7 +126,8 @@ div:has(> [data-q="banner"]) {{ padding-right: {INSET}px; }}
 }}
 </style>"""
 """The readout's room at the panel's edge (:data:`INSET`), the phone layout and touch targets (by viewport and
-pointer: no switch), in every tab."""
+pointer: no switch), in every tab; labels break at spaces only (viser puts a ``<wbr>`` after each ``_`` and ``/``:
+"F_max" was cut after "F_")."""
 
 BANNER_PX = 20
 """Font size of the pose status and its warnings in the box of live numbers [CSS px]."""
