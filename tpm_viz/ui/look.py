@@ -226,8 +226,9 @@ class Look:
         self._asks: list[threading.Timer] = []
         self._nudge = 1.0
         gui = view.gui
-        self.row = frame_row_css(view.words.selector, view.panel.frame_camera)
-        self.style = gui.add_html(PHONE_CSS + self.row)
+        self.style = gui.add_html(PHONE_CSS)
+        self.row = gui.add_html(frame_row_css(view.words.selector, view.panel.frame_camera))
+        """*Language* and *Frame the mechanism* on one row (its own style sheet)."""
         self.live: Any = None  # the box of banner and forces (a viser panel), made when first needed
         self.live_html: Any = None
         self.live_style: Any = None
@@ -304,7 +305,7 @@ class Look:
             return
         self.presentation = on
         client = self.view.client
-        self.style.content = PHONE_CSS + self.row + (PRESENTATION_CSS if on else "")
+        self.style.content = PHONE_CSS + (PRESENTATION_CSS if on else "")
         dock_panel(client.gui, PRESENTATION_WIDTH if on else PANEL_WIDTH)
         if on:  # the controls fold to the rail for the audience; one click on the rail brings them back
             client.gui.main_panel.minimize()

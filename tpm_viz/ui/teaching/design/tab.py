@@ -372,17 +372,12 @@ class DesignView:
         large, when a map is being computed: ``on_map``)."""
         first = self.scene.show()
         self._draw_comparison()
-        if on_map:
-            self.scene.look_map()
-        elif first:
-            self.scene.look()
+        if on_map or first:
+            self.scene.look_map() if on_map else self.scene.look()
 
     def _look(self) -> None:
         self._show_area()
-        if self.spec is not None:
-            self.scene.look_map()
-        else:
-            self.scene.look()
+        self.scene.look_map() if self.spec is not None else self.scene.look()
 
     def _back(self) -> None:
         self.scene.hide()
