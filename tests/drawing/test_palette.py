@@ -11,6 +11,7 @@ import math
 
 import pytest
 
+from tpm_viz.classroom.text import LEGEND
 from tpm_viz.drawing.palette import PALETTE, hex_colour
 from tpm_viz.ui.panels import GUIDE_COLOURS
 
@@ -69,3 +70,9 @@ def test_the_guides_legend_is_the_palette_and_its_colours_are_apart() -> None:
     assert {name: colour for colour, name in GUIDE_COLOURS} == {n: hex_colour(k) for n, k in keys.items()}
     for (_, x), (_, y) in itertools.combinations(keys.items(), 2):
         assert delta_e(PALETTE[x], PALETTE[y]) >= APART, (x, y)
+
+
+def test_the_move_tabs_legend_is_the_palette_too() -> None:
+    """The longer legend under the Move tab: the same colours (it still showed P′ in the old blue)."""
+    keys = ("workspace", "inverse", "direct", "stroke", "circle")
+    assert [colour for colour, _text in LEGEND[: len(keys)]] == [hex_colour(k) for k in keys]
