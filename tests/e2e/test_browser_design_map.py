@@ -1,5 +1,6 @@
 """The design map agrees with its legend (issue 40, item 4), read from headless Chromium's screenshots (software
-WebGL) on a 1366×768 laptop in English and a 390×844 touch phone in Korean.
+WebGL) on a 1024×768 projector in presentation mode (the panel open), a 1366×768 laptop in English and a 390×844
+touch phone in Korean.
 
 The default map (7 × 7 designs, coloured by GCI) is computed in the page. Then, in one screenshot:
 
@@ -10,7 +11,7 @@ The default map (7 × 7 designs, coloured by GCI) is computed in the page. Then,
 - the best design's ring is dark on its yellow cell (darker by more than 60 of 255), and the axis labels are
   outside the map, apart from every cell and ring (their anchors projected beyond the map's edges, on the side
   they extend to);
-- the map is framed large: its projected height is at least half the canvas;
+- the map is framed large: it spans at least half the canvas, across or up (whichever the canvas's shape limits);
 - a click on a cell's centre picks that design (the image of the colours lets the clicks through to the cells).
 
 Screenshots in a temporary folder named in the output.
@@ -28,9 +29,9 @@ from PIL import Image
 
 from tests.e2e.test_browser_layout import chromium  # noqa: F401  (fixture)
 from tests.e2e.test_browser_phone import CANVAS, _project, _settled
-from tests.e2e.test_browser_stage import _open
+from tests.e2e.test_browser_stage import _open, _presentation_on
 from tests.support.protocol import wait_for
-from tests.support.stage import GROUP_OF, open_tab
+from tests.support.stage import GROUP_OF, STAGE, open_tab
 from tpm_viz.core.words import Lang, shown
 from tpm_viz.ui.app import TpmApp, build_server
 from tpm_viz.ui.teaching.design.scene import AREA, LABEL_GAP, MAP_CORNER, MAP_SIDE, SWATCH_Z, map_cell_centres
@@ -85,13 +86,30 @@ def _world(points) -> np.ndarray:
 
 
 @pytest.mark.parametrize(
-    ("size", "locale", "lang"), [((1366, 768), "en-US", Lang.EN), ((390, 844), "ko-KR", Lang.KO)], ids=["en", "ko"]
+    ("size", "locale", "lang", "presentation"),
+    [
+        ((1024, 768), "en-US", Lang.EN, True),
+        ((1366, 768), "en-US", Lang.EN, False),
+        ((390, 844), "ko-KR", Lang.KO, False),
+    ],
+    ids=["1024-presentation", "1366-en", "390-ko"],
 )
-def test_the_maps_cells_are_the_legends_colours_and_the_marks_stand_apart(served, chromium, size, locale, lang):  # noqa: F811
+def test_the_maps_cells_are_the_legends_colours_and_the_marks_stand_apart(
+    served,
+    chromium,  # noqa: F811
+    size,
+    locale,
+    lang,
+    presentation,
+):
     shots = tempfile.mkdtemp(prefix="tpm-viz-design-map-")
     context, page, view = _open(served, chromium, size, locale=locale)
     try:
         page.get_by_role("button", name=shown(lang, "Got it"), exact=True).click()
+        if presentation:  # the projector: presentation mode, the panel opened again to work in it
+            _presentation_on(page, view)
+            page.locator('[aria-label^="Expand"]').first.click()
+            wait_for(lambda: page.evaluate(STAGE)["rows"], what="the panel back")
         open_tab(page, shown(lang, "Design"), shown(lang, GROUP_OF["Design"]))
         dv = view.teaching.design
         page.locator(f'[id="{widget_uuid(dv.compute)}"]').click()
@@ -136,7 +154,10 @@ def test_the_maps_cells_are_the_legends_colours_and_the_marks_stand_apart(served
         labels = _project(view, _world([(x0, y0 - LABEL_GAP, 0.0), (x0, y0 + MAP_SIDE + LABEL_GAP, 0.0)]), rect)
         assert labels[0][1] >= edges[0][1] + 10, (labels, edges)  # the x label's top below the map's bottom edge
         assert labels[1][1] <= edges[1][1] - 10, (labels, edges)  # the y label's bottom above the map's top edge
-        assert edges[0][1] - edges[1][1] >= 0.5 * (rect[3] - rect[1]), (edges, rect)  # framed large
+        corners = _project(view, _world([(x, y, 0.0) for x in (x0, x0 + MAP_SIDE) for y in (y0, y0 + MAP_SIDE)]), rect)
+        width, height = np.ptp(corners[:, 0]), np.ptp(corners[:, 1])
+        share = max(width / (rect[2] - rect[0]), height / (rect[3] - rect[1]))
+        assert share >= 0.5, (corners, rect)  # framed large: half the canvas or more, across or up
 
         k = int(np.flatnonzero(ok)[len(np.flatnonzero(ok)) // 2])
         page.mouse.click(float(px[k][0]), float(px[k][1]))
