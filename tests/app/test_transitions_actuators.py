@@ -49,11 +49,11 @@ def test_a_mm_field_reads_what_people_type(text, mm):
         ("350", "d1: 350 mm is out of range; type a value from 0 to 300 mm"),
         ("0.5 m", "d1: 500 mm is out of range; type a value from 0 to 300 mm"),
         ("-1", "d1: -1 mm is out of range; type a value from 0 to 300 mm"),
-        ("1e308 m", "d1: 1e308 m is too large"),
+        ("1e308 m", "d1 [mm]: '1e308 m' is too large"),
         ("abc", "'abc' is not a number"),
         ("m", "'m' is not a number"),
-        ("150 µm", "is not a number"),  # only m and cm besides mm
-        ("1.5e2 km", "is not a number"),
+        ("1.5e2 km", "d1: 1.5e+08 mm is out of range; type a value from 0 to 300 mm"),  # read, then out of range
+        ("5 N", "d1 [mm]: 'N' is a force unit, but d1 is a length in m"),
         ("", "is empty"),
     ],
 )

@@ -123,3 +123,39 @@ def test_another_version_and_a_bomb_are_refused():
     bomb = zlib.compress(b"[" * 20_000_000)
     body = base64.urlsafe_b64encode(bomb).decode().rstrip("=")
     _refused(f"{LINK_VERSION}.{body}.{hashlib.sha256(bomb).hexdigest()[:16]}", "damaged")
+
+
+def test_with_a_store_an_upload_is_kept_by_hash_and_the_link_fits_a_qr_code():
+    """Issue 40, item 8: a 400-row CSV made a 2,690-character link, too long for a QR code. With a store (the class
+    served) the upload is kept by its SHA-256 and the link names only that; it fits a QR code of version 17 at error
+    level M (segno's own count; 85 modules a side, as a link without an upload), and reads back to the same knots."""
+    segno = pytest.importorskip("segno")
+    blobs: dict[str, bytes] = {}
+
+    def put(data: bytes) -> str:
+        digest = hashlib.sha256(data).hexdigest()
+        blobs[digest] = data
+        return digest
+
+    saved = _saved(400)
+    assert len(encode_link(_saved(100))) > 2600  # no store: the knots go in the link (a QR code's worth and more)
+    token = encode_link(saved, put)
+    url = f"http://192.0.2.7:8080/?share={token}"
+    (digest,) = blobs
+    body = token.split(".")[1]
+    raw = json.loads(zlib.decompress(base64.urlsafe_b64decode(body + "=" * (-len(body) % 4))))
+    assert raw["trajectory"] == {"stored": digest} and len(url) < 600  # the link names the upload by its hash only
+    assert segno.make(url, error="m").version <= 17
+    back = decode_link(token, blobs.get)
+    np.testing.assert_allclose(back.source.knots[1], saved.source.knots[1])
+    assert back.state.params == saved.state.params and back.playing_t == saved.playing_t
+
+
+def test_a_link_naming_an_unknown_upload_quotes_nothing_of_it():
+    """A hand-made link that names a digest this server lacks, with markup in every text field it could carry: one
+    line, and no character of the link's own text in it."""
+    raw = encode_saved(_saved())
+    hostile = "<img src=x onerror=alert(1)>**bold**"
+    raw["trajectory"] = {"stored": "ab" * 32, "label": hostile, "name": hostile}
+    text = _refused(_token(raw), "kept on the server that made the link", lambda d: None)
+    assert "<" not in text and "img" not in text and "bold" not in text and "ab" * 32 not in text

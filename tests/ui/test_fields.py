@@ -101,7 +101,7 @@ def test_a_prefix_is_never_applied_and_a_value_out_of_range_is_refused_next_to_t
     client.enter(view.panel.p)
     note = view.panel.p.note.handle
     wait_for(lambda: "out of range" in note.content, what="the refusal under p")
-    assert "p1: -100000 mm is out of range; type a value from -10000 to 10000 mm (in use: 0 mm)" in note.content
+    assert "p1: -100000 mm is out of range; type a value from -10000 to 10000 mm (in use: 0.0 mm)" in note.content
     assert _state(view) is before and field.value == "-100000"
     assert view.panel.message.content == ""  # not at the top of the panel
     client.enter(view.panel.p, {"p1": "-5e1"})  # a later success clears it
@@ -162,7 +162,7 @@ def test_the_field_follows_the_value_in_use_unless_it_is_being_typed_in(connect)
     other_client, other = connect()
     other_client.enter(other.panel.p, {"p1": "30", "p2": "20"})  # another tab moves the shared platform
     wait_for(  # both: on a loaded machine the other tab's quiet time may apply p1 before its p2 arrives
-        lambda: (view.panel.p.inputs["p1"].value, view.panel.p.inputs["p2"].value) == ("30", "20"),
+        lambda: (view.panel.p.inputs["p1"].value, view.panel.p.inputs["p2"].value) == ("30.0", "20.0"),
         what="p = (30, 20) shown in this tab",
     )
     client.set_value(view.panel.p.inputs["p1"], "4")  # this tab starts typing
@@ -276,7 +276,7 @@ def test_a_keystroke_not_yet_seen_by_the_tab_is_never_written_over(connect):
     handle = box.inputs["p1"]
     with view.hub.lock:
         box.show({"p1": 30.0, "p2": 20.0})
-        assert (handle.value, box.inputs["p2"].value) == ("30", "20")
+        assert (handle.value, box.inputs["p2"].value) == ("30.0", "20.0")
         arrive(handle, "4")  # arrived, callback not run yet
         box.show({"p1": 10.0, "p2": 20.0})  # another tab's move
         assert handle.value == "4"
@@ -284,7 +284,7 @@ def test_a_keystroke_not_yet_seen_by_the_tab_is_never_written_over(connect):
         box.show({"p1": 12.0, "p2": 20.0})
         assert handle.value == "4" and box.group.typing
         box.show({"p1": 12.0, "p2": 20.0}, force=True)  # new values asked for elsewhere (e.g. the paper's)
-        assert handle.value == "12"
+        assert handle.value == "12.0"
 
 
 def test_a_frame_drawn_while_a_slider_input_is_on_its_way_does_not_turn_it_into_an_echo(connect):

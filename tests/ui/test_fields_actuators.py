@@ -38,7 +38,7 @@ def _note(view) -> str:
 def test_enter_applies_a_number_in_scientific_notation_and_keeps_the_text(connect):
     client, view = connect()
     box = view.panel.d_typed
-    assert box.inputs["d1"].value == "130" and box.inputs["d2"].value == "130"  # the value in use, mm
+    assert box.inputs["d1"].value == "130.0" and box.inputs["d2"].value == "130.0"  # in use, mm, as the readout
     client.enter(box, {"d1": "1.5e2"})
     wait_for(lambda: _state(view).pose.d[0] == 0.15, what="d1 = 150 mm")
     assert _state(view).pose.d[1] == pytest.approx(HOME_D, abs=1e-15)  # d2 was not typed: unchanged
@@ -58,7 +58,7 @@ def test_out_of_the_stroke_is_refused_under_the_box_as_the_fix_in_mm(connect):
     version = _state(view)
     client.enter(view.panel.d_typed, {"d2": "0.5 m"})
     wait_for(lambda: "type a value from 0 to 300 mm" in _note(view), what="the refusal under d1, d2")
-    assert "d2: 500 mm is out of range" in _note(view) and "(in use: 130 mm)" in _note(view)
+    assert "d2: 500 mm is out of range" in _note(view) and "(in use: 130.0 mm)" in _note(view)
     assert _state(view) is version  # the last good state stays
     assert view.panel.d_typed.inputs["d2"].value == "0.5 m"  # the field keeps what was typed
     client.enter(view.panel.d_typed, {"d2": "abc"})
@@ -92,7 +92,7 @@ def test_the_slider_still_drives_and_the_typed_field_shows_its_value(connect):
     client, view = connect()
     client.set_value(view.panel.d[0], 250.0)
     wait_for(lambda: abs(_state(view).pose.d[0] - 0.25) < 1e-12, what="d1 = 250 mm by the slider")
-    wait_for(lambda: view.panel.d_typed.inputs["d1"].value == "250", what="the typed field shows it")
+    wait_for(lambda: view.panel.d_typed.inputs["d1"].value == "250.0", what="the typed field shows it")
     uuids = [widget_uuid(handle) for handle in view.panel.d]
     css = view.panel.d_css.content
     assert all(f'[id="{u}"] ~ *' in css for u in uuids) and "display: none" in css  # no number box beside them

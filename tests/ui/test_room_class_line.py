@@ -18,7 +18,7 @@ def test_the_class_line_counts_tabs_and_is_redrawn_once_per_burst(app, connect, 
     leaving: list[ProtocolClient] = []
     tabs = [connect() for _ in range(3)] + [open_tab(app, leaving) for _ in range(3)]
     first = tabs[0][1]
-    six = "6 tab(s) connected, 6 on the shared mechanism"
+    six = "6 tabs connected, 6 on the shared mechanism"
     wait_for(lambda: all(six in view.panel.class_info.content for _c, view in tabs), what="6 tabs on every line")
     writes: list[str] = []
     original = type(first).set_class_info
@@ -28,7 +28,7 @@ def test_the_class_line_counts_tabs_and_is_redrawn_once_per_burst(app, connect, 
     for client in leaving:  # three tabs leave at once, one switches to its own copy
         client.close()
     wait_for(lambda: len(app.views) == 3, what="three tabs gone")
-    wait_for(lambda: "3 tab(s) connected, 2 on the shared mechanism" in first.panel.class_info.content, what="3")
+    wait_for(lambda: "3 tabs connected, 2 on the shared mechanism" in first.panel.class_info.content, what="3")
     time.sleep(3 * app_module.CLASS_INFO_DELAY)
     # the redraw runs on its own timer, not in a hub step: the last lines of the six-tab redraw may still be written
     # after every tab shows it; the burst's own redraws are the ones after it
@@ -40,8 +40,18 @@ def test_the_class_line_counts_tabs_and_is_redrawn_once_per_burst(app, connect, 
 
 def test_the_class_line_follows_the_tab_language(connect):
     (_c1, v1), (_c2, v2) = connect(), connect()
-    wait_for(lambda: "2 tab(s) connected" in v1.panel.class_info.content, what="the line")
+    wait_for(lambda: "2 tabs connected" in v1.panel.class_info.content, what="the line")
     v1.words.set(Lang.KO)
     wait_for(lambda: HANGUL.search(v1.panel.class_info.content), what="the Korean line")
     assert "2" in v1.panel.class_info.content  # the same count
     assert not HANGUL.search(v2.panel.class_info.content)  # the other tab stays in English
+
+
+def test_one_tab_is_one_tab_in_english_and_in_korean(connect):
+    """Not "1 tab(s) connected" (issue 40, item 8): English has a singular; the Korean line counts the same way."""
+    client, view = connect()
+    wait_for(lambda: "1 tab connected, 1 on the shared mechanism." in view.panel.class_info.content, what="singular")
+    connect()
+    wait_for(lambda: "2 tabs connected, 2 on the shared mechanism." in view.panel.class_info.content, what="plural")
+    client.set_value(view.words.selector, Lang.KO.label)
+    wait_for(lambda: "탭 2개 연결됨" in view.panel.class_info.content, what="the Korean line")

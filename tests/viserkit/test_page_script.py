@@ -52,6 +52,7 @@ def test_the_script_builds_no_code_and_no_markup_from_data():
 
 def test_the_script_reads_exactly_the_settings_python_sends():
     read = set(re.findall(r"\bCONFIG\.(\w+)", page.SCRIPT))
+    read |= set(re.findall(r"\)\.(\w+);", page.SEEN_SCRIPT.split("JSON.parse(", 1)[1].split("\n", 1)[0]))  # seen.js
     assert read == set(page.CONFIG), (
         f"read but not sent: {read - set(page.CONFIG)}; sent, unread: {set(page.CONFIG) - read}"
     )
@@ -80,7 +81,8 @@ def test_the_settings_survive_any_text_and_cannot_end_their_element():
         == hostile
     )
     tag = page.page_tag(hostile, "void 0;").decode()
-    assert tag.lower().count("</script") == 2  # the element's own end and the script's, nothing in between
+    assert tag.lower().count("</script") == 3  # the element's own end, the script's and seen.js's, nothing in between
+    assert page.SEEN_SCRIPT in tag and "</script" not in page.SEEN_SCRIPT.lower()
     with pytest.raises(ValueError, match="</script"):
         page.page_tag(page.CONFIG, "const x = '</script>';")
 

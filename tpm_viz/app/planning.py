@@ -25,7 +25,7 @@ from tpm_viz.app.paths import GeometricPath, path_for
 from tpm_viz.app.planner import Limits, Plan, PlanSamples, plan_cycle, plan_path
 from tpm_viz.app.sizing import Sizing, size_motion, size_trajectory
 from tpm_viz.core.errors import InputError
-from tpm_viz.core.numbers import shorten
+from tpm_viz.core.numbers import parse_number, shorten
 from tpm_viz.core.params import Params
 from tpm_viz.core.words import Phrase
 from tpm_viz.paper.dynamics import inverse_dynamics
@@ -51,15 +51,18 @@ MAX_WAYPOINTS = 50
 
 
 def parse_waypoints(text: str) -> np.ndarray:
-    """``"x,y; x,y; ..."`` in mm -> ``(n, 2)`` [m]; a one-line :class:`InputError` otherwise."""
+    """``"x,y; x,y; ..."`` in mm -> ``(n, 2)`` [m]; a one-line :class:`InputError` otherwise. Each coordinate is read
+    with :func:`~tpm_viz.core.numbers.parse_number` (``1e2``, ``−60``; a comma separates, so no decimal comma)."""
     if not isinstance(text, str) or len(text) > 2000:
         raise InputError(Phrase("waypoints: type them as 'x,y; x,y' in mm"))
     points = []
     for k, item in enumerate(p for p in re.split(r"[;\n]", text) if p.strip()):
         parts = [v for v in re.split(r"[,\s]+", item.strip()) if v]
         try:
-            x, y = (float(v) for v in parts)
-        except ValueError:
+            if len(parts) != 2:
+                raise InputError(item)
+            x, y = (parse_number(v) for v in parts)  # the one parser: 1e2, the Unicode minus (commas separate)
+        except InputError:
             raise InputError(
                 Phrase("waypoint {k} ({text}) must be two numbers 'x,y' in mm", k=k + 1, text=shorten(item.strip()))
             ) from None

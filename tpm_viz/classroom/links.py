@@ -9,10 +9,12 @@ damaged one (bad characters, a checksum that does not match, a payload that does
 :func:`~tpm_viz.classroom.sessionfile.decode_saved` builds ``Params``, the pose, the load and the trajectory with the
 library's own validation). No secret is involved: any tpm-viz server reads any link.
 
-An uploaded trajectory that would make the token longer than :data:`MAX_TOKEN_CHARS` is kept by content hash
-through ``put_blob`` (the classroom store's ``put_blob(data) -> sha256 hex``); the token then names the digest,
-and a server that does not hold it (``get_blob(digest) -> bytes | None``) refuses the link with one line that says
-to open it on the server that made it or to upload the CSV there.
+An uploaded trajectory is kept by content hash whenever there is a store (``put_blob``: the classroom store's
+``put_blob(data) -> sha256 hex``, when the class is served): the token names only the digest, so that the link stays
+short enough for a QR code (a 400-row CSV made a 2,690-character link, too long for one). Without a store the upload
+goes in the token, up to :data:`MAX_TOKEN_CHARS`. A server that does not hold the digest (``get_blob(digest) -> bytes |
+None``) refuses the link with one line that says to open it on the server that made it or to upload the CSV there,
+quoting nothing the link carries.
 
 A link is ``http://HOST:PORT/?share=TOKEN`` (:func:`share_url`). The page request is the only request that sees the
 query (viser's websocket URL has none): :class:`PendingLinks` keeps its token under a random nonce for
@@ -83,17 +85,19 @@ def _pack(raw: dict[str, Any]) -> str:
 
 
 def encode_link(saved: Saved, put_blob: PutBlob | None = None) -> str:
-    """The token of ``saved``; an uploaded trajectory that makes it too long goes to ``put_blob`` (refused in one
-    line when there is no store)."""
+    """The token of ``saved``; an uploaded trajectory goes to ``put_blob`` when there is one (the token names its
+    digest), else in the token (refused in one line when that makes it longer than :data:`MAX_TOKEN_CHARS`)."""
     raw = encode_saved(saved)
-    token = _pack(raw)
     trajectory = raw.get("trajectory")
-    if len(token) <= MAX_TOKEN_CHARS or not isinstance(trajectory, dict) or trajectory.get("kind") != "csv":
-        return token
+    if not isinstance(trajectory, dict) or trajectory.get("kind") != "csv":
+        return _pack(raw)
     if put_blob is None:
-        raise InputError(T("the uploaded trajectory is too large for a link and this server cannot store it"))
+        token = _pack(raw)
+        if len(token) > MAX_TOKEN_CHARS:
+            raise InputError(T("the uploaded trajectory is too large for a link and this server cannot store it"))
+        return token
     data = json.dumps(trajectory, sort_keys=True, separators=(",", ":"), allow_nan=False).encode()
-    raw["trajectory"] = {"stored": put_blob(data), "label": str(trajectory.get("label", ""))[:200]}
+    raw["trajectory"] = {"stored": put_blob(data)}
     return _pack(raw)
 
 
@@ -162,12 +166,11 @@ def _stored(ref: dict[str, Any], get_blob: GetBlob | None) -> Any:
     if not isinstance(digest, str) or not _DIGEST.match(digest):
         raise InputError(T("the share link is damaged: copy it again in full"))
     data = None if get_blob is None else get_blob(digest)
-    if data is None:
+    if data is None:  # nothing of the link is quoted: its text is anyone's
         raise InputError(
-            Phrase(
-                "this link's uploaded trajectory {name} is kept on the server that made the link: open the link "
-                "there, or upload the CSV here",
-                name=repr(str(ref.get("label", ""))[:80]),
+            T(
+                "this link's uploaded trajectory is kept on the server that made the link: open the link there, or "
+                "upload the CSV here"
             )
         )
     if hashlib.sha256(data).hexdigest() != digest or len(data) > MAX_STATE_BYTES:

@@ -194,11 +194,11 @@ def _forces(state: AppState, readout: Readout, lang: Lang) -> str:
 
 
 LEGEND = (
-    ("#22c55e", "workspace: poses inside the stroke (eq. 4, working mode)"),
-    ("#f59e0b", "inverse singularity |p_j| = l_a, cos θ_i = 0 (eq. 11); a leg turns amber near it"),
-    ("#dc2626", "direct singularity cos(θ₁+θ₂) = 0 (eq. 12); the platform turns red near it"),
-    ("#db2777", "a slider at its stroke end turns pink"),
-    ("#3b82f6", "leg constraint circles (radius l_a) and P′, the other assembly mode"),
+    (hex_colour("workspace"), "workspace: poses inside the stroke (eq. 4, working mode)"),
+    (hex_colour("inverse"), "inverse singularity |p_j| = l_a, cos θ_i = 0 (eq. 11); a leg turns amber near it"),
+    (hex_colour("direct"), "direct singularity cos(θ₁+θ₂) = 0 (eq. 12); the platform turns red near it"),
+    (hex_colour("stroke"), "a slider at its stroke end turns pink"),
+    (hex_colour("circle"), "leg constraint circles (radius l_a) and P′, the other assembly mode"),
     (TAU_POS, "force arrow τ_i > 0 (along +e_i)"),
     (TAU_NEG, "force arrow τ_i < 0"),
 )

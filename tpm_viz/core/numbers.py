@@ -8,7 +8,9 @@ Accepted (``docs/csv.md`` lists the same rules for CSV cells):
   1.0, never a thousand;
 - digit groups separated by spaces (normal, no-break or thin spaces) in the integer part: ``1 000`` and
   ``12 345,5``, but only groups of exactly three digits after the first (``1 00`` is refused);
-- the field's own unit after the number when ``unit`` is given: ``5 mm`` in a field in mm.
+- the field's own unit after the number when ``unit`` is given: ``5 mm`` in a field in mm; with
+  :func:`parse_quantity`, that unit with any other SI prefix too (one rule for every unit the app accepts: ``5 kN``
+  in a field in N is 5000, ``0.15 m`` in a field in mm is 150, ``20 µm`` in mm is 0.02, ``1 kHz`` in Hz is 1000).
 
 Refused with :class:`~tpm_viz.core.errors.InputError`: empty text, text that is not a number, a number with both ``.``
 and ``,`` or with several commas (``1,234.5``, ``1.234,5``, ``1,000,000``: thousands separators are ambiguous;
@@ -72,10 +74,22 @@ UNITS: dict[str, tuple[str, float, float]] = {
     "°": ("angle", math.pi, 180.0),
     "hz": ("frequency", 1.0, 1.0),
     "rad/s": ("frequency", 1.0, 2.0 * math.pi),
+    "kg": ("mass", 1.0, 1.0),
+    "g": ("mass", 1.0, 1000.0),
 }
+_PREFIXES = {"k": (1000.0, 1.0), "m": (1.0, 1000.0), "u": (1.0, 1e6), "c": (1.0, 100.0)}
+"""SI prefixes any unit of :data:`UNITS` takes (centi on lengths only), as (multiplier, divisor): kilo, milli, micro
+(``µ``, ``μ`` or ``u``). Mega and the rest are left out: case is ignored, so ``MN`` would read as ``mN``."""
+_BASES = ("m", "s", "m/s", "m/s^2", "n", "rad", "hz", "g")
+for _base in _BASES:
+    for _p, (_pm, _pd) in _PREFIXES.items():
+        _q, _mul, _div = UNITS[_base]
+        if _p + _base not in UNITS and (_p != "c" or _q == "length"):
+            UNITS[_p + _base] = (_q, _mul * _pm, _div * _pd)
 """Units people write (e.g. in a CSV header) -> (quantity, multiplier, divisor): SI value = value * mul / div.
-Case is ignored, ``µm``/``μm`` is ``um``, ``s²``/``s2`` is ``s^2``. A frequency is in Hz; ``rad/s`` is an angular
-frequency, ``ω = 2π f`` (a natural frequency ``ω_n`` typed in rad/s)."""
+Case is ignored, ``µm``/``μm`` is ``um``, ``s²``/``s2`` is ``s^2``; every unit also with a prefix of
+:data:`_PREFIXES` (``5 kN``, ``0.15 m`` in a field in mm, ``250 ms``, ``1 kHz``, ``500 g``). A frequency is in Hz;
+``rad/s`` is an angular frequency, ``ω = 2π f`` (a natural frequency ``ω_n`` typed in rad/s)."""
 _SI = {
     "length": "m",
     "time": "s",
@@ -84,6 +98,7 @@ _SI = {
     "force": "N",
     "angle": "rad",
     "frequency": "Hz",
+    "mass": "kg",
 }
 _QUANTITY = {
     "length": T("length"),
@@ -93,9 +108,10 @@ _QUANTITY = {
     "force": T("force"),
     "angle": T("angle"),
     "frequency": T("frequency"),
+    "mass": T("mass"),
 }
 """The quantities of :data:`UNITS` as words (messages)."""
-_ALT = {"m": "mm", "s": "ms", "m/s": "mm/s", "m/s^2": "mm/s^2", "N": "kN", "rad": "deg", "Hz": "rad/s"}
+_ALT = {"m": "mm", "s": "ms", "m/s": "mm/s", "m/s^2": "mm/s^2", "N": "kN", "rad": "deg", "Hz": "rad/s", "kg": "g"}
 """A second unit a refusal suggests besides the SI one, by SI unit."""
 _MINUS = str.maketrans({"\u2212": "-", "\uff0d": "-", "\ufe63": "-"})
 _SPACES = "\u0020\u00a0\u202f\u2009\u2007"
@@ -247,7 +263,10 @@ def parse_quantity(text: object, name: str | Phrase = "value", unit: str = "") -
 
 
 def _entry(unit: str) -> tuple[str, float, float] | None:
-    """The :data:`UNITS` entry of ``unit`` as people write it (case, ``µ``, ``²``), or None."""
+    """The :data:`UNITS` entry of ``unit`` as people write it (case, ``µ``, ``²``), or None; a unit written with a
+    capital ``M`` is None (mega is not taken: ``MN`` must never read as ``mN``)."""
+    if unit.startswith("M"):
+        return None
     key = unit.lower().replace(" ", "").replace("µ", "u").replace("μ", "u").replace("²", "^2")
     return UNITS.get(key[:-1] + "^2" if key.endswith("/s2") else key)
 

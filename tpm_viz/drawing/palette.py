@@ -1,8 +1,11 @@
 """The one palette of tpm-viz: every named colour as RGB (0-255), and as CSS hex through :func:`hex_colour`.
 
 The 3D scene, the panel's HTML, the charts and the floor maps take their colours from here, so that a leg, a
-warning or a force has the same colour everywhere (teal leg 1, purple leg 2, amber inverse singularity, red direct
-singularity, pink stroke end, green/red positive/negative force).
+warning or a force has the same colour everywhere (teal leg 1, indigo leg 2, amber inverse singularity, red direct
+singularity, pink stroke end, brown for the other assembly mode P′ and its circles, green/red positive/negative force).
+Colours that must be told apart are far apart in CIELAB (``tests/drawing/test_palette.py``), also as the lit 3D view
+shows them: leg 2 was a purple that the lights made lilac, next to the stroke end's pink, and P′ was the blue of
+viser's drag handle.
 """
 
 from __future__ import annotations
@@ -15,7 +18,7 @@ PALETTE: dict[str, tuple[int, int, int]] = {
     "stop": (71, 85, 105),
     "slider": (51, 65, 85),
     "leg1": (13, 148, 136),
-    "leg2": (109, 40, 217),
+    "leg2": (67, 56, 202),
     "pin": (30, 41, 59),
     "platform": (100, 116, 139),
     "marker": (250, 204, 21),
@@ -28,7 +31,7 @@ PALETTE: dict[str, tuple[int, int, int]] = {
     "tau1": (37, 99, 235),
     "tau2": (220, 38, 38),
     "load": (71, 85, 105),
-    "circle": (59, 130, 246),
+    "circle": (146, 64, 14),
     "locus_direct": (220, 38, 38),
     "locus_inverse": (245, 158, 11),
     "workspace": (34, 197, 94),

@@ -1,6 +1,7 @@
 """The lab report of a run: one self-contained HTML file.
 
-Nothing in it needs the network: the style is inline CSS, the path an inline SVG polyline, the force plot the
+Nothing in it needs the network: the style is inline CSS, the path an inline SVG (axes in mm with ticks, one scale on
+both: :func:`nice_ticks`), the force plot the
 inline SVG of :func:`tpm_viz.drawing.figures.force_plot_svg` (the style of the paper's Figs. 4-5: closed form solid,
 Pinocchio dotted, their difference below), the procedure (a)-(e) MathML (:func:`tpm_viz.app.equations.
 procedure_html`) and the run's CSV a ``data:`` link. It prints to PDF from a browser (a print style sheet: no
@@ -115,34 +116,71 @@ def _parameters(params: Params, lang: Lang) -> str:
     return "<table>" + head + "".join(rows) + "</table>"
 
 
+PLOT_PX = 400
+"""Side of the path plot [px]; its margins (left, right, top, bottom) hold the axes' numbers and names."""
+PLOT_MARGINS = (58, 14, 14, 44)
+
+
+def nice_ticks(lo: float, hi: float, count: int = 5) -> list[float]:
+    """Round values (1, 2 or 5 times a power of ten apart) inside ``[lo, hi]``, about ``count`` of them."""
+    span = max(hi - lo, 1e-9)
+    raw = span / max(count - 1, 1)
+    power = 10.0 ** math.floor(math.log10(raw))
+    step = min((m * power for m in (1.0, 2.0, 5.0, 10.0)), key=lambda v: abs(math.log(v / raw)))
+    first = math.ceil(lo / step - 1e-9) * step
+    return [round(first + k * step, 10) for k in range(int((hi - first) / step + 1e-9) + 1)]
+
+
 def _path_svg(run: Run, lang: Lang) -> str:
-    """The platform's path [mm] as an inline SVG (y up), start and end marked."""
+    """The platform's path [mm] as an inline SVG: axes p₁ and p₂ in mm with ticks and numbers, the same scale on
+    both (the path's true shape), y up, start (circle) and end (square) marked."""
     p = run.p * 1e3
     lo, hi = p.min(axis=0), p.max(axis=0)
     span = float(max(hi[0] - lo[0], hi[1] - lo[1], 1.0))
-    pad = 0.12 * span
-    x0, y0, size = lo[0] - pad, -(hi[1] + pad), span + 2 * pad
-    points = " ".join(f"{x:.3f},{-y:.3f}" for x, y in p)
-    stroke = size / 250
-    mark = size / 60
-    (sx, sy), (ex, ey) = p[0], p[-1]
+    mid = (lo + hi) / 2
+    half = 0.56 * span  # the path and a little room around it, in mm
+    (x_lo, x_hi), (y_lo, y_hi) = ((float(c - half), float(c + half)) for c in mid)
+    left, right, top, bottom = PLOT_MARGINS
+    side = PLOT_PX - max(left + right, top + bottom)  # a square plot: one scale for p1 and p2
+    scale = side / (2 * half)  # px per mm
+
+    def px(x: float, y: float) -> tuple[float, float]:
+        return left + (x - x_lo) * scale, top + (y_hi - y) * scale
+
+    points = " ".join("{:.2f},{:.2f}".format(*px(x, y)) for x, y in p)
+    (sx, sy), (ex, ey) = px(*p[0]), px(*p[-1])
+    ticks = []
+    for v in nice_ticks(x_lo, x_hi):
+        x, _ = px(v, y_lo)
+        ticks.append(
+            f'<line x1="{x:.2f}" y1="{top + side}" x2="{x:.2f}" y2="{top + side + 5}" stroke="#444"/>'
+            f'<text x="{x:.2f}" y="{top + side + 18}" text-anchor="middle" data-axis="x" data-mm="{v:g}">{v:g}</text>'
+        )
+    for v in nice_ticks(y_lo, y_hi):
+        _, y = px(x_lo, v)
+        ticks.append(
+            f'<line x1="{left - 5}" y1="{y:.2f}" x2="{left}" y2="{y:.2f}" stroke="#444"/>'
+            f'<text x="{left - 8}" y="{y + 4:.2f}" text-anchor="end" data-axis="y" data-mm="{v:g}">{v:g}</text>'
+        )
     label = say(
         lang,
         Phrase(
             "path of P from {start} (circle) to {end} (square), mm",
-            start=f"({sx:.1f}, {sy:.1f})",
-            end=f"({ex:.1f}, {ey:.1f})",
+            start=f"({p[0][0]:.1f}, {p[0][1]:.1f})",
+            end=f"({p[-1][0]:.1f}, {p[-1][1]:.1f})",
         ),
     )
     return (
-        f'<svg xmlns="http://www.w3.org/2000/svg" role="img" width="360" height="360" '
-        f'viewBox="{x0:.3f} {y0:.3f} {size:.3f} {size:.3f}"><title>{_esc(label)}</title>'
-        f'<rect x="{x0:.3f}" y="{y0:.3f}" width="{size:.3f}" height="{size:.3f}" fill="#fafafa" stroke="#bbb" '
-        f'stroke-width="{stroke:.3f}"/>'
-        f'<polyline points="{points}" fill="none" stroke="#ca8a04" stroke-width="{2 * stroke:.3f}"/>'
-        f'<circle cx="{sx:.3f}" cy="{-sy:.3f}" r="{mark:.3f}" fill="#15803d"/>'
-        f'<rect x="{ex - mark:.3f}" y="{-ey - mark:.3f}" width="{2 * mark:.3f}" height="{2 * mark:.3f}" '
-        f'fill="#b91c1c"/></svg>'
+        f'<svg xmlns="http://www.w3.org/2000/svg" role="img" width="{PLOT_PX}" height="{PLOT_PX}" '
+        f'viewBox="0 0 {PLOT_PX} {PLOT_PX}" font-family="sans-serif" font-size="12" fill="#333">'
+        f"<title>{_esc(label)}</title>"
+        f'<rect x="{left}" y="{top}" width="{side}" height="{side}" fill="#fafafa" stroke="#444"/>'
+        + "".join(ticks)
+        + f'<text x="{left + side / 2:.1f}" y="{top + side + 36}" text-anchor="middle">p1 (mm)</text>'
+        f'<text transform="translate(14 {top + side / 2:.1f}) rotate(-90)" text-anchor="middle">p2 (mm)</text>'
+        f'<polyline points="{points}" fill="none" stroke="#ca8a04" stroke-width="2"/>'
+        f'<circle cx="{sx:.2f}" cy="{sy:.2f}" r="5" fill="#15803d"/>'
+        f'<rect x="{ex - 5:.2f}" y="{ey - 5:.2f}" width="10" height="10" fill="#b91c1c"/></svg>'
     )
 
 

@@ -250,10 +250,11 @@ class TpmApp:
         connected = set(self.server.get_clients())
         with self._views_lock:
             views = [v for cid, v in self.views.items() if not v.closed and cid in connected]
-        count = Phrase(
-            "{tabs} tab(s) connected, {shared} on the shared mechanism.",
-            tabs=len(views),
-            shared=self.hub.shared_viewers(),
+        tabs, shared = len(views), self.hub.shared_viewers()
+        count = (  # English has a singular (Korean counts both alike)
+            Phrase("{tabs} tab connected, {shared} on the shared mechanism.", tabs=tabs, shared=shared)
+            if tabs == 1
+            else Phrase("{tabs} tabs connected, {shared} on the shared mechanism.", tabs=tabs, shared=shared)
         )
         if self.lti is not None and self.lti.tickets.course:  # the class label: the LMS course's title
             count = Phrase("Course: {course}. {count}", course=self.lti.tickets.course, count=count)

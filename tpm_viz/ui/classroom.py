@@ -40,6 +40,7 @@ from tpm_viz.classroom.launches import TICKET_SECONDS, Tickets, ticket_of_query
 from tpm_viz.classroom.links import PENDING_SECONDS, PendingLinks, token_of_query
 from tpm_viz.classroom.network import PROXIED, HostRules, client_address, header_problem, host_name, is_loopback
 from tpm_viz.ui.keyboard import Keyboard
+from tpm_viz.ui.seen import Sightings
 from tpm_viz.viserkit.page import ALIVE_PATH, with_script
 
 __all__ = [
@@ -228,6 +229,8 @@ class Handshakes:
         self._logged = 0.0
         self.keyboard = Keyboard()
         """The tabs' keys (:mod:`.keyboard`): the page script's requests are answered here."""
+        self.sightings = Sightings(self.keyboard)
+        """What the pages see (a finger, the tab opened: :mod:`.seen`), answered here."""
 
     def _refusal(self, connection: Any, headers: Any) -> Any:
         """400 for malformed or duplicated headers, 403 for a ``Host`` not of this server (DNS rebinding), else
@@ -271,6 +274,8 @@ class Handshakes:
             return connection.respond(*key)  # a key of the page script (viserkit/page.py)
         if request.path.partition("?")[0] == ALIVE_PATH:  # a disconnected page asking whether to reconnect
             return connection.respond(http.HTTPStatus.OK, "ok\n")
+        if (seen := self.sightings.answer(request.path, same_origin(headers))) is not None:
+            return connection.respond(*seen)  # what the page sees (viserkit/seen.py)
         if headers.get("Upgrade", "").lower() == "websocket":
             if same_origin(headers):
                 return None

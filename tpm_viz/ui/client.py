@@ -239,7 +239,7 @@ class ClientView:
         panel.own_copy.on_update(self._on_own_copy)
         for what, handle in panel.show_toggles.items():
             handle.on_update(lambda event, what=what: self._on_show(event, what))
-        panel.frame_camera.on_click(self._on_frame)
+        panel.frame_camera.on_click(self.on_frame)
 
     def commit_drag(self, phase: str, position: np.ndarray) -> None:
         """Commit this tab's drag to ``position`` [m] (under the hub's lock; geared on a touch tab: ui/phone.py)."""
@@ -340,8 +340,10 @@ class ClientView:
             self.client.flush()
 
     @guarded
-    def _on_frame(self, event) -> None:
-        if getattr(event, "client", None) is None:
+    def on_frame(self, event) -> None:
+        """*Frame the mechanism* (the panel's, the box of live numbers'): the camera framed again for the canvas."""
+        if getattr(event, "client", None) is None or self.closed:
             return
-        self.frame_camera(self.session.state.params)
-        self.client.flush()
+        with self.hub.lock:
+            self.frame_camera(self.session.state.params)
+            self.client.flush()

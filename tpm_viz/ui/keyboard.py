@@ -159,6 +159,16 @@ class Keyboard:
         with self._lock:
             return self._nonces.get(id(view))
 
+    def spend(self, nonce: str, same_site: bool) -> Any | None:
+        """The view of the tab holding ``nonce`` if the request may be answered: from this site, and a token of
+        the tab's bucket (a key's rate: :mod:`~tpm_viz.ui.seen` asks too); None otherwise (counted as refused)."""
+        with self._lock:
+            tab = self._tabs.get(nonce) if same_site else None
+            if tab is None or not tab.take(time.monotonic()):
+                self.refused += 1
+                return None
+            return tab.view
+
     def leave(self, view: Any) -> None:
         """``view``'s tab went away: its nonce is no longer accepted."""
         with self._lock:

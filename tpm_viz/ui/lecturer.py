@@ -43,15 +43,17 @@ class Lecture(Protocol):
 LOOPBACK_ONLY = T("Served on this computer only: students cannot connect. Restart with --host 0.0.0.0.")
 
 
-def join_html(urls: list[str]) -> str:
-    """The URLs students type and a QR code of the first one (HTML for the panel)."""
+def join_html(urls: list[str], loopback: bool = False) -> str:
+    """The URLs students type and a QR code of the first one (HTML for the panel). ``loopback``: the server is bound
+    to this computer only (``--classroom`` with ``--host 127.0.0.1``): the room's addresses are listed, but no
+    student can connect to them, and the panel says so (as the terminal does)."""
     if not urls:
         return (
             "<p><b>No network address found</b>: connect this computer to the room's network "
             "(students use the same wifi), then restart the app.</p>"
         )
     links = "".join(f"<div style='font-size:1.1em'><b>{html.escape(u)}</b></div>" for u in urls)
-    if all(is_loopback(urlsplit(u).hostname or "") for u in urls):
+    if loopback or all(is_loopback(urlsplit(u).hostname or "") for u in urls):
         links += f"<p style='color:#b91c1c'><b>{LOOPBACK_ONLY.template}</b></p>"
     image = f"<img alt='QR code of {html.escape(urls[0])}' src='{qr_data_uri(urls[0])}' style='width:180px'>"
     return f"<div>Students open (same network):{links}{image}</div>"
@@ -60,11 +62,14 @@ def join_html(urls: list[str]) -> str:
 class LecturerPanel:
     """The *Lecturer* folder of one tab."""
 
-    def __init__(self, gui: TabGui, lecture: Lecture, view: Any, urls: list[str] | None, presenter: bool):
+    def __init__(
+        self, gui: TabGui, lecture: Lecture, view: Any, urls: list[str] | None, presenter: bool, loopback: bool = False
+    ):
+        """``loopback``: the server is bound to this computer only (the join box warns: :func:`join_html`)."""
         self._lecture, self._view = lecture, view
         self.folder = gui.add_folder("Lecturer", expand_by_default=urls is not None)
         with self.folder:
-            self.join = gui.add_html(join_html(urls) if urls is not None else "")
+            self.join = gui.add_html(join_html(urls, loopback) if urls is not None else "")
             self.join.visible = urls is not None
             self.notice = gui.add_markdown("")
             self.notice.visible = False

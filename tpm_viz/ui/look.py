@@ -41,7 +41,7 @@ from tpm_viz.ui.language import KEEP_ALL
 from tpm_viz.ui.panels import FOLDED
 from tpm_viz.ui.scene import camera_pose
 from tpm_viz.ui.widgets.framing import LIVE_BAND, frame_box
-from tpm_viz.viserkit.core import point_camera
+from tpm_viz.viserkit.core import point_camera, widget_uuid
 
 __all__ = [
     "BUTTON_TOUCH",
@@ -57,6 +57,7 @@ __all__ = [
     "Look",
     "dock_panel",
     "frame_camera",
+    "frame_row_css",
     "mechanism_box",
 ]
 
@@ -103,6 +104,7 @@ INSET = 16
 content) and 5 px to spare, so "N" never touches the panel's edge."""
 PHONE_CSS = f"""<style>
 div:has(> [data-q="banner"]) {{ padding-right: {INSET}px; }}
+label wbr {{ display: none; }}
 @media {_PHONE} {{
   [data-guide] > div > span {{ max-width: 100%; overflow-wrap: anywhere; }}
   {_SHEET_CSS} {{ width: 100% !important; left: 0 !important; right: 0 !important; }}
@@ -124,7 +126,8 @@ div:has(> [data-q="banner"]) {{ padding-right: {INSET}px; }}
 }}
 </style>"""
 """The readout's room at the panel's edge (:data:`INSET`), the phone layout and touch targets (by viewport and
-pointer: no switch), in every tab."""
+pointer: no switch), in every tab; labels break at spaces only (viser puts a ``<wbr>`` after each ``_`` and ``/``:
+"F_max" was cut after "F_")."""
 
 BANNER_PX = 20
 """Font size of the pose status and its warnings in the box of live numbers [CSS px]."""
@@ -155,6 +158,23 @@ body:has([data-dock-rail-root]) [data-floating-window]:has([data-live]) {{ visib
 """Presentation mode: large, dark type (the charts' titles and legends too; their axes are drawn on a canvas, sized by
 :meth:`~.teaching.player.charts.Charts.set_presentation`); the box of banner and forces shown only while the panel is
 collapsed."""
+
+
+def frame_row_css(language: Any, button: Any) -> str:
+    """The panel's first row: the *Language* selector (``language``) and *Frame the mechanism* (``button``, the next
+    control) side by side, 45 % and 55 % of the width (the root of the panel is a block: a float), so that the button
+    costs no height above the tabs. Empty for a GUI without a page (a test's stand-in)."""
+    try:
+        selector, uuid = widget_uuid(language), widget_uuid(button)
+    except AttributeError:
+        return ""
+    row = f'div:has(> div > div > p > label[for="{selector}"])'
+    wrapper = f'div:has(> button[id="{uuid}"])'
+    return (
+        f"<style>{row} {{ float: left; width: 45%; }}"
+        f" {wrapper} {{ margin-left: calc(45% + 4px) !important; }} {wrapper} ~ * {{ clear: both; }}"
+        f" {wrapper} > button {{ width: 100%; }}</style>"
+    )
 
 
 def mechanism_box(params: Params) -> tuple[np.ndarray, np.ndarray]:
@@ -207,6 +227,8 @@ class Look:
         self._nudge = 1.0
         gui = view.gui
         self.style = gui.add_html(PHONE_CSS)
+        self.row = gui.add_html(frame_row_css(view.words.selector, view.panel.frame_camera))
+        """*Language* and *Frame the mechanism* on one row (its own style sheet)."""
         self.live: Any = None  # the box of banner and forces (a viser panel), made when first needed
         self.live_html: Any = None
         self.live_style: Any = None
@@ -295,6 +317,9 @@ class Look:
                 self.live_html = self.view.gui.add_html("")
                 # the panel's style sheets are unmounted with it when it collapses: this box carries its own
                 self.live_style = self.view.gui.add_html("")
+                # the panel's *Frame the mechanism*, one tap away with the panel folded too
+                frame = self.view.gui.add_button("Frame the mechanism", icon=viser.Icon.FOCUS_CENTERED, color="gray")
+                frame.on_click(self.view.on_frame)
             self.live.float(x=LIVE_GAP, y=-LIVE_GAP, width=LIVE_WIDTH)
         if self.live is not None:
             self.live.visible = on

@@ -31,6 +31,7 @@ from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.classroom.text import legend_html
 from tpm_viz.core.params import PARAM_INFO, Params
 from tpm_viz.core.words import Lang
+from tpm_viz.drawing.palette import hex_colour
 from tpm_viz.ui.fields import Note, TypedBox
 from tpm_viz.ui.widgets.typed import QUIET, Quantity, TypedField, TypedGroup, force_note
 from tpm_viz.ui.worded import TabGui, Tabs, Worded
@@ -72,17 +73,17 @@ Equations), *Lab* (Control, Planner, Design), *Setup* (Parameters, Class & view)
 the open group's tabs: two rows of tabs at most, at 1024 px and in Korean too."""
 
 GUIDE_LINES = (
-    "Drag the arrows on the grey platform P in 3D (or type p in Move): the legs and the forces follow.",
+    "Drag the blue square at the grey platform P in 3D (or type p in Move): the legs and the forces follow.",
     "Near a singularity: the grey buttons at the top of Move. The banner above the tabs turns amber or red.",
 )
 GUIDE_COLOURS = (
-    ("#22c55e", "workspace"),
-    ("#f59e0b", "inverse singularity"),
-    ("#dc2626", "direct singularity"),
-    ("#db2777", "stroke end"),
-    ("#3b82f6", "other assembly mode P′"),
+    (hex_colour("workspace"), "workspace"),
+    (hex_colour("inverse"), "inverse singularity"),
+    (hex_colour("direct"), "direct singularity"),
+    (hex_colour("stroke"), "stroke end"),
+    (hex_colour("circle"), "other assembly mode P′"),
 )
-"""The colours of the 3D view in the guide, by name (the legend of the Move tab says more)."""
+"""The colours of the 3D view in the guide, by name, from the palette (the legend of the Move tab says more)."""
 _CHIP = "<span style='display:inline-block;width:10px;height:10px;border-radius:2px;background:{}'></span>"
 GUIDE_HTML = (
     "<div data-guide='1' style='font-size:0.85em;line-height:1.35'>"
@@ -91,8 +92,7 @@ GUIDE_HTML = (
     + "".join(f"<span>{_CHIP.format(colour)} <span>{name}</span></span>" for colour, name in GUIDE_COLOURS)
     + "</div></div>"
 )
-"""The first visit's guide: what to drag, where the singularities are, the colours (each text a template of the
-catalogue, shown in the tab's language)."""
+"""The first visit's guide: what to drag, the singularities, the colours (templates of the catalogue)."""
 
 PARAM_NAMES = {"pivot_spacing": "pivot spacing", "stroke": "stroke Δd"}
 """Name of a parameter in the notes of its field (the others: their own name)."""
@@ -124,7 +124,7 @@ def _ui(name: str, value_si: float) -> float:
 def _vector(name: str, values=(0.0, 0.0)) -> TypedGroup:
     """The group of a typed vector (:data:`VECTORS`), applied on Enter or after :data:`QUIET` seconds."""
     keys, unit, bound, _labels = VECTORS[name]
-    quantities = [Quantity(key, unit, 1.0, -bound, bound) for key in keys]
+    quantities = [Quantity(key, unit, 1.0, -bound, bound, places=1 if unit == "mm" else None) for key in keys]
     return TypedGroup({q.name: TypedField(q, v) for q, v in zip(quantities, values, strict=True)}, quiet=QUIET)
 
 
@@ -137,7 +137,7 @@ def _actuators(stroke_mm: float, d_mm) -> TypedGroup:
     """The typed actuator positions (mm), each in the stroke ``[0, Δd]``, applied on Enter or after :data:`QUIET`."""
     return TypedGroup(
         {
-            key: TypedField(Quantity(key, "mm", 1.0, 0.0, stroke_mm, ACTUATOR_RESOLUTION), float(value))
+            key: TypedField(Quantity(key, "mm", 1.0, 0.0, stroke_mm, ACTUATOR_RESOLUTION, places=1), float(value))
             for key, value in zip(ACTUATOR_LABELS, d_mm, strict=True)
         },
         quiet=QUIET,
@@ -214,6 +214,7 @@ class Panel:
         self._written: dict[int, object] = {}
         self._dashboard_at = 0.0
         stroke_mm = state.params.stroke * 1e3
+        self.frame_camera = gui.add_button("Frame the mechanism", icon=viser.Icon.FOCUS_CENTERED, color="gray")
         self.guide = gui.add_folder("Start here", visible=False)
         """The first visit's guide (what to drag, the colours, the singularities): shown by :mod:`.guide`."""
         with self.guide:
@@ -282,7 +283,6 @@ class Panel:
             )
             self.class_info = gui.add_markdown("")
             self.show_toggles = {k: gui.add_checkbox(label, True) for k, label in SHOW_LABELS.items()}
-            self.frame_camera = gui.add_button("Snapshot the mechanism", icon=viser.Icon.FOCUS_CENTERED)
             self.presentation = gui.add_checkbox(
                 "Presentation mode", False, hint="Large type, thick lines and a wider panel: for a projector"
             )

@@ -17,6 +17,7 @@ from typing import Any, TypeVar
 from tpm_viz.classroom import sessionfile
 from tpm_viz.classroom.away import Away
 from tpm_viz.classroom.guard import guarded, log
+from tpm_viz.classroom.network import is_loopback
 from tpm_viz.classroom.sessionfile import Document, Saved
 from tpm_viz.core.errors import TpmVizError
 from tpm_viz.core.words import Lang, T, say
@@ -219,7 +220,8 @@ class Room:
         self.app.hub.membership_changed()
 
     def _add_lecturer(self, view: Any) -> None:
-        panel = LecturerPanel(view.gui, self, view, self.urls, presenter=self.app.access.enabled)
+        bound = is_loopback(str(self.app.server.get_host()))  # --classroom on 127.0.0.1: nobody can join
+        panel = LecturerPanel(view.gui, self, view, self.urls, presenter=self.app.access.enabled, loopback=bound)
         panel.show_notice(self.notice)
         self._lecturers[view] = panel
         for hook in self.lecturer_hooks:

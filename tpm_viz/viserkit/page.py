@@ -37,6 +37,9 @@ into the script). The gzipped variant is unpacked, edited and packed once per pa
   words the server put in the tab's hidden element, else the browser's first language among :data:`RECONNECT`'s)
   that connects at once. No page reload: nothing typed is lost by it.
 
+A second, separate script goes in with it: :data:`~tpm_viz.viserkit.seen.SEEN_SCRIPT` (a coarse pointer, the tab
+of the panel that is open).
+
 The wire format of a key (:func:`key_request`) is in :mod:`.keys` (re-exported here).
 """
 
@@ -50,6 +53,8 @@ from typing import Any
 
 from tpm_viz.core.words import Lang, T, say
 from tpm_viz.viserkit.keys import KEY_PATH, KEYS, QUEUED, KeyRequest, key_request
+from tpm_viz.viserkit.seen import SEEN_SCRIPT
+from tpm_viz.viserkit.seen import SETTINGS as SEEN_SETTINGS
 
 __all__ = [
     "ALIVE_PATH",
@@ -120,6 +125,7 @@ CONFIG: dict[str, Any] = {
     "gap": TIP_GAP,
     "notice": NOTICE_CSS,
     "reconnect": RECONNECT,
+    "seen": SEEN_SETTINGS,
 }
 """What the script is told (``page.js`` reads it as ``CONFIG``): its one input from Python, sent as JSON data in its
 own element, never written into the script's code."""
@@ -142,7 +148,7 @@ def page_tag(config: dict[str, Any] = CONFIG, script: str = SCRIPT) -> bytes:
     if "</script" in script.lower():
         raise ValueError("the page script contains '</script'")
     data = f'<script type="application/json" id="tpmviz-page-config">{config_json(config)}</script>'
-    return f"{data}<script>{script}</script>".encode()
+    return f"{data}<script>{script}</script><script>{SEEN_SCRIPT}</script>".encode()  # seen.js: viserkit/seen.py
 
 
 _TAG = page_tag()

@@ -30,7 +30,7 @@ from tpm_viz.viserkit.doors import ServerDoor
 __all__ = ["VISER_SERIALIZE", "VISER_WINDOW_LOOP", "align", "arrive", "connection_states", "lean_buffer"]
 __all__ += ["message_buffer", "messages", "shared_serialize", "tunnel_class", "upload_states", "widget_uuid"]
 __all__ += ["event_loop", "gizmo_echoes", "share_tunnel", "shared_buffer", "thread_pool", "wake_safely"]
-__all__ += ["image_bytes", "outgoing_replaced", "props_api", "recorded_seconds", "widget_value"]
+__all__ += ["gui_inputs", "image_bytes", "outgoing_replaced", "props_api", "recorded_seconds", "widget_value"]
 
 messages = _messages
 """viser's message classes (``viser._messages``)."""
@@ -122,3 +122,28 @@ def recorded_seconds(serializer: Any) -> float:
 def tunnel_class() -> type:
     """viser's share-URL tunnel (a test replaces its ``__init__`` to see whether one is opened)."""
     return viser._tunnel.ViserTunnel
+
+
+def gui_inputs(gui: Any) -> list[tuple[tuple[str, ...], Any]]:
+    """Every input of a tab's GUI (``client.gui``): ``(tabs, handle)``, ``tabs`` the labels of the tabs the input
+    sits in, outermost first (``()`` in the panel's root or a floating panel). Inputs in folders and forms are in
+    their tab; an input that no walk from the root reaches is listed with ``("?",)`` (none should be)."""
+    found: dict[str, tuple[tuple[str, ...], Any]] = {}
+
+    def walk(container: Any, tabs: tuple[str, ...]) -> None:
+        for child in list(getattr(container, "_children", {}).values()):
+            for tab in list(getattr(child, "_tab_handles", ())):
+                walk(tab, (*tabs, str(tab._label)))
+            if getattr(child, "_children", None) is not None:
+                walk(child, tabs)
+            impl = getattr(child, "_impl", None)
+            if impl is not None and impl.uuid in gui._gui_input_handle_from_uuid:
+                found[impl.uuid] = (tabs, child)
+
+    walk(gui._container_handle_from_uuid["root"], ())
+    for container in list(gui._container_handle_from_uuid.values()):  # floating panels: their own roots
+        if getattr(container, "_parent", None) is None and getattr(container, "_impl", None) is None:
+            walk(container, ())
+    for uuid, handle in list(gui._gui_input_handle_from_uuid.items()):
+        found.setdefault(uuid, (("?",), handle))
+    return list(found.values())

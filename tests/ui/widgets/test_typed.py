@@ -287,7 +287,7 @@ def test_a_group_with_a_bad_field_is_refused_as_a_whole_and_applies_nothing():
     app.tick(0.2 + QUIET)
     assert app.applied == [] and x.text == "12" and y.text == "1O"
     lines = [str(x) for x in group.lines(0.2 + QUIET)]
-    assert lines == ["f_x: in use 0 N", "f_y [N]: '1O' is not a number (examples: 0.25, 0,25, -1.5e-3) (in use: 0 N)"]
+    assert lines == ["f_x: in use 0 N", "f_y [N] has an unknown unit 'O' (use N or kN) (in use: 0 N)"]
     group.typed("y", "10", 5.0)
     app.tick(5.0 + QUIET)
     assert app.applied == [(5.0 + QUIET, {"x": 12.0, "y": 10.0})]

@@ -276,9 +276,10 @@ class ExplorerView:
         if self.ellipses_on:
             drawing = ellipse_polylines(state.params, state.pose.p, ELLIPSE_SCALE, ELLIPSE_CAP)
         scene = self.view.client.scene
+        planner = "planner" in getattr(getattr(self.view, "teaching", None), "open_tabs", ())
         for name in ("velocity", "force"):
             handle = self._ellipses.get(name)
-            if drawing is None:
+            if drawing is None or planner:  # the Planner shows its own path and forces (ui/seen.py)
                 if handle is not None and handle.visible:
                     handle.visible = False
                 continue

@@ -32,7 +32,7 @@ CONTROL_SETTINGS = {
 """The control lab's settings, by the name of the :class:`~.control.tab.ControlView` attribute holding the slider."""
 
 PLANNER_SETTINGS = {
-    "force": Setting("Force limit F_max (N)", Quantity("F_max", "N", lo=20.0, hi=1000.0), 5.0, 200.0),
+    "force": Setting("F_max, force limit (N)", Quantity("F_max", "N", lo=20.0, hi=1000.0), 5.0, 200.0),
     "speed": Setting("Speed limit (m/s, 0 = none)", Quantity("speed limit", "m/s", lo=0.0, hi=5.0), 0.05, 0.0),
 }
 """The planner's limits, by the name of the :class:`~.planner.tab.PlannerView` attribute holding the slider."""

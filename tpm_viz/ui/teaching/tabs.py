@@ -40,6 +40,7 @@ from tpm_viz.ui.teaching.planner.tab import PlannerView
 from tpm_viz.ui.teaching.player.tab import PlayerView
 from tpm_viz.ui.teaching.takeout.buttons import TakeOut, takeout_for
 from tpm_viz.ui.worded import Tabs
+from tpm_viz.viserkit.seen import tab_marker
 
 
 def _open_if_open(opener: weakref.WeakMethod, group: str) -> None:
@@ -109,6 +110,8 @@ class Teaching:
         self.waiting: set[str] = set()
         """The groups of :data:`LATER` not built yet (:meth:`open` builds one)."""
         self._attached = False
+        self.open_tabs: frozenset[str] = frozenset()
+        """The marked tabs the page shows now (:meth:`shown`): ``player``, ``control``, ``planner``, ``design``."""
 
     # -- the views of the deferred tabs: built when asked for --------------------------------------------------
     @property
@@ -172,18 +175,22 @@ class Teaching:
         gui, tabs, worker = self.view.gui, self._tabs[group], self.services.worker
         if group == "teach":
             with tabs.add_tab("Player", icon=viser.Icon.PLAYER_PLAY):
+                gui.add_html(tab_marker("player"))  # the page says when the tab is shown (ui/seen.py)
                 self._player.build(gui)
                 self._takeouts.append(takeout_for(self.view, worker, self._player, "player", gui))
             with tabs.add_tab(TAB.template, icon=viser.Icon.CHECKLIST) as tab:
                 self.exercises.build(gui, tab)
         if group == "lab":
             with tabs.add_tab("Control", icon=viser.Icon.ADJUSTMENTS):
+                gui.add_html(tab_marker("control"))
                 self._control.build(gui)
                 self._takeouts.append(takeout_for(self.view, worker, self._control, "control", gui))
             with tabs.add_tab("Planner", icon=viser.Icon.ROUTE):
+                gui.add_html(tab_marker("planner"))
                 self._planner.build(gui)
                 self._takeouts.append(takeout_for(self.view, worker, self._planner, "planner", gui))
             with tabs.add_tab("Design", icon=viser.Icon.RULER_MEASURE):
+                gui.add_html(tab_marker("design"))
                 self._design.build(gui)
 
     def open(self, group: str) -> bool:
@@ -244,6 +251,22 @@ class Teaching:
         """The session's run changed: redraw the player (if its tab exists: it draws the run when built)."""
         if self.built("teach"):
             self._player.refresh()
+
+    def shown(self, names: frozenset[str]) -> None:
+        """The marked tabs the page shows now (:mod:`tpm_viz.ui.seen`; under the hub's lock): the drawing of a tab
+        just opened comes to the front of the scene (the Player's trace, the Control lab's run, the Planner's path
+        and forces), and the explorer's ellipses are left out while the Planner is shown. A refusal (a student on
+        the shared mechanism: the plan cannot be shown on it) is raised after the drawing changed."""
+        opened, self.open_tabs = names - self.open_tabs, names
+        frame = self.view.session.frame
+        if frame is not None:
+            self.explorer.render(frame)
+        if "player" in opened and self.built("teach"):
+            self._player.opened()
+        if "control" in opened and self.built("lab"):
+            self._control.opened()
+        if "planner" in opened and self.built("lab"):
+            self._planner.opened()
 
     def render(self, frame: Snapshot) -> None:
         """Draw the teaching layer's part of ``frame`` (under the hub's lock)."""

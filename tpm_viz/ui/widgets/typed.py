@@ -6,8 +6,9 @@ minus, the field's unit after the number). This module is their logic, as plain 
 times, so that it is tested without a browser (``tests/ui/widgets/test_typed.py``):
 
 - :class:`Quantity`: what one field holds (name, UI unit, SI scale, accepted range): text -> SI value, or one line
-  saying what to change; SI value -> a short text that reads back to it. A length field in mm also reads a length
-  typed in m or cm (``0.15 m`` is 150 mm: :data:`OTHER_UNITS`).
+  saying what to change; SI value -> a short text that reads back to it. The field's unit may be typed after the
+  number with any SI prefix (:func:`tpm_viz.core.numbers.parse_quantity`: ``0.15 m`` is 150 in a field in mm,
+  ``5 kN`` is 5000 in a field in N).
 - :class:`TypedField`: one field's text and the value in use. It is *clean* (its text is the app's, written by
   :meth:`TypedField.show`), *typing* (keystrokes not yet settled: never read for use, never overwritten by the app)
   or *held* (settled but not in use: refused, or waiting for the value it asked for). A held text stays until the
@@ -30,12 +31,11 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
 
 from tpm_viz.core.errors import InputError, TpmVizError
-from tpm_viz.core.numbers import parse_number, plausibility
+from tpm_viz.core.numbers import fixed, parse_quantity, plausibility
 from tpm_viz.core.words import Phrase
 
 __all__ = [
     "FORCE_TYPICAL",
-    "OTHER_UNITS",
     "QUIET",
     "SHORT_DURATION",
     "Quantity",
@@ -55,9 +55,6 @@ times larger (2 kN) get a plausibility note."""
 SHORT_DURATION = 0.02
 """Trajectory durations below this [s] get a plausibility note (the forces grow as ``1/T²``)."""
 
-OTHER_UNITS: dict[str, tuple[tuple[str, float], ...]] = {"mm": (("cm", 10.0), ("m", 1e3))}
-"""Units accepted after a number besides the field's own, by the field's unit: (unit, its value in the field's
-unit). A length in mm may be typed in cm or m (``0.15 m``, ``15 cm``: 150 mm)."""
 
 CLEAN, TYPING, HELD = "clean", "typing", "held"
 
@@ -72,7 +69,9 @@ def _compact(value: float) -> str:
 class Quantity:
     """What one typed field holds: ``name`` (in messages), its UI ``unit``, ``scale`` (SI value of one UI unit,
     e.g. 1e-3 for mm), the accepted range ``[lo, hi]`` in UI units and the ``resolution`` below which a value is
-    shown as 0 (UI units: rounding noise such as ``-3e-14 mm`` of a computed pose is not a number to show)."""
+    shown as 0 (UI units: rounding noise such as ``-3e-14 mm`` of a computed pose is not a number to show);
+    ``places``: the decimals the app writes (the readout's: one for the Move tab's millimetres), None: six significant
+    digits."""
 
     name: str
     unit: str = ""
@@ -80,20 +79,12 @@ class Quantity:
     lo: float = -math.inf
     hi: float = math.inf
     resolution: float = 1e-9
+    places: int | None = None
 
     def number(self, text: object) -> float:
-        """The number ``text`` spells in the field's unit (the unit may be typed, or one of :data:`OTHER_UNITS`:
-        ``0.15 m`` is 150 in a mm field), not range-checked; else :class:`~tpm_viz.InputError`."""
-        if isinstance(text, str) and not (self.unit and text.strip().endswith(self.unit)):
-            s = text.strip()
-            for unit, factor in OTHER_UNITS.get(self.unit, ()):
-                head = s[: -len(unit)].rstrip() if s.endswith(unit) else ""
-                if head and (head[-1].isdigit() or head[-1] in ".,"):
-                    value = parse_number(head, self.name, self.unit) * factor
-                    if not math.isfinite(value):
-                        raise InputError(Phrase("{name}: {value} is too large", name=self.name, value=s))
-                    return value
-        return parse_number(text, self.name, self.unit)
+        """The number ``text`` spells in the field's unit (the unit may be typed, with any SI prefix: ``0.15 m`` is
+        150 in a mm field, ``5 kN`` is 5000 in an N field), not range-checked; else :class:`~tpm_viz.InputError`."""
+        return parse_quantity(text, self.name, self.unit)
 
     def read(self, text: object) -> float:
         """The SI value ``text`` spells, else :class:`~tpm_viz.InputError` with one line saying what to change."""
@@ -133,8 +124,11 @@ class Quantity:
         return si
 
     def text(self, si: float) -> str:
-        """The field's text for the SI value ``si`` (UI unit, six significant digits, 0 below the resolution)."""
+        """The field's text for the SI value ``si`` (UI unit; :attr:`places` decimals, else six significant digits;
+        0 below the resolution; never ``-0``)."""
         value = si / self.scale
+        if self.places is not None:
+            return fixed(value, f".{self.places}f")
         return _compact(0.0 if abs(value) < self.resolution else value)
 
     def shown(self, si: float) -> str:

@@ -8,9 +8,12 @@ row where the box was, a typed field of the app (:class:`~.fields.TypedBox` of o
 the accepted range) with its note under the row: the same refusals and "in use" notes as every typed number.
 
 The slider's value is the value in use: a settled text is written into the slider (then ``on_change()`` runs, as
-a drag of the slider runs the tab's own callback), and a drag of the slider, or a value the app writes
-(:meth:`TypedSlider.set`), is shown in the field (over what is typed there: the newest input wins). Units are those
-of the label (UI units: Hz, kg, %, N, µm, m/s); the tab reads ``slider.value`` as before.
+a drag of the slider runs the tab's own callback; if it refuses the value, the slider goes back and the refusal is
+shown under the field), and a drag of the slider, or a value the app writes (:meth:`TypedSlider.set`), is shown in
+the field (over what is typed there: the newest input wins). A value that only follows something else (the time of
+a playback: :meth:`TypedSlider.follow`) is shown in the field unless a text is being typed there. The range may
+change (:meth:`TypedSlider.limit`: the time boxes span the run loaded). Units are those of the label (UI units: Hz,
+kg, %, N, µm, m/s, s); the tab reads ``slider.value`` as before.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from tpm_viz.classroom.guard import guarded
+from tpm_viz.core.errors import TpmVizError
 from tpm_viz.ui.fields import TypedBox
 from tpm_viz.ui.widgets.typed import QUIET, Quantity, TypedField, TypedGroup
 from tpm_viz.viserkit.core import widget_uuid
@@ -72,6 +76,7 @@ class TypedSlider:
         gui = view.gui
         self.view = view
         self.on_change = on_change
+        self._following = False  # the app writes a followed value: the field keeps what is being typed there
         form = gui.add_form(None)
         with form:
             self.slider = gui.add_slider(label, quantity.lo, quantity.hi, step, float(value), hint=hint)
@@ -92,11 +97,36 @@ class TypedSlider:
         self.slider.value = float(value)
         self.box.show({KEY: float(value)}, force=True)
 
+    def follow(self, value: float) -> None:
+        """Write ``value`` [UI unit] into the slider as the app's reading of something that moves by itself (a
+        playback's time): the field shows it unless a text is being typed there (under the hub's lock)."""
+        self._following = True
+        try:
+            self.slider.value = float(value)
+        finally:
+            self._following = False
+
+    def limit(self, lo: float, hi: float, step: float) -> None:
+        """Accept ``[lo, hi]`` with ``step`` [UI units] from now on, in the slider and in the field (a run of
+        another length was loaded); the value in use is kept inside."""
+        self.box.group.limit(float(lo), float(hi))
+        for name, value in (("min", lo), ("max", hi), ("step", step)):
+            if getattr(self.slider, name) != float(value):
+                setattr(self.slider, name, float(value))
+        if not lo <= self.value <= hi:
+            self.follow(min(max(self.value, float(lo)), float(hi)))
+
     def _apply(self, values: Mapping[str, float]) -> None:
-        """A settled text (under the hub's lock): into the slider, then the tab's reaction."""
+        """A settled text (under the hub's lock): into the slider, then the tab's reaction; if that refuses it
+        (:class:`~tpm_viz.TpmVizError`), the slider goes back to the value it had and the refusal is told."""
+        before = self.value
         self.set(values[KEY])
         if self.on_change is not None:
-            self.on_change()
+            try:
+                self.on_change()
+            except TpmVizError:
+                self.set(before)
+                raise
 
     @guarded
     def _on_slider(self, event: Any) -> None:
@@ -104,7 +134,7 @@ class TypedSlider:
         with self.view.hub.lock:
             if self.view.closed:
                 return
-            self.box.show({KEY: float(self.slider.value)}, force=True)
+            self.box.show({KEY: float(self.slider.value)}, force=not self._following)
             self.box.draw(self.view.lang)
             if getattr(event, "client", None) is not None:
                 self.view.client.flush()

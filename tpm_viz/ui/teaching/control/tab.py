@@ -49,7 +49,7 @@ from tpm_viz.ui.teaching.control.text import (
     setup_phrase,
 )
 from tpm_viz.ui.teaching.motion import MotionPlayer, TimeChart
-from tpm_viz.ui.teaching.player.tab import SPEEDS
+from tpm_viz.ui.teaching.player.tab import SPEEDS, time_quantity
 from tpm_viz.ui.teaching.settings import CONTROL_SETTINGS
 from tpm_viz.ui.teaching.stage import CONTROL, ControlNodes, bring, front
 from tpm_viz.ui.widgets.typed_sliders import TypedSlider, add_sliders
@@ -118,7 +118,8 @@ class ControlView:
         self.lesson = gui.add_button("Why computed torque? (run all three)", icon=viser.Icon.SCHOOL, color="teal")
         self.summary = gui.add_html(run_html(None, None))
         self.controls = gui.add_button_group("Playback", ("Play", "Pause", "To start"))
-        self.time = gui.add_slider("Time t (s)", 0.0, 0.2, 0.001, 0.0)
+        self.time_typed = TypedSlider(self.view, "Time t (s)", time_quantity(0.2), 0.001, 0.0, self._typed_time)
+        self.time = self.time_typed.slider
         self.speed = gui.add_dropdown("Speed", tuple(SPEEDS), initial_value="0.05×")
         self.magnify = gui.add_dropdown("Magnify the error", tuple(MAGNIFY), initial_value="×1 (true error)")
         self.error_chart = TimeChart(
@@ -282,8 +283,8 @@ class ControlView:
         e = run.error * 1e6
         self.error_chart.show(run.t, (e[:, 0], e[:, 1], run.error_norm * 1e6))
         self.force_chart.show(run.t, (run.tau[:, 0], run.tau[:, 1], run.tau_ff[:, 0], run.tau_ff[:, 1]))
-        self.time.max = max(float(run.t[-1]), 1e-3)
-        self.time.step = max(float(run.t[-1]) / 400.0, 1e-4)
+        end = max(float(run.t[-1]), 1e-3)
+        self.time_typed.limit(0.0, end, max(end / 400.0, 1e-4))
         bring(self.view, CONTROL)
         self._draw_paths()
 
@@ -316,6 +317,15 @@ class ControlView:
             if t is not None and abs(t - float(self.time.value)) < 1e-9:
                 return  # the echo of a value written by playback
             self.player.seek(float(self.time.value))
+
+    def opened(self) -> None:
+        """The page shows the Control tab (under the hub's lock): its run's paths and ghost in front."""
+        bring(self.view, CONTROL, redraw=True)
+
+    def _typed_time(self) -> None:
+        """A typed time, settled and written into the slider (under the hub's lock): the run at that time."""
+        bring(self.view, CONTROL)
+        self.player.seek(float(self.time.value))
 
     @guarded(on_error=_internal_error)
     def _on_magnify(self, event) -> None:
@@ -376,4 +386,4 @@ class ControlView:
         self.error_chart.mark(t)
         self.force_chart.mark(t)
         if t is not None and abs(float(self.time.value) - t) > 1e-9:
-            self.time.value = float(np.clip(round(t, 4), 0.0, self.time.max))
+            self.time_typed.follow(float(np.clip(round(t, 4), 0.0, self.time.max)))

@@ -4,11 +4,17 @@ drawn beside it, each with its task rectangle.
 Everything is in the tab's own scope under ``/design``, a frame at :data:`AREA` (in front of the live mechanism,
 outside its camera framing), created the first time the *Design* tab draws and hidden by *Back to the mechanism*.
 The map is one batched mesh of :data:`MAP_SIDE` square, one instance per design (column fastest, as
-:class:`~.map.MapSpec` numbers them), so that viser's click event gives the design (``instance_index``).
+:class:`~.map.MapSpec` numbers them), so that viser's click event gives the design (``instance_index``). viser lights
+every mesh (its materials are ``standard`` or ``toon``: the worst viridis row came out bright magenta, the rest
+pastel), so the colours are an image laid over it (:func:`swatches`, unlit: the cells in the legend's colours, in
+the floor's plane at any view), the lit mesh a little smaller beneath (it only takes the clicks). The axis labels
+sit :data:`LABEL_GAP` outside the map, extending away from it (never over a cell or a ring), and
+:meth:`DesignScene.look_map` frames the map large, seen from nearly straight above.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 
 import numpy as np
@@ -22,8 +28,20 @@ from tpm_viz.paper import arrangement as arr
 from tpm_viz.paper.arrangement import Arrangement
 from tpm_viz.ui.teaching.design.drawings import ArrangementDrawing, extent
 from tpm_viz.ui.teaching.design.map import SWEPT, MapSpec, prototype_at
+from tpm_viz.viserkit.core import point_camera
 
-__all__ = ["AREA", "MAP_CORNER", "MAP_SIDE", "MARKS", "DesignScene", "comparison_designs", "map_cell_centres"]
+__all__ = [
+    "AREA",
+    "MAP_CORNER",
+    "MAP_SIDE",
+    "MARKS",
+    "SWATCH_Z",
+    "DesignScene",
+    "comparison_designs",
+    "map_cell_centres",
+    "map_view",
+    "swatches",
+]
 
 AREA = (0.0, -2.0)
 """World XY [m] of the Design area's origin."""
@@ -32,11 +50,25 @@ MAP_SIDE = 0.6
 MAP_CORNER = (-0.7, 0.0)
 """Lower-left corner [m] of the map in the area."""
 MAP_Z = 0.002
+SWATCH_Z = 0.006
+"""Height [m] of the image of the cells' colours: over the lit cells (their top at 0.004 m), under the rings."""
+MARK_Z = 0.008
+SWATCH_PX = 20
+"""Texels of one cell's side in that image (a gap of :data:`GAP_PX` on each side, the floor's colour)."""
+GAP_PX = 1
+FLOOR = (248, 250, 252)
+LABEL_GAP = 0.05
+"""Room [m] between the map's edge and an axis label's anchor (the label extends away from the map)."""
+VIEW_TILT = math.radians(15.0)
+"""How far from straight above :meth:`DesignScene.look_map` looks at the map."""
+VIEW_MARGIN = 1.25
+"""The framed map with its labels, and this much room around them."""
 GAP = 0.12
 """Space [m] between the map and the drawings, and between the drawings."""
 PENDING = (241, 245, 249)
 """A cell not computed yet."""
-MARKS = {"best": (255, 255, 255), "picked": (37, 99, 235), "prototype": (220, 38, 38)}
+MARKS = {"best": (15, 23, 42), "picked": (37, 99, 235), "prototype": (220, 38, 38)}
+"""The best design's ring (near black: the best cell is the yellow end of viridis), the picked one's, the cross."""
 
 
 def map_cell_centres(spec: MapSpec) -> np.ndarray:
@@ -71,6 +103,30 @@ def comparison_designs(
         placed = task.centred_at(float(home[0]), float(home[1]))
         out[kind] = (mine, spec.task if spec is not None and spec.arrangement is kind else placed)
     return out
+
+
+def map_view(fov: float, aspect: float) -> tuple[np.ndarray, np.ndarray]:
+    """Camera ``(position, look_at)`` [m, world] that frames the map with its labels large in a canvas of vertical
+    field of view ``fov`` [rad] and ``aspect`` (width / height), seen :data:`VIEW_TILT` from straight above."""
+    cx, cy = AREA[0] + MAP_CORNER[0] + MAP_SIDE / 2, AREA[1] + MAP_CORNER[1] + MAP_SIDE / 2
+    half = VIEW_MARGIN * (MAP_SIDE / 2 + LABEL_GAP + 0.03)  # the labels' height beyond the gap
+    tan = math.tan(fov / 2) if 0.0 < fov < math.pi else math.tan(math.radians(37.5))
+    distance = half / (tan * min(1.0, aspect if aspect > 0 else 1.0))
+    look_at = np.array([cx, cy, 0.0])
+    return look_at + distance * np.array([0.0, -math.sin(VIEW_TILT), math.cos(VIEW_TILT)]), look_at
+
+
+def swatches(spec: MapSpec, cols: np.ndarray) -> np.ndarray:
+    """The image ``(rows, columns, 3)`` uint8 of the map's colours ``cols`` ``(n, 3)`` (design order: column fastest,
+    row 1 at the bottom): each cell a square of :data:`SWATCH_PX` texels with a gap of the floor's colour."""
+    nx, ny, k = spec.x.count, spec.y.count, SWATCH_PX
+    image = np.empty((ny * k, nx * k, 3), dtype=np.uint8)
+    image[:] = FLOOR
+    grid = np.asarray(cols, dtype=np.uint8).reshape(ny, nx, 3)  # viser lays the image's first row at its -y edge
+    for j in range(ny):
+        for i in range(nx):
+            image[j * k + GAP_PX : (j + 1) * k - GAP_PX, i * k + GAP_PX : (i + 1) * k - GAP_PX] = grid[j, i]
+    return image
 
 
 def _square(cx: float, cy: float, w: float, h: float, z: float) -> np.ndarray:
@@ -112,6 +168,16 @@ class DesignScene:
         if self.area is not None and self.area.visible:
             self.area.visible = False
 
+    def look_map(self) -> None:
+        """Point the tab's camera at the map, framed large for its canvas (:func:`map_view`; shown)."""
+        self.show()
+        camera = self.client.camera
+        try:
+            fov, aspect = float(camera.fov), camera.image_width / max(camera.image_height, 1)
+        except AssertionError:  # no camera message yet
+            fov, aspect = math.radians(75.0), 1.0
+        point_camera(camera, *map_view(fov, aspect))
+
     def look(self) -> None:
         """Point the tab's camera at the area (shown)."""
         self.show()
@@ -126,7 +192,7 @@ class DesignScene:
         scene = self.client.scene
         if self._cells_for != spec or self.cells is None:
             w, h = MAP_SIDE / spec.x.count, MAP_SIDE / spec.y.count
-            box = trimesh.creation.box(extents=(0.92 * w, 0.92 * h, 0.004))
+            box = trimesh.creation.box(extents=(0.8 * w, 0.8 * h, 0.004))  # under its swatch: the clicks
             self.cells = cells = scene.add_batched_meshes_simple(
                 "/design/map/cells",
                 box.vertices,
@@ -142,27 +208,41 @@ class DesignScene:
             cells.on_click(on_click)
             self._cells_for = spec
             x0, y0 = MAP_CORNER
-            for axis, pos, arrow in (("x", (x0, y0 - 0.03), "→"), ("y", (x0 - 0.02, y0 + MAP_SIDE + 0.04), "↑")):
+            for axis, y, anchor, arrow in (
+                ("x", y0 - LABEL_GAP, "top-left", "→"),
+                ("y", y0 + MAP_SIDE + LABEL_GAP, "bottom-left", "↑"),
+            ):
                 a = spec.x if axis == "x" else spec.y
                 text = f"{arrow} {SWEPT[a.name]} {a.start * 1e3:.0f}–{a.stop * 1e3:.0f} mm"
-                scene.add_label(f"/design/map/{axis}", text, position=(*pos, MAP_Z), anchor="top-left")
+                scene.add_label(f"/design/map/{axis}", text, position=(x0, y, MAP_Z), anchor=anchor)
         else:
             self.cells.batched_colors = cols
+        x0, y0 = MAP_CORNER
+        scene.add_image(  # the colours, unlit (module docstring)
+            "/design/map/swatches",
+            swatches(spec, cols),
+            MAP_SIDE,
+            MAP_SIDE,
+            format="png",
+            position=(x0 + MAP_SIDE / 2, y0 + MAP_SIDE / 2, SWATCH_Z),
+            cast_shadow=False,
+            receive_shadow=False,
+        )
         self._marks(spec, best, picked)
 
     def _marks(self, spec: MapSpec, best: int | None, picked: int | None) -> None:
-        """Ring the best cell (white) and the picked one (blue), cross the prototype (red)."""
+        """Ring the best cell (near black) and the picked one (blue), cross the prototype (red)."""
         w, h = MAP_SIDE / spec.x.count, MAP_SIDE / spec.y.count
         centres = map_cell_centres(spec)
         segs, cols = [], []
         for kind, k in (("best", best), ("picked", picked)):
             if k is not None:
-                segs.append(_square(centres[k, 0], centres[k, 1], 0.96 * w, 0.96 * h, MAP_Z + 0.004))
+                segs.append(_square(centres[k, 0], centres[k, 1], 0.96 * w, 0.96 * h, MARK_Z))
                 cols += [MARKS[kind]] * 4
         proto = prototype_at(spec)
         if proto is not None:
             cx, cy = MAP_CORNER[0] + (proto[0] + 0.5) * w, MAP_CORNER[1] + (proto[1] + 0.5) * h
-            r, z = 0.3 * min(w, h), MAP_Z + 0.005
+            r, z = 0.3 * min(w, h), MARK_Z + 0.001
             segs.append(
                 np.array([[[cx - r, cy - r, z], [cx + r, cy + r, z]], [[cx - r, cy + r, z], [cx + r, cy - r, z]]])
             )

@@ -3,9 +3,8 @@ compared side by side (``docs/design.md``).
 
 - **Map.** A task rectangle (mm, typed), an arrangement and two of ``a, b, l_a, Δd`` with ranges and counts (at most
   15 x 15): the designs are evaluated by :func:`tpm_viz.design.indices.evaluate` (every index, cycle time included) in
-  the tab's turns of the fair worker, :data:`~.map.CHUNK` designs a job, a progress line meanwhile. The map
-  is a grid of coloured cells on the floor of the Design area (one batched mesh: a click gives the cell), grey where
-  the design is infeasible, the best cell ringed, the paper's prototype crossed.
+  the tab's turns of the fair worker, :data:`~.map.CHUNK` designs a job, a progress line meanwhile. The map is a grid
+  of coloured cells on the Design area's floor (a click gives the cell), grey where infeasible, the best ringed.
 - **Load.** Clicking a cell, typing its column and row (Enter), or *Load best design*: a perpendicular design
   becomes the tab's mechanism through the *Parameters* tab's path (:func:`tpm_viz.app.transitions.apply_params`,
   the tab's own copy or, for the presenter, the shared one); a parallel design is drawn in the comparison.
@@ -211,7 +210,7 @@ class DesignView:
         self._request += 1
         request = self._request
         self.pick_box.group.limit(1.0, float(max(x.count, y.count)))
-        self._show_area()
+        self._show_area(on_map=True)
         self._redraw()
         return lambda: self._next(request, spec, 0)
 
@@ -370,16 +369,17 @@ class DesignView:
         self.scene.draw_comparison(designs, labels)
 
     # -- the area and the camera ---------------------------------------------------------------------------
-    def _show_area(self) -> None:
-        """Show the Design area (the camera goes there the first time) with the comparison."""
+    def _show_area(self, on_map: bool = False) -> None:
+        """Show the Design area with the comparison; the camera goes there the first time (to the map, framed
+        large, when a map is being computed: ``on_map``)."""
         first = self.scene.show()
         self._draw_comparison()
-        if first:
-            self.scene.look()
+        if on_map or first:
+            self.scene.look_map() if on_map else self.scene.look()
 
     def _look(self) -> None:
         self._show_area()
-        self.scene.look()
+        self.scene.look_map() if self.spec is not None else self.scene.look()
 
     def _back(self) -> None:
         self.scene.hide()

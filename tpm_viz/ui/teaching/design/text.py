@@ -87,13 +87,13 @@ def legend_html(index: str, span: tuple[float, float] | None, feasible: int, tot
             f"<span>{_esc(lang, Phrase('best {value}', value=best))}</span></div>"
         )
     keys = Phrase(
-        "{feasible} of {total} designs cover the task; grey: infeasible (no number). White ring: best design; "
+        "{feasible} of {total} designs cover the task; grey: infeasible (no number). Black ring: best design; "
         "red cross: the paper's prototype.",
         feasible=feasible,
         total=total,
     )
     return (
-        f'<div data-q="design-legend" style="{_STYLE}"><b>{_esc(lang, T(info.label))}</b>{scale}'
+        f'<div data-q="design-legend" style="{_STYLE};padding-right:16px"><b>{_esc(lang, T(info.label))}</b>{scale}'
         f'<div style="color:#64748b">{_esc(lang, keys)}</div></div>'
     )
 

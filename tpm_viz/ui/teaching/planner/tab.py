@@ -226,6 +226,11 @@ class PlannerView:
             "/planner/path", segments(s.p, TRACE_Z, 400), PATH_COLOUR, thickness=2.5, thickness_units="screen"
         )
         show(self._path, front(self.view, PLAN) == PLAN)
+        if not was_playing and "planner" in getattr(self.view.teaching, "open_tabs", ()):
+            try:  # the Planner is open: its plan, not another run, on the mechanism
+                self._replace_other_run()
+            except TpmVizError:
+                pass  # a student on the shared mechanism: the path is shown, the mechanism is the lecturer's
         if was_playing:
             try:
                 self.player.play(SPEEDS.get(self.play_speed.value, 0.1), bool(self.loop.value))
@@ -260,6 +265,22 @@ class PlannerView:
             self.path.value = "waypoints"
             self.waypoints.value = text
         self.request()
+
+    def opened(self) -> None:
+        """The page shows the Planner tab (under the hub's lock): its path in front, and, when the mechanism shows
+        another run (the Control lab's, the Player's: their dynamic load), the plan's start and its forces instead
+        (a pose placed by hand stays). Raises the refusal when this tab may not move the mechanism (a student on the
+        shared one): the path is shown all the same."""
+        bring(self.view, PLAN, redraw=True)
+        self._replace_other_run()
+
+    def _replace_other_run(self) -> None:
+        """The plan's start in place of another run's sample on the mechanism (see :meth:`opened`)."""
+        motion, state = self.player.motion, self.view.session.state
+        if not isinstance(motion, PlanMotion) or motion.params != state.params:
+            return
+        if state.trajectory.kind != "none" and self.player.at(state) is None:
+            self.player.seek(0.0)
 
     # -- playback ------------------------------------------------------------------------------------------
     @guarded(on_error=_internal_error)

@@ -97,7 +97,7 @@ NARROWEST_PX = 303
 320 px wide phone, measured in Chromium (390 px: 373; the docked panel: 365). A wider chart has room to spare."""
 X_LABEL = T("time t (s)")
 FORCE_COLOURS = (hex_colour("tau1"), hex_colour("tau2"))  # τ1, τ2 as in the PNG figures (blue, red)
-LEG_COLOURS = (hex_colour("leg1"), hex_colour("leg2"))  # leg 1 teal, leg 2 purple as in the 3D view
+LEG_COLOURS = (hex_colour("leg1"), hex_colour("leg2"))  # leg 1 teal, leg 2 indigo as in the 3D view
 MARKER = hex_colour("inverse")
 FORCES = (T("Actuator forces τ (paper solid, Pinocchio dotted)"), T("force (N)"), 240)
 KINEMATICS = (  # attribute of Run, title, y-axis label, scale SI -> UI

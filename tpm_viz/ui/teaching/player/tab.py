@@ -5,10 +5,12 @@ run as CSV and the force plot as PNG.
 The run and the playback belong to the session (:mod:`tpm_viz.classroom.runhub`); this view only reads widgets, calls
 :class:`~tpm_viz.classroom.runhub.RunHub` and draws. The duration is a typed field
 (:class:`~tpm_viz.ui.fields.TypedBox`: ``5e-1`` and ``0,5`` are 0.5 s; applied on Enter or after a quiet time; the value
-in use and the plausibility notes under it); the player's refusals (upload, choice, playback, exports) are shown under
-the upload button, to that tab only, and the next success clears them. During playback the charts and the trace are
-refreshed at most :data:`CHART_HZ` times a second (the kinematic charts every other time), with the time slider and the
-summary; the 3D platform moves at every frame, and the last frame is always drawn in full.
+in use and the plausibility notes under it). So is the time: a slider with a typed field
+(:class:`~tpm_viz.ui.widgets.typed_sliders.TypedSlider`, a time from 0 to the run's duration: ``2e-1`` is 0.2 s,
+``abc`` and ``-5`` are refused under it with the time in use). The player's refusals (upload, choice, playback,
+exports) are shown under the upload button, to that tab only, and the next success clears them. During playback the
+charts and the trace are refreshed at most :data:`CHART_HZ` times a second (the kinematic charts every other time),
+with the time slider and the summary; the 3D platform moves at every frame, and the last frame is always drawn in full.
 """
 
 from __future__ import annotations
@@ -35,9 +37,10 @@ from tpm_viz.ui.teaching.player.text import summary_html
 from tpm_viz.ui.teaching.player.trace import PathTrace
 from tpm_viz.ui.teaching.stage import PLAYER, bring, front, show
 from tpm_viz.ui.widgets.typed import QUIET, Quantity, TypedField, TypedGroup, duration_note, force_note
+from tpm_viz.ui.widgets.typed_sliders import TypedSlider
 from tpm_viz.ui.worded import TabGui
 
-__all__ = ["CHART_HZ", "SPEEDS", "PlayerView"]
+__all__ = ["CHART_HZ", "SPEEDS", "PlayerView", "time_quantity"]
 
 SPEEDS = {"0.01×": 0.01, "0.02×": 0.02, "0.05×": 0.05, "0.1×": 0.1, "0.2×": 0.2, "0.5×": 0.5, "1× (real time)": 1.0}
 """Playback speeds (the paper's motions last 0.2-0.5 s)."""
@@ -50,6 +53,11 @@ _UNSET = object()
 def _internal_error(owner, exc: Exception) -> None:
     """The guard's report to the tab whose callback failed (the traceback is in the server log)."""
     owner.view.refuse(Phrase("internal error ({kind}), logged on the server", kind=type(exc).__name__), resync=False)
+
+
+def time_quantity(duration: float) -> Quantity:
+    """What a *Time t (s)* box accepts: a time from 0 to the run's ``duration`` [s] (the Player, the Control lab)."""
+    return Quantity("t", "s", 1.0, 0.0, float(duration))
 
 
 def _option(source: Source) -> str:
@@ -95,7 +103,8 @@ class PlayerView:
         self.note = Note(gui)
         """Refusals of the player's controls (upload, choice, playback, exports), under the upload button."""
         self.controls = gui.add_button_group("Playback", ("Play", "Pause", "To start"))
-        self.time = gui.add_slider("Time t (s)", 0.0, 0.2, 0.001, 0.0)
+        self.time_typed = TypedSlider(self.view, "Time t (s)", time_quantity(0.2), 0.001, 0.0, self._typed_time)
+        self.time = self.time_typed.slider
         self.speed = gui.add_dropdown("Speed", tuple(SPEEDS), initial_value="0.05×")
         self.loop = gui.add_checkbox("Loop", False)
         self.summary = gui.add_html("")
@@ -230,6 +239,15 @@ class PlayerView:
             t = read_number(self.time.value, T("time t"), lo=0.0, hi=1e4)
             self.runs.seek(self.session, t, origin=self.view)
 
+    def opened(self) -> None:
+        """The page shows the Player tab (under the hub's lock): its path and trace in front."""
+        bring(self.view, PLAYER, redraw=True)
+
+    def _typed_time(self) -> None:
+        """A typed time, settled and written into the slider (under the hub's lock): the run at that time."""
+        bring(self.view, PLAYER)
+        self.runs.seek(self.session, float(self.time.value), origin=self.view)
+
     def _download(self, name: str, data: bytes) -> None:
         self.view.client.send_file_download(name, data, save_immediately=True)
 
@@ -305,13 +323,19 @@ class PlayerView:
             self.charts.show_time(t, forces_only=frame.in_drag and self._pushes % 2 == 1)
             self.trace.show_time(run, t if in_front else None)
             if t is not None:
-                self._put(self.time, float(np.clip(round(t, 4), 0.0, self.time.max)))
+                self._follow_time(float(np.clip(round(t, 4), 0.0, self.time.max)))
         if due or new_run or force:
             shown_t = self._shown_t if self._shown_t is not _UNSET else t
             self.summary.content = summary_html(ps, run, shown_t, self.view.lang)
             self.duration.notes = () if run is None else (duration_note(run.duration), force_note(run.peak))
             self.duration.draw(self.view.lang)
             self.note.draw(self.view.lang)
+
+    def _follow_time(self, t: float) -> None:
+        """The time shown [s] (the run's, as it plays or was sought): in the slider, and in the typed field unless
+        a time is being typed there."""
+        self.time_typed.follow(t)
+        self._written[id(self.time)] = self.time.value
 
     def _set_run(self, run) -> None:
         self._run = run
@@ -329,8 +353,7 @@ class PlayerView:
         self._put(self.choice, _option(run.source))
         self.duration.show({"T": run.duration})
         self.duration.disable(run.source.kind not in ("line", "circle"))
-        self.time.max = run.duration
-        self.time.step = max(run.duration / 400.0, 1e-4)
+        self.time_typed.limit(0.0, run.duration, max(run.duration / 400.0, 1e-4))
 
     def close(self) -> None:
         """The tab went away (nothing to release: scene nodes go with the client)."""
