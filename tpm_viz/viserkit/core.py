@@ -157,10 +157,21 @@ class ClientDoor:
     def __init__(self, client: viser.ClientHandle) -> None:
         self._conn = client._websock_connection
         self._gui = client.gui
+        self._client_id = client.client_id
+        self.server: viser.ViserServer = client._viser_server
+        """The tab's server (its upload budget: :func:`~.uploads.budget_of`)."""
         self.gui_update: wire.GuiUpdate = cast(wire.GuiUpdate, self._gui._handle_gui_updates)
         """viser's own handler of ``GuiUpdateMessage`` (call it to let a message through)."""
         self.upload_start: wire.Upload = cast(wire.Upload, self._gui._handle_file_transfer_start)
         self.upload_part: wire.Upload = cast(wire.Upload, self._gui._handle_file_transfer_part)
+
+    def address(self) -> str:
+        """The client address of the tab (as :class:`~tpm_viz.ui.classroom.Handshakes` read it), or ``""``."""
+        request = connection_request(self.server, self._client_id)
+        if request is None:
+            return ""
+        address = request[0]
+        return str(address[0] if isinstance(address, tuple) and address else address)
 
     def widget(self, uuid: str) -> Any:
         """The GUI handle with this uuid, or None."""

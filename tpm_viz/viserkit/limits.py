@@ -13,7 +13,8 @@
   outgoing backlog (messages queued and not yet written: a tab that stopped reading) stays over
   :attr:`Limits.max_backlog_bytes` for :attr:`Limits.backlog_grace` seconds, and meanwhile runs none of its callbacks;
   after tabs leave it returns freed heap to the system (``malloc_trim``); at most :attr:`Limits.max_connections`
-  tabs (the next one is told so in a notification, then closed). Uploads are bounded per tab in :mod:`.transport`.
+  tabs (the next one is told so in a notification, then closed). Uploads are bounded per tab, per address and per
+  server in :mod:`.transport` and :mod:`.uploads` (a tab's bytes in flight given back when it leaves).
 - **Well-formed messages only**: every incoming message is checked against its declared field types
   (:func:`~.transport.message_problem`) before viser dispatches it; a handler that still fails is one log line. A
   tab that sends more than :attr:`Limits.max_malformed` malformed messages within :attr:`Limits.malformed_window`
@@ -40,6 +41,7 @@ import viser
 from tpm_viz.classroom.guard import FAULTS, log_fault, report
 from tpm_viz.viserkit.core import ServerDoor, thread_pool
 from tpm_viz.viserkit.transport import message_problem
+from tpm_viz.viserkit.uploads import budget_of
 from tpm_viz.viserkit.wire import Incoming, Wrapper
 
 __all__ = [
@@ -204,6 +206,8 @@ class ServerGuard:
         self._pool = pool = thread_pool(server)
         self._submit = pool.__dict__.get("submit")  # an instance's own (the callbacks' guard), or None: the class's
         self.gate = Gate(pool.submit, limits.max_callbacks_per_tab)
+        self.uploads = budget_of(server)
+        """The server's bytes of uploads in flight (:mod:`.uploads`): a tab's are given back when it leaves."""
         pool.submit = self.gate.submit
         self.accepted: set[int] = set()
         self.refused: set[int] = set()
@@ -237,6 +241,7 @@ class ServerGuard:
         self.refused.discard(client_id)
         self._malformed.pop(client_id, None)
         self.gate.forget(client_id)
+        self.uploads.leave(client_id)
         FAULTS.forget(client_id)
 
     def _wrap(self, log: bool) -> Wrapper:
