@@ -16,7 +16,7 @@ folds to its rail (viser's ``minimize``: the 3D canvas is then the whole screen 
 brings it back for the lecturer. A box of live numbers floats over the bottom of the canvas while the panel is folded
 (a separate viser panel, shown by the style sheet only then; the framing keeps its band free): the pose status and
 its warnings at :data:`BANNER_PX`, p, d, τ₁ and τ₂ with their bars at :data:`READOUT_PX` CSS pixels. With the panel
-open, its readout is the same compact one (:data:`~.panels.FOLDED` left out) in large, dark type, the panel wider
+open, its readout is the same compact one (:data:`~.panel_css.FOLDED` left out) in large, dark type, the panel wider
 (:data:`PRESENTATION_WIDTH`); thicker lines and larger labels in 3D (:mod:`.tabscene`), the player's charts with 18 px
 dark axes (:data:`~.teaching.player.charts.LARGE`). All of it is this tab's own: the style sheet is an HTML element of
 the tab's GUI, and every tab's GUI is its own.
@@ -34,11 +34,12 @@ import numpy as np
 import viser
 
 from tpm_viz.classroom.guard import guarded
+from tpm_viz.core.markup import Html, html
 from tpm_viz.core.params import Params
 from tpm_viz.core.words import Lang, T
 from tpm_viz.drawing import meshes
 from tpm_viz.ui.language import KEEP_ALL
-from tpm_viz.ui.panels import FOLDED
+from tpm_viz.ui.panel_css import FOLDED
 from tpm_viz.ui.scene import camera_pose
 from tpm_viz.ui.widgets.framing import LIVE_BAND, frame_box
 from tpm_viz.viserkit.core import point_camera
@@ -101,7 +102,7 @@ _SHEET_PCT = round(SHEET * 100)
 INSET = 16
 """Room at the right of the readout and the force column [CSS px]: the panel's scroll bar (11 px, drawn over its
 content) and 5 px to spare, so "N" never touches the panel's edge."""
-PHONE_CSS = f"""<style>
+PHONE_CSS = Html(f"""<style>
 div:has(> [data-q="banner"]) {{ padding-right: {INSET}px; }}
 @media {_PHONE} {{
   [data-guide] > div > span {{ max-width: 100%; overflow-wrap: anywhere; }}
@@ -122,14 +123,14 @@ div:has(> [data-q="banner"]) {{ padding-right: {INSET}px; }}
   .mantine-Button-root, .mantine-Tabs-tab {{ min-height: {BUTTON_TOUCH}px !important; }}
   .mantine-ActionIcon-root {{ min-width: {BUTTON_TOUCH}px !important; min-height: {BUTTON_TOUCH}px !important; }}
 }}
-</style>"""
+</style>""")
 """The readout's room at the panel's edge (:data:`INSET`), the phone layout and touch targets (by viewport and
 pointer: no switch), in every tab."""
 
 BANNER_PX = 20
 """Font size of the pose status and its warnings in the box of live numbers [CSS px]."""
 
-PRESENTATION_CSS = f"""<style>
+PRESENTATION_CSS = Html(f"""<style>
 div:has(> [data-q="banner"]) {{ color: #0f172a; padding-right: {INSET}px; }}
 [data-q="banner"] {{ font-size: {BANNER_PX}px !important; }}
 div:has(> [data-q="banner"]) td {{ font-size: 17px !important; color: #0f172a !important; }}
@@ -151,7 +152,7 @@ body:has([data-dock-rail-root]) [data-floating-window]:has([data-live]) {{ visib
 [data-live] table {{ margin-top: 2px !important; }}
 [data-live] tbody {{ display: flex; flex-wrap: wrap; column-gap: 1.2em; }}
 @media {_PHONE} {{ div:has(> div > [data-live]) {{ display: none !important; }} }}
-</style>"""
+</style>""")
 """Presentation mode: large, dark type (the charts' titles and legends too; their axes are drawn on a canvas, sized by
 :meth:`~.teaching.charts.Charts.set_presentation`); the box of banner and forces shown only while the panel is
 collapsed."""
@@ -310,7 +311,7 @@ class Look:
         """Copy the panel's dashboard into the box of banner and forces (presentation mode only)."""
         if not self.presentation or self.live_html is None:
             return
-        content = f'<div data-live="1">{self.view.panel.dashboard.content}</div>'
+        content = html('<div data-live="1">{dashboard}</div>', dashboard=self.view.panel.dashboard.content)
         if self.live_html.content != content:
             self.live_html.content = content
         style = PRESENTATION_CSS + (KEEP_ALL if self.view.lang is Lang.KO else "")

@@ -5,8 +5,12 @@ HTML, chart titles, series and axis labels). :class:`TabGui` creates each elemen
 them (:func:`show_text`: a whole text of the catalogue with :func:`tpm_viz.core.words.shown`; each text between two tags
 of HTML with :func:`tpm_viz.core.words.shown_html`) and returns a :class:`Worded` handle over viser's own:
 
-- setting a text (``handle.content = "<b>Forces</b>"``, ``label``, ``hint``, ``options``, ``title``, ``series``,
-  ``axes``) keeps the English and writes the shown text to viser's handle; reading it gives the English back;
+- setting a text (``handle.content = Html("<b>Forces</b>")``, ``label``, ``hint``, ``options``, ``title``,
+  ``series``, ``axes``) keeps the English and writes the shown text to viser's handle; reading it gives the English
+  back;
+- an HTML or Markdown element shows as markup only what the code built as such (:class:`~tpm_viz.core.markup.Html`,
+  :class:`~tpm_viz.core.markup.Markdown`); anything else is text, escaped here (:func:`as_html`,
+  :func:`as_markdown`): a share link's label, a file name, a lesson's words are never read as markup by the page;
 - a choice (:class:`Choice`: a dropdown, a button group) reads and writes its English option, whatever the page
   shows; the page's choice, made in the tab's language, is mapped back to the English option at the same place;
 - ``on_update`` / ``on_click`` / ``on_upload`` / ``on_submit`` callbacks get an event whose ``target`` is the
@@ -29,10 +33,11 @@ from typing import Any, ClassVar, TypeVar
 
 import viser
 
+from tpm_viz.core.markup import Html, Markdown, escape, markdown_text
 from tpm_viz.core.words import Lang, shown, shown_html
 from tpm_viz.viserkit.core import relabel_tab, removed
 
-__all__ = ["TEXTS", "Choice", "Tab", "TabGui", "Tabs", "Worded", "show_text"]
+__all__ = ["TEXTS", "Choice", "Tab", "TabGui", "Tabs", "Worded", "as_html", "as_markdown", "show_text"]
 
 TEXTS = frozenset({"label", "hint", "content", "title", "options", "series", "axes"})
 """The text properties of a GUI element that a tab shows in its language."""
@@ -46,8 +51,23 @@ def _shown_content(lang: Lang, text: str) -> str:
     return whole if whole is not text else shown_html(lang, text)
 
 
+def as_html(content: object) -> Html:
+    """What an HTML element shows: an :class:`~tpm_viz.core.markup.Html` as markup, anything else as text (escaped:
+    :mod:`tpm_viz.core.markup`)."""
+    return content if isinstance(content, Html) else escape("" if content is None else content)
+
+
+def as_markdown(content: object) -> Markdown:
+    """What a Markdown element shows: a :class:`~tpm_viz.core.markup.Markdown` as Markdown, anything else as text
+    (every Markdown and HTML character escaped)."""
+    return content if isinstance(content, Markdown) else markdown_text("" if content is None else content)
+
+
 def show_text(lang: Lang, name: str, value: Any) -> Any:
-    """The value of the text property ``name`` as a tab in ``lang`` shows it (see the module docstring)."""
+    """The value of the text property ``name`` as a tab in ``lang`` shows it (see the module docstring); a text is
+    sent as a plain ``str`` (viser's encoder takes no subclass, e.g. :class:`~tpm_viz.core.markup.Html`)."""
+    if isinstance(value, str):
+        value = str(value)
     if lang is Lang.EN or value is None:
         return value
     if name == "content" and isinstance(value, str):
@@ -69,6 +89,9 @@ class Worded:
 
     _AS: ClassVar[dict[str, str]] = {}
     """Text property -> the name :func:`show_text` translates it as (markdown: a whole text, not HTML)."""
+    _CONTENT: ClassVar[Any] = staticmethod(as_html)
+    """What a ``content`` becomes before it is shown (an HTML element: :func:`as_html`; Markdown:
+    :func:`as_markdown`): no text reaches the page as markup unless the code built it as such."""
 
     def __init__(self, gui: TabGui, handle: Any, texts: dict[str, Any]) -> None:
         object.__setattr__(self, "handle", handle)
@@ -84,6 +107,8 @@ class Worded:
         if isinstance(getattr(type(self), name, None), property):
             object.__setattr__(self, name, value)
         elif name in TEXTS:
+            if name == "content":
+                value = type(self)._CONTENT(value)
             self._texts[name] = value
             setattr(self.handle, name, self._show(name, value))
         else:
@@ -145,10 +170,11 @@ class Worded:
         return func
 
 
-class Markdown(Worded):
+class MarkdownElement(Worded):
     """A markdown element: its content shown as a whole text of the catalogue, as its label would be."""
 
     _AS: ClassVar[dict[str, str]] = {"content": "label"}
+    _CONTENT: ClassVar[Any] = staticmethod(as_markdown)
 
 
 class Choice(Worded):
@@ -278,10 +304,16 @@ class TabGui:
         return self._new(Tabs, self.gui.add_panel(**kw))
 
     # -- texts and charts ---------------------------------------------------------------------------------------
-    def add_markdown(self, content: str, **kw: Any) -> Markdown:
-        return self._new(Markdown, self.gui.add_markdown(self._show("label", content), **kw), content=content)
+    def add_markdown(self, content: Markdown | str, **kw: Any) -> MarkdownElement:
+        """A Markdown element: ``content`` as Markdown if it is a :class:`~tpm_viz.core.markup.Markdown`, else as
+        text."""
+        content = as_markdown(content)
+        handle = self.gui.add_markdown(self._show("label", content), **kw)
+        return self._new(MarkdownElement, handle, content=content)
 
-    def add_html(self, content: str, **kw: Any) -> Worded:
+    def add_html(self, content: Html | str, **kw: Any) -> Worded:
+        """An HTML element: ``content`` as markup if it is an :class:`~tpm_viz.core.markup.Html`, else as text."""
+        content = as_html(content)
         return self._new(Worded, self.gui.add_html(self._show("content", content), **kw), content=content)
 
     def add_uplot(

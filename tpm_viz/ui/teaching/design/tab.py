@@ -26,6 +26,7 @@ from tpm_viz.app.readouts import reason
 from tpm_viz.classroom.guard import guarded
 from tpm_viz.classroom.worker import Worker
 from tpm_viz.core.errors import BusyError, InputError, TpmVizError
+from tpm_viz.core.markup import Markdown, escape
 from tpm_viz.core.params import Params
 from tpm_viz.core.words import Phrase, T, say
 from tpm_viz.design.atlas import Row
@@ -81,9 +82,11 @@ class DesignView:
     def build(self, gui: TabGui) -> None:
         """The *Design* tab's widgets (inside the tab's context)."""
         gui.add_markdown(
-            "Size the machine for a task: a map of designs over two dimensions, coloured by an index; click a cell "
-            "(or type its column and row) to load the design. The map and the comparison are drawn in the Design "
-            "area of the scene."
+            Markdown(
+                "Size the machine for a task: a map of designs over two dimensions, coloured by an index; click a cell "
+                "(or type its column and row) to load the design. The map and the comparison are drawn in the Design "
+                "area of the scene."
+            )
         )
         self.arrangement = gui.add_dropdown(
             "Arrangement", tuple(a.value for a in Arrangement), initial_value="perpendicular"
@@ -331,7 +334,7 @@ class DesignView:
         self._compare_request += 1
         request = self._compare_request
         self.compare_note = T("Comparing: each arrangement at these dimensions and at its own optimum (5-30 s)…")
-        self.compare_status.content = say(self.view.lang, self.compare_note)
+        self.compare_status.content = escape(say(self.view.lang, self.compare_note))
         self._show_area()
         return lambda: self.worker.submit(
             "design-compare",
@@ -392,6 +395,6 @@ class DesignView:
         """The tab's language changed: every text of the tab again, in it (under the hub's lock)."""
         lang = self.view.lang
         self._redraw()
-        self.compare_status.content = say(lang, self.compare_note) if self.compare_note is not None else ""
+        self.compare_status.content = escape(say(lang, self.compare_note) if self.compare_note is not None else "")
         self.table.content = text.table_html(self.compared, text.HOLDS[self._hold.value], lang) if self.compared else ""
         self._draw_comparison()

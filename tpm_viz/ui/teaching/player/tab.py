@@ -25,6 +25,7 @@ from tpm_viz.classroom.runhub import RunHub, following
 from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.core.csvio import format_columns
 from tpm_viz.core.errors import InputError, TpmVizError
+from tpm_viz.core.markup import Markdown
 from tpm_viz.core.words import Phrase, T
 from tpm_viz.drawing.figures import force_plot_png, force_plot_svg
 from tpm_viz.paper.trajectories import DEFAULT_DURATIONS
@@ -77,9 +78,11 @@ class PlayerView:
     def build(self, gui: TabGui) -> None:
         """The *Player* tab's widgets (inside the tab's context)."""
         gui.add_markdown(
-            "Play a trajectory: the platform follows it, leaves a trace, and the charts mark the current time. "
-            "Your own CSV needs the columns `t,p1,p2` (s, m), at least 4 rows, at most "
-            f"{MAX_UPLOAD_BYTES / 2**20:g} MiB; it must stay inside the stroke and clear of the singularities."
+            Markdown(
+                "Play a trajectory: the platform follows it, leaves a trace, and the charts mark the current time. "
+                "Your own CSV needs the columns `t,p1,p2` (s, m), at least 4 rows, at most "
+                f"{MAX_UPLOAD_BYTES / 2**20:g} MiB; it must stay inside the stroke and clear of the singularities."
+            )
         )
         self.choice = gui.add_dropdown("Trajectory", (NONE, *PAPER), initial_value=NONE)
         quantity = Quantity("T", "s", 1.0, MIN_DURATION, MAX_DURATION)
