@@ -35,7 +35,7 @@ from tpm_viz.core.words import Lang
 from tpm_viz.ui.fields import Note, TypedBox
 from tpm_viz.ui.panel_css import fold_css, slider_css
 from tpm_viz.ui.widgets.typed import QUIET, Quantity, TypedField, TypedGroup, force_note
-from tpm_viz.ui.worded import TabGui, Tabs, Worded
+from tpm_viz.ui.worded import TabGui, Tabs, Worded, put, stored
 
 __all__ = ["ACTUATOR_HINT", "ACTUATOR_LABELS", "GROUPS", "GUIDE_HTML", "PARAM_LABELS", "Panel", "slider_css"]
 
@@ -333,13 +333,13 @@ class Panel:
             self._written.clear()
 
     def _put(self, handle, value) -> None:
-        """Write a widget value and remember it (see :meth:`is_echo`). The value the server wrote last is not
-        written again over one the page sent since: that input's callback is on its way and applies it (or refuses
-        it and shows the state again); writing first would make it look like an echo and lose it."""
+        """Write a widget value and remember it (see :meth:`is_echo`), never over a value the page sent since
+        (:mod:`tpm_viz.viserkit.inputs`): that input's callback applies it (or refuses it and shows the state
+        again); writing first would make it look like an echo and lose it."""
         if self._written.get(id(handle), _UNSET) == value and handle.value != value:
             return
-        handle.value = value
-        self._written[id(handle)] = handle.value
+        if put(handle, value):
+            self._written[id(handle)] = stored(handle)
 
     def is_echo(self, *handles) -> bool:
         """Whether these widgets still hold the values the server wrote last: then a callback that reads them

@@ -25,7 +25,6 @@ the callbacks skip the server's own echoes of that). Texts built with numbers ar
 from __future__ import annotations
 
 import dataclasses
-import functools
 import inspect
 import threading
 from collections.abc import Callable, Sequence
@@ -33,55 +32,32 @@ from typing import Any, ClassVar, TypeVar
 
 import viser
 
-from tpm_viz.core.markup import Html, Markdown, escape, markdown_text
-from tpm_viz.core.words import Lang, shown, shown_html
+from tpm_viz.core.markup import Html, Markdown
+from tpm_viz.core.words import Lang
+from tpm_viz.ui.shown import as_html, as_markdown, show_text
 from tpm_viz.viserkit.core import relabel_tab, removed
+from tpm_viz.viserkit.inputs import running, sent, writable
 
-__all__ = ["TEXTS", "Choice", "Tab", "TabGui", "Tabs", "Worded", "as_html", "as_markdown", "show_text"]
+__all__ = ["TEXTS", "Choice", "Tab", "TabGui", "Tabs", "Worded", "as_html", "as_markdown", "put", "show_text", "stored"]
 
 TEXTS = frozenset({"label", "hint", "content", "title", "options", "series", "axes"})
 """The text properties of a GUI element that a tab shows in its language."""
 
 
-@functools.lru_cache(maxsize=512)
-def _shown_content(lang: Lang, text: str) -> str:
-    """An HTML or markdown text as ``lang`` shows it (memoised: every tab of a session in one language is sent the
-    same dashboard and equations at each frame)."""
-    whole = shown(lang, text)
-    return whole if whole is not text else shown_html(lang, text)
+def put(handle: Any, value: Any) -> bool:
+    """Write a widget's value unless an input of the browser is on its way to its callback (:meth:`Worded.put`;
+    a handle that is not a :class:`Worded`, e.g. a test's stand-in, likewise). -> whether it was written."""
+    if isinstance(handle, Worded):
+        return handle.put(value)
+    if not writable(handle):
+        return False
+    handle.value = value
+    return True
 
 
-def as_html(content: object) -> Html:
-    """What an HTML element shows: an :class:`~tpm_viz.core.markup.Html` as markup, anything else as text (escaped:
-    :mod:`tpm_viz.core.markup`)."""
-    return content if isinstance(content, Html) else escape("" if content is None else content)
-
-
-def as_markdown(content: object) -> Markdown:
-    """What a Markdown element shows: a :class:`~tpm_viz.core.markup.Markdown` as Markdown, anything else as text
-    (every Markdown and HTML character escaped)."""
-    return content if isinstance(content, Markdown) else markdown_text("" if content is None else content)
-
-
-def show_text(lang: Lang, name: str, value: Any) -> Any:
-    """The value of the text property ``name`` as a tab in ``lang`` shows it (see the module docstring); a text is
-    sent as a plain ``str`` (viser's encoder takes no subclass, e.g. :class:`~tpm_viz.core.markup.Html`)."""
-    if isinstance(value, str):
-        value = str(value)
-    if lang is Lang.EN or value is None:
-        return value
-    if name == "content" and isinstance(value, str):
-        return _shown_content(lang, value)
-    if isinstance(value, str):
-        return shown(lang, value)
-    if name in ("series", "axes") and isinstance(value, (tuple, list)):  # uPlot: dictionaries with a "label"
-        return tuple(
-            {**v, "label": shown(lang, v["label"])} if isinstance(v, dict) and isinstance(v.get("label"), str) else v
-            for v in value
-        )
-    if isinstance(value, (tuple, list)):
-        return tuple(shown(lang, v) if isinstance(v, str) else v for v in value)
-    return value
+def stored(handle: Any) -> Any:
+    """A widget's value as viser holds it now (not the one its running callback's event brought)."""
+    return handle.handle.value if isinstance(handle, Worded) else handle.value
 
 
 class Worded:
@@ -101,7 +77,12 @@ class Worded:
 
     def __getattr__(self, name: str) -> Any:
         texts = self.__dict__.get("_texts", {})
-        return texts[name] if name in texts else getattr(self.__dict__["handle"], name)
+        if name in texts:
+            return texts[name]
+        handle = self.__dict__["handle"]
+        if name == "value":  # in its own callback: the value its event brought (viserkit/inputs.py)
+            return sent(handle, handle.value)
+        return getattr(handle, name)
 
     def __setattr__(self, name: str, value: Any) -> None:
         if isinstance(getattr(type(self), name, None), property):
@@ -111,8 +92,19 @@ class Worded:
                 value = type(self)._CONTENT(value)
             self._texts[name] = value
             setattr(self.handle, name, self._show(name, value))
+        elif name == "value":
+            self.put(value)
         else:
             setattr(self.handle, name, value)
+
+    def put(self, value: Any) -> bool:
+        """Write the widget's value, unless a value the browser sent is on its way to this widget's callback
+        (:mod:`tpm_viz.viserkit.inputs`: a redraw, a deferred build or a restore never writes over an input; its
+        callback applies it, or refuses it and writes the state again). -> whether it was written."""
+        if not writable(self.handle):
+            return False
+        self.handle.value = value
+        return True
 
     def __enter__(self) -> Worded:
         self.handle.__enter__()
@@ -143,12 +135,20 @@ class Worded:
 
             async def run_async(event: Any) -> None:
                 if (ours := event_of(event)) is not None:
+                    if getattr(event, "client", None) is not None:
+                        with running(self.handle):  # awaited by viser on the loop at once: nothing came between
+                            pass
                     await func(ours)
 
             return run_async
 
         def run(event: Any) -> None:
-            if (ours := event_of(event)) is not None:
+            if (ours := event_of(event)) is None:
+                return
+            if getattr(event, "client", None) is None:  # the server's own write, echoed: no input applied
+                func(ours)
+                return
+            with running(self.handle, event):  # the inputs arrived so far are this call's (viserkit/inputs.py)
                 func(ours)
 
         return run
@@ -189,8 +189,9 @@ class Choice(Worded):
 
     @property
     def value(self) -> Any:
-        """The English option chosen (the page's choice mapped back; a value of no option as it is)."""
-        raw, english = self.handle.value, tuple(self._texts["options"])
+        """The English option chosen (the page's choice mapped back; a value of no option as it is; in its own
+        callback, the one its event brought)."""
+        raw, english = sent(self.handle, self.handle.value), tuple(self._texts["options"])
         if raw in english and self._gui.lang is Lang.EN:
             return raw
         options = tuple(self.handle.options)
@@ -204,11 +205,15 @@ class Choice(Worded):
 
     @value.setter
     def value(self, value: Any) -> None:
+        self.put(value)
+
+    def put(self, value: Any) -> bool:
+        """Write the English option ``value`` (shown in the tab's language), unless an input is on its way."""
         english = tuple(self._texts["options"])
         options = tuple(self.handle.options)
         if value in english and len(options) == len(english):
             value = options[english.index(value)]
-        self.handle.value = value
+        return super().put(value)
 
     def relabel(self) -> None:
         """Options first, then the value (the same English option), then the other texts."""

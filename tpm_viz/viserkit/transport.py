@@ -50,6 +50,7 @@ from tpm_viz.app.inputs import MAX_TEXT, MAX_UPLOAD_BYTES, TOO_LARGE, value_prob
 from tpm_viz.classroom.guard import log_fault
 from tpm_viz.core.words import Lang, Phrase, T, say
 from tpm_viz.viserkit.core import ClientDoor, Malformed, widget_value
+from tpm_viz.viserkit.inputs import arrived
 from tpm_viz.viserkit.patches import skipped
 from tpm_viz.viserkit.uploads import UploadBudget, budget_of, expire_later
 
@@ -103,6 +104,7 @@ def harden(
             if problem is not None:
                 log_fault(cid, "gui", f"GUI update dropped: {problem}")
                 return
+            arrived(handle, message.updates)  # its callback will apply it: no redraw writes over it meanwhile
         await door.gui_update(client_id, message)
 
     door.replace(gui_update, uploads.start, uploads.part)

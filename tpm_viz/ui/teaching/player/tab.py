@@ -36,7 +36,7 @@ from tpm_viz.ui.teaching.player.text import summary_html
 from tpm_viz.ui.teaching.player.trace import PathTrace
 from tpm_viz.ui.teaching.stage import PLAYER, bring, front, show
 from tpm_viz.ui.widgets.typed import QUIET, Quantity, TypedField, TypedGroup, duration_note, force_note
-from tpm_viz.ui.worded import TabGui
+from tpm_viz.ui.worded import TabGui, put, stored
 
 __all__ = ["CHART_HZ", "SPEEDS", "PlayerView"]
 
@@ -123,9 +123,10 @@ class PlayerView:
         return self.view.session
 
     def _put(self, handle, value) -> None:
-        if handle.value != value:
-            handle.value = value
-        self._written[id(handle)] = handle.value
+        """Write a widget value and remember it (see :meth:`_is_echo`), never over an input on its way
+        (:mod:`tpm_viz.viserkit.inputs`)."""
+        if stored(handle) == value or put(handle, value):
+            self._written[id(handle)] = stored(handle)
 
     def _is_echo(self, *handles) -> bool:
         return all(self._written.get(id(h), _UNSET) == h.value for h in handles)
