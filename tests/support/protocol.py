@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import asyncio
 import os
+import socket
 import subprocess
 import sys
 import tempfile
@@ -58,19 +59,25 @@ class ServerProcess:
     """``python app.py --port 0`` on loopback, in a child process."""
 
     def __init__(
-        self, presenter_token: str | None = None, session: Path | None = None, args: tuple[str, ...] = ()
+        self,
+        presenter_token: str | None = None,
+        session: Path | None = None,
+        args: tuple[str, ...] = (),
+        root: Path | None = None,
     ) -> None:
         """``session``: the session file (default: a new one in a temporary folder, never the user's);
-        ``args``: more command-line options (e.g. ``--fresh``)."""
+        ``args``: more command-line options (e.g. ``--fresh``); ``root``: the checkout whose ``app.py`` runs
+        (default: this one; a benchmark measures another, e.g. the code before a change)."""
+        root = ROOT if root is None else Path(root)
         self.log = tempfile.NamedTemporaryFile(prefix="tpm-viz-server-", suffix=".log", delete=False)
         if session is None:
             session = Path(tempfile.mkdtemp(prefix="tpm-viz-session-")) / "session.json"
         self.session = session
-        cmd = [sys.executable, str(ROOT / "app.py"), "--host", "127.0.0.1", "--port", "0", "--session", str(session)]
+        cmd = [sys.executable, str(root / "app.py"), "--host", "127.0.0.1", "--port", "0", "--session", str(session)]
         if presenter_token:
             cmd += ["--presenter-token", presenter_token]
         cmd += list(args)
-        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=self.log, text=True, cwd=ROOT)
+        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=self.log, text=True, cwd=root)
         line = self.proc.stdout.readline().strip()
         if not line.startswith("tpm-viz serving at http://127.0.0.1:"):
             self.stop()
@@ -263,9 +270,15 @@ def wait_for(predicate, timeout: float = 30.0, interval: float = 0.01, what: str
 class ProtocolClient:
     """A browser stand-in at the websocket level (see the module docstring)."""
 
-    def __init__(self, port: int) -> None:
+    def __init__(self, port: int, source: str | None = None) -> None:
+        """``source``: the loopback address to connect from (e.g. ``127.0.0.2``: another device)."""
+        sock = None if source is None else socket.create_connection(("127.0.0.1", port), 30, (source, 0))
         self.ws = connect_sync(
-            f"ws://127.0.0.1:{port}", subprotocols=[f"viser-v{viser.__version__}"], max_size=None, compression=None
+            f"ws://127.0.0.1:{port}",
+            subprotocols=[f"viser-v{viser.__version__}"],
+            max_size=None,
+            compression=None,
+            sock=sock,
         )
         self.received = 0
         self.nodes: dict[tuple[str, str], dict] = {}

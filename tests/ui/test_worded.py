@@ -21,6 +21,7 @@ from websockets.sync.client import connect as connect_sync
 
 from tests.support.protocol import CAMERA, ProtocolClient, wait_for
 from tpm_viz.app.readouts import LOAD_MODES
+from tpm_viz.core.markup import Html
 from tpm_viz.core.words import Lang
 from tpm_viz.ui.worded import TabGui
 from tpm_viz.viserkit.probe import arrive, outgoing_replaced, widget_uuid
@@ -160,7 +161,7 @@ def test_handles_keep_english_for_the_code_and_show_the_catalogue(plain_gui):
     gui = TabGui(plain_gui, Lang.KO)
     load = gui.add_dropdown("Load", LOAD_MODES, initial_value="dynamic", hint="Forward kinematics")
     steps = gui.add_button_group("Playback", ("Play", "Pause", "To start"))
-    note = gui.add_html("<p><b>Forces</b> 3 N</p>")
+    note = gui.add_html(Html("<p><b>Forces</b> 3 N</p>"))  # the code's markup (text would be escaped)
     seen: list = []
     load.on_update(lambda event: seen.append((event.target, event.target.value)))
     assert tuple(load.handle.options) == (KO["static"], KO["dynamic"]) and load.handle.value == KO["dynamic"]

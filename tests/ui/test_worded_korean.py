@@ -141,7 +141,7 @@ def test_a_korean_tab_has_no_english_sentence_on_any_tab(app):
         shown = (pl.summary, cv.summary, cv.table_html, cv.lesson_text, pv.result_html, pv.sizing)
         wait_for(lambda: all(client.holds(handle) for handle in (*shown, view.panel.equations)), what="the texts")
         line = view.panel.class_info  # the classroom line: written again for the new language (coalesced, a moment)
-        held = lambda: client.gui.get(widget_uuid(line), {}).get("_markdown") or ""  # noqa: E731  (markdown)
+        held = lambda: client.gui.get(widget_uuid(line), {}).get("content") or ""  # noqa: E731  (its HTML)
         wait_for(lambda: HANGUL.search(line.content) and held() == line.content, what="the classroom line in Korean")
         texts = client.texts()
         equations = client.gui[widget_uuid(view.panel.equations)]["content"]

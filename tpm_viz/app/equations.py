@@ -17,6 +17,7 @@ from typing import SupportsFloat
 import numpy as np
 from numpy.typing import ArrayLike
 
+from tpm_viz.core.markup import Html
 from tpm_viz.core.params import Params
 from tpm_viz.core.words import Lang, Phrase, T, say
 from tpm_viz.paper.dynamics import DynamicsResult
@@ -110,7 +111,7 @@ def _unit(text: str) -> str:
 
 def procedure_html(
     params: Params, res: DynamicsResult, jac: Jacobians, f_ext: ArrayLike = (0.0, 0.0), lang: Lang = Lang.EN
-) -> str:
+) -> Html:
     """HTML of steps (a)-(e) for one state (arrays of shape ``(2,)`` in ``res``), numbers substituted, words in
     ``lang``.
 
@@ -191,7 +192,9 @@ def procedure_html(
         f"<p>{say(lang, Phrase(_DET.template, det=_plain(jac.det_jx)))}</p>",
     ]
     # contain:inline-size: the panel's width decides the block's width, not the widest matrix (which scrolls)
-    return '<div class="tpm-equations" style="contain:inline-size;padding-right:10px">' + "".join(parts) + "</div>"
+    return Html(
+        '<div class="tpm-equations" style="contain:inline-size;padding-right:10px">' + "".join(parts) + "</div>"
+    )
 
 
 def _plain(x: str | SupportsFloat) -> str:
@@ -199,10 +202,12 @@ def _plain(x: str | SupportsFloat) -> str:
     return f"{x:.4f}" if math.isfinite(x) else "—"
 
 
-def errata_html(lang: Lang = Lang.EN) -> str:
+def errata_html(lang: Lang = Lang.EN) -> Html:
     """The confirmed errata, as HTML in ``lang``, for the equations panel and the lab report."""
     items = "".join(f"<li>{say(lang, item)}</li>" for item in _ERRATA)
-    return f'<div style="contain:inline-size;padding-right:10px"><p>{say(lang, _ERRATA_HEAD)}</p><ol>{items}</ol></div>'
+    return Html(
+        f'<div style="contain:inline-size;padding-right:10px"><p>{say(lang, _ERRATA_HEAD)}</p><ol>{items}</ol></div>'
+    )
 
 
 ERRATA_HTML = errata_html()

@@ -9,7 +9,11 @@ Bounds: :data:`MAX_PER_BROWSER` tabs per browser, :data:`MAX_PER_ADDRESS` browse
 :data:`MAX_AWAY` browsers in all. A new browser of an address that has its share pushes out that address's own
 oldest; when all are full, the oldest browser of the address holding the most goes (never another address's while
 this one has any). Evictions are logged at most once a minute per address (:data:`EVICTION_LOG_SECONDS`), the next
-line counting those not said (a student minting 400 cookies is one line, not 250).
+line counting those not said (a student minting 400 cookies is one line, not 250). The samples of uploaded trajectories
+kept with the tabs are bounded too, at :data:`MAX_UPLOAD_BYTES` in all (a 20,000-row upload is 480 kB of samples, and
+275 tabs that uploaded one and left held them all for 30 minutes): over it, the oldest upload of the address holding the
+most is let go (its tab still comes back on its own copy, without that trajectory, and is told so:
+:data:`UPLOAD_NOT_KEPT`).
 
 The presenter's right is never restored from a cookie alone: :meth:`Away.presenter` is true only for a record of a
 presenter's tab coming back from the same address within :data:`PRESENTER_SECONDS`; :meth:`Away.end_presenters`
@@ -18,6 +22,7 @@ presenter's tab coming back from the same address within :data:`PRESENTER_SECOND
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import threading
 import time
@@ -27,7 +32,8 @@ from typing import Any
 from tpm_viz.classroom.guard import Faults
 from tpm_viz.classroom.sessionfile import KEEP_SECONDS, Saved
 
-__all__ = ["EVICTION_LOG_SECONDS", "MAX_AWAY", "MAX_PER_ADDRESS", "MAX_PER_BROWSER", "PRESENTER_SECONDS", "Away"]
+__all__ = ["EVICTION_LOG_SECONDS", "MAX_AWAY", "MAX_PER_ADDRESS", "MAX_PER_BROWSER", "MAX_UPLOAD_BYTES"]
+__all__ += ["PRESENTER_SECONDS", "UPLOAD_NOT_KEPT", "Away", "upload_bytes"]
 
 log = logging.getLogger("tpm_viz.classroom")
 
@@ -39,6 +45,20 @@ PRESENTER_SECONDS = 120.0
 """How long [s] a presenter's tab that dropped may come back as the presenter (from the same address only)."""
 EVICTION_LOG_SECONDS = 60.0
 """At most one log line per source address per this many seconds [s] about the browsers it had forgotten."""
+MAX_UPLOAD_BYTES = 32 << 20
+"""Bytes of uploaded trajectories' samples kept with the tabs that left, in all (about 70 of the largest)."""
+UPLOAD_NOT_KEPT = "upload_not_kept"
+"""The key of a record whose uploaded trajectory was let go (:data:`MAX_UPLOAD_BYTES`): True."""
+
+
+def upload_bytes(record: dict[str, Any]) -> int:
+    """Bytes of the uploaded trajectory's samples a record keeps (0: none)."""
+    saved = record.get("saved")
+    source = getattr(saved, "source", None)
+    knots = getattr(source, "knots", None)
+    if getattr(source, "kind", None) != "csv" or knots is None:
+        return 0
+    return sum(int(getattr(a, "nbytes", 0)) for a in knots)
 
 
 def _close(a: Any, b: Any) -> bool:
@@ -66,6 +86,9 @@ class Away:
         self._address: dict[str, str] = {}
         self.changed = 0
         """Counts changes (the saver writes only when it moved)."""
+        self.let_go = 0
+        """Uploads let go over :data:`MAX_UPLOAD_BYTES` so far (tests and benchmarks)."""
+        self._told = (0, float("-inf"))  # let_go and time.monotonic() of the last log line
 
     def _prune(self) -> None:
         now = self._clock()
@@ -120,6 +143,7 @@ class Away:
             self._tabs.setdefault(key, []).append(record)
             self._address[key] = str(address)
             self._prune()
+            self._bound_uploads()
             self.changed += 1
 
     def take(self, key: str, camera: Any = None) -> dict[str, Any] | None:
@@ -189,6 +213,41 @@ class Away:
                 self._tabs.setdefault(key, []).extend(dict(r, camera=None, address=address) for r in records)
                 self._address[key] = address
             self._prune()
+            self._bound_uploads()
+
+    def uploads(self) -> int:
+        """Bytes of uploaded samples kept (tests and benchmarks)."""
+        with self._lock:
+            return sum(upload_bytes(r) for records in self._tabs.values() for r in records)
+
+    def _bound_uploads(self) -> None:
+        """Over :data:`MAX_UPLOAD_BYTES` of uploaded samples: let go the oldest upload of the address holding the
+        most, until under it (under the lock)."""
+        kept = [(r, n, a) for k, a in self._address.items() for r in self._tabs.get(k, []) if (n := upload_bytes(r))]
+        total = sum(n for _r, n, _a in kept)
+        if total <= MAX_UPLOAD_BYTES:
+            return
+        by_address: dict[str, int] = {}
+        for _r, n, a in kept:
+            by_address[a] = by_address.get(a, 0) + n
+        kept.sort(key=lambda e: e[0]["left_at"])
+        dropped = 0
+        while total > MAX_UPLOAD_BYTES and kept:
+            top = max(by_address, key=lambda a: by_address[a])
+            index = next(i for i, e in enumerate(kept) if e[2] == top)
+            record, n, address = kept.pop(index)
+            record["saved"] = dataclasses.replace(record["saved"], source=None)
+            record[UPLOAD_NOT_KEPT] = True
+            total, by_address[address], dropped = total - n, by_address[address] - n, dropped + 1
+        self.let_go += dropped
+        told, at = self._told
+        if time.monotonic() - at >= 60.0:  # one line a minute at most, with the count since the last one
+            log.info(
+                "let go %d uploaded trajectories of tabs that left (over %d MiB kept)",
+                self.let_go - told,
+                MAX_UPLOAD_BYTES >> 20,
+            )
+            self._told = (self.let_go, time.monotonic())
 
     def __len__(self) -> int:
         with self._lock:

@@ -27,9 +27,11 @@ import logging
 import math
 import threading
 import time
+import weakref
 from collections import OrderedDict, deque
-from collections.abc import Callable, Hashable
+from collections.abc import Callable, Hashable, MutableMapping
 from dataclasses import dataclass
+from typing import Any
 
 from tpm_viz.core.errors import BusyError, TpmVizError
 from tpm_viz.core.words import T
@@ -57,39 +59,62 @@ def _log_bug(exc: Exception, what: str) -> None:
 class Demand:
     """How much each tab asked lately: +1 per request (a replaced one too), decaying as ``exp(-age / tau)``. The
     requests of one action (a parameter change re-plans and redraws the map: a burst within ``burst`` [s]) count
-    once."""
+    once.
+
+    A tab that can be referenced weakly (a browser tab's view, a session) is remembered weakly: the memory of its
+    demand never keeps it alive (a private session holds its tab's whole page: a class that uploaded and left kept
+    up to 256 of them, ~2 MB each, until enough others asked). Other keys (names, tuples) are kept, bounded by
+    :meth:`prune`."""
 
     def __init__(self, tau: float = TAU, clock: Callable[[], float] = time.monotonic, burst: float = BURST) -> None:
         self.tau, self.burst = tau, burst
         self._clock = clock
-        self._last: dict[Hashable, tuple[float, float]] = {}  # tab -> (demand, at [s])
+        self._last: dict[Hashable, tuple[float, float]] = {}  # tab -> (demand, at [s]): keys held strongly
+        self._weak: weakref.WeakKeyDictionary[Any, tuple[float, float]] = weakref.WeakKeyDictionary()
+
+    def _table(self, tab: Hashable) -> MutableMapping[Any, tuple[float, float]]:
+        """Where ``tab`` is remembered: weakly if it can be."""
+        try:
+            weakref.ref(tab)
+        except TypeError:
+            return self._last
+        return self._weak
 
     def of(self, tab: Hashable) -> float:
         """The demand of ``tab`` now (0 for a tab never seen)."""
-        value, at = self._last.get(tab, (0.0, 0.0))
+        value, at = self._table(tab).get(tab, (0.0, 0.0))
+        return self._decayed(value, at)
+
+    def _decayed(self, value: float, at: float) -> float:
         return value * math.exp(-max(0.0, self._clock() - at) / self.tau) if value else 0.0
 
     def add(self, tab: Hashable) -> None:
-        _value, at = self._last.get(tab, (0.0, -math.inf))
+        table = self._table(tab)
+        _value, at = table.get(tab, (0.0, -math.inf))
         now = self._clock()
         if now - at >= self.burst:
-            self._last[tab] = (self.of(tab) + 1.0, now)
+            table[tab] = (self.of(tab) + 1.0, now)
 
     def forget(self, tab: Hashable) -> None:
-        self._last.pop(tab, None)
+        self._table(tab).pop(tab, None)
 
     def prune(self, keep: int = 256) -> None:
         """Bounded memory (and no closed tab or old session kept alive): over ``keep`` tabs, forget those whose
         demand has faded (< 0.01: nothing for about 14 s), then if still over, those that asked least."""
-        if len(self._last) > keep:
-            for tab in [t for t in self._last if self.of(t) < 0.01]:
-                del self._last[tab]
-        if len(self._last) > keep:
-            for tab in sorted(self._last, key=self.of)[: len(self._last) - keep // 2]:
-                del self._last[tab]
+        if len(self) <= keep:
+            return
+        tables: tuple[MutableMapping[Any, tuple[float, float]], ...] = (self._last, self._weak)
+        entries = [(table, tab, self._decayed(*entry)) for table in tables for tab, entry in list(table.items())]
+        for table, tab, demand in entries:
+            if demand < 0.01:
+                table.pop(tab, None)
+        if len(self) > keep:
+            alive = sorted((e for e in entries if e[2] >= 0.01), key=lambda e: e[2])
+            for table, tab, _demand in alive[: len(self) - keep // 2]:
+                table.pop(tab, None)
 
     def __len__(self) -> int:
-        return len(self._last)
+        return len(self._last) + len(self._weak)
 
 
 @dataclass(frozen=True)

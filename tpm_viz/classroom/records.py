@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import weakref
 from collections import OrderedDict
 from collections.abc import Mapping
 from pathlib import Path
@@ -37,17 +38,18 @@ class Records:
 
     def __init__(self, store: Store) -> None:
         self.store = store
-        self._put: OrderedDict[int, tuple[Source, str]] = OrderedDict()  # id(source) -> (source, digest)
+        self._put: OrderedDict[int, tuple[weakref.ref[Source], str]] = OrderedDict()
+        """id(source) -> (the source, weakly: remembering a digest never keeps 480 kB of samples alive; digest)."""
 
     # -- writing ------------------------------------------------------------------------------------------------
     def _digest(self, source: Source, samples: dict[str, Any]) -> str:
         known = self._put.get(id(source))
-        if known is not None and known[0] is source:
+        if known is not None and known[0]() is source:
             self._put.move_to_end(id(source))
             return known[1]
         data = json.dumps(samples, allow_nan=False).encode()
         digest = self.store.put_blob(data)
-        self._put[id(source)] = (source, digest)
+        self._put[id(source)] = (weakref.ref(source), digest)
         while len(self._put) > _REMEMBERED_SOURCES:
             self._put.popitem(last=False)
         return digest

@@ -31,6 +31,7 @@ must return quickly (queue any network call); an exception it raises is logged a
 from __future__ import annotations
 
 import sqlite3
+import threading
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
@@ -58,6 +59,8 @@ CLASS_SEED = "class_seed"
 NO_ATTEMPTS = T("no attempts left")
 ScoreSink = Callable[[str, str, float, float], None]
 """``sink(identity_hash, exercise_id, best_score, latest_score)`` (module docstring)."""
+_TURN_STRIPES = 64
+"""Locks one student's answers wait on (a student's is ``hash(identity) % 64``: bounded, whatever the class)."""
 CSV_COLUMNS: tuple[str, ...] = ("student", "exercise", "variant", "seed", "attempts", "best_score", "latest_score")
 CSV_COLUMNS += ("last_answer", "last_time")
 
@@ -96,6 +99,7 @@ class Gradebook:
         """Called after each graded answer is kept (:data:`ScoreSink`; None: nobody)."""
         self.listeners: list[Callable[[Row], None]] = []
         """Called with each kept row, before the sink (the lecturer's live table)."""
+        self._turns = tuple(threading.Lock() for _ in range(_TURN_STRIPES))
         try:
             kept = rows.setting(CLASS_SEED)
             self._class_seed = None if kept is None else parse_seed(kept)
@@ -133,7 +137,12 @@ class Gradebook:
 
     def submit(self, identity: str, exercise_id: str, text: object) -> Submitted:
         """Grade ``text`` as ``identity``'s next attempt at ``exercise_id`` and keep it (module docstring).
-        :class:`InputError` for an unknown exercise."""
+        :class:`InputError` for an unknown exercise. One student's answers are graded one after another (two tabs
+        answering at once get attempts 1 and 2, never both 1); other students' are graded meanwhile."""
+        with self._turns[hash(identity) % _TURN_STRIPES]:
+            return self._submit(identity, exercise_id, text)
+
+    def _submit(self, identity: str, exercise_id: str, text: object) -> Submitted:
         item = self.exercises.get(exercise_id)
         if item is None:
             raise InputError(Phrase("unknown exercise {id}", id=repr(str(exercise_id)[:70])))

@@ -6,7 +6,6 @@ and the dashboard HTML are the same for all of them, so they are computed at mos
 
 from __future__ import annotations
 
-import html
 import time
 from collections.abc import Callable
 from functools import cached_property
@@ -18,6 +17,7 @@ from tpm_viz.app.readouts import Readout
 from tpm_viz.app.state import AppState
 from tpm_viz.classroom.text import dashboard_html
 from tpm_viz.core.errors import TpmVizError
+from tpm_viz.core.markup import Html, html
 from tpm_viz.core.words import Lang, say
 from tpm_viz.drawing import meshes
 from tpm_viz.paper.dynamics import inverse_dynamics_detail
@@ -41,8 +41,8 @@ class Snapshot:
         :mod:`tpm_viz.classroom.pacing`)."""
         self.complete_readout: Callable[[], Readout] | None = None
         """For a live frame whose ``readout`` lacks the reference forces: computes the readout with them."""
-        self._dashboards: dict[Lang, str] = {}
-        self._equations: dict[Lang, str] = {}
+        self._dashboards: dict[Lang, Html] = {}
+        self._equations: dict[Lang, Html] = {}
         self.made_at = time.monotonic()
         self.numbers: Snapshot = self
         """The frame whose numbers the dashboard shows: this one, or mid-drag a recent one (:meth:`follow`)."""
@@ -74,11 +74,11 @@ class Snapshot:
         return positions.astype(np.float32), wxyzs.astype(np.float32)
 
     @property
-    def equations(self) -> str:
+    def equations(self) -> Html:
         """The paper's procedure (a)-(e) with this state's numbers (MathML), and the errata, in English."""
         return self.equations_in(Lang.EN)
 
-    def equations_in(self, lang: Lang) -> str:
+    def equations_in(self, lang: Lang) -> Html:
         """The paper's procedure (a)-(e) with this state's numbers (MathML), and the errata, their words in ``lang``
         (built once per language)."""
         if lang not in self._equations:
@@ -89,16 +89,16 @@ class Snapshot:
                 jac = jacobians(state.params, state.pose.p, state.pose.d)
                 body = procedure_html(state.params, res, jac, f_ext, lang)
             except TpmVizError as exc:
-                body = f"<p>{html.escape(say(lang, exc))}</p>"
+                body = html("<p>{why}</p>", why=say(lang, exc))
             self._equations[lang] = body + errata_html(lang)
         return self._equations[lang]
 
     @cached_property
-    def dashboard(self) -> str:
+    def dashboard(self) -> Html:
         """The HTML of the always-visible top of the panel (its messages in English)."""
         return self.dashboard_in(Lang.EN)
 
-    def dashboard_in(self, lang: Lang) -> str:
+    def dashboard_in(self, lang: Lang) -> Html:
         """The HTML of the always-visible top of the panel, its messages in ``lang`` (built once per language, from the
         numbers frame :attr:`numbers`)."""
         numbers = self.numbers

@@ -15,6 +15,7 @@ import numpy as np
 
 from tpm_viz.app.readouts import Readout
 from tpm_viz.app.state import AppState
+from tpm_viz.core.markup import Html
 from tpm_viz.core.words import Lang, Phrase, T, say
 from tpm_viz.drawing.palette import hex_colour
 
@@ -204,18 +205,20 @@ LEGEND = (
 )
 
 
-def legend_html() -> str:
+def legend_html() -> Html:
     """The colour legend of the 3D view."""
     rows = "".join(
         f'<div style="display:flex;gap:6px;align-items:baseline"><span style="flex:none;width:10px;height:10px;'
         f'background:{color};border-radius:2px;display:inline-block"></span><span>{html.escape(text)}</span></div>'
         for color, text in LEGEND
     )
-    return f'<div style="font-size:0.8em;color:#334155;line-height:1.4;padding:2px 0">{rows}</div>'
+    return Html(f'<div style="font-size:0.8em;color:#334155;line-height:1.4;padding:2px 0">{rows}</div>')
 
 
-def dashboard_html(state: AppState, readout: Readout, lang: Lang = Lang.EN) -> str:
+def dashboard_html(state: AppState, readout: Readout, lang: Lang = Lang.EN) -> Html:
     """The always-visible top of the panel: banner, kinematic readouts, force bars. Its messages (the alerts, the
     note of the last move, the force note) in ``lang``; its fixed words are shown in the tab's language by the
     tab's connection (:mod:`tpm_viz.ui.language`)."""
-    return f"<div>{_banner(state, readout, lang)}{_kinematics(readout, lang)}{_forces(state, readout, lang)}</div>"
+    return Html(
+        f"<div>{_banner(state, readout, lang)}{_kinematics(readout, lang)}{_forces(state, readout, lang)}</div>"
+    )

@@ -203,6 +203,7 @@ class TpmApp:
             with self._views_lock:
                 self.views.pop(client.client_id, None)
             self.keyboard.leave(view)
+            self.exercises.leaving(view)
             self.access.logout(view)
             view.close()
             if self.services.later is not None:

@@ -27,6 +27,7 @@ from tpm_viz.classroom.pacing import watch_phase, watch_slot
 from tpm_viz.classroom.session import Hub, Session
 from tpm_viz.classroom.sessionfile import Saved
 from tpm_viz.classroom.snapshot import Snapshot
+from tpm_viz.core.markup import html
 from tpm_viz.core.params import Params
 from tpm_viz.core.words import Phrase, say
 from tpm_viz.drawing import meshes
@@ -34,7 +35,7 @@ from tpm_viz.ui.fields import Place, Typing, control
 from tpm_viz.ui.language import TabWords, first_language
 from tpm_viz.ui.login import LoginPanel
 from tpm_viz.ui.look import Look
-from tpm_viz.ui.panels import Panel
+from tpm_viz.ui.panels import CLASS_LINE, Panel
 from tpm_viz.ui.scene import MechanismScene
 from tpm_viz.ui.share import ShareBox
 from tpm_viz.ui.tabscene import TabScene
@@ -209,7 +210,7 @@ class ClientView:
 
     def set_class_info(self, text: str | Phrase) -> None:
         """The classroom line of the *Class & view* tab."""
-        content = say(self.lang, text)
+        content = html(CLASS_LINE, text=say(self.lang, text))
         if self.panel.class_info.content != content:  # a line for every tab at every join: only what changed
             self.panel.class_info.content = content
 

@@ -36,15 +36,16 @@ from typing import Any, Protocol, cast
 
 from tpm_viz.classroom.guard import guarded
 from tpm_viz.core.errors import TpmVizError
+from tpm_viz.core.markup import Html
 from tpm_viz.core.words import Lang, Phrase, say
 from tpm_viz.ui.widgets.typed import TypedGroup
 
 __all__ = ["ONE_LINE_CSS", "Note", "Place", "TypedBox", "Typing", "Waker", "as_phrase", "control", "note_html"]
 
-ONE_LINE_CSS = """<style>
+ONE_LINE_CSS = Html("""<style>
 textarea.mantine-Textarea-input { max-height: 1.625rem !important; resize: none !important;
   overflow: hidden !important; white-space: pre !important; line-height: 1.5rem !important; }
-</style>"""
+</style>""")
 """The typed fields (viser's multi-line text inputs, autosized to two rows) drawn as one line, like viser's one-line
 text input: every textarea of the panel is a typed field's. Added once per tab (by :class:`Typing`)."""
 
@@ -76,14 +77,14 @@ def as_phrase(what: object) -> Phrase:
     return Phrase(text.replace("{", "{{").replace("}", "}}"))  # an English text: shown as it is, or its Korean
 
 
-def note_html(lines: Sequence[str], problem: bool = False, notes: Sequence[str] = ()) -> str:
+def note_html(lines: Sequence[str], problem: bool = False, notes: Sequence[str] = ()) -> Html:
     """The HTML of a note: ``lines`` (dark red if ``problem``, else slate), then ``notes`` (amber); empty if none."""
     if not lines and not notes:
-        return ""
+        return Html("")
     colour = "#991b1b" if problem else "#334155"
     rows = [f'<div style="color:{colour}">{html.escape(x)}</div>' for x in lines]
     rows += [f'<div style="color:#92400e">{html.escape(x)}</div>' for x in notes]
-    return '<div style="font-size:0.8em;line-height:1.35;margin:-0.2em 0.75em 0.5em">' + "".join(rows) + "</div>"
+    return Html('<div style="font-size:0.8em;line-height:1.35;margin:-0.2em 0.75em 0.5em">' + "".join(rows) + "</div>")
 
 
 class Note:

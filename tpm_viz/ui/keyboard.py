@@ -34,6 +34,7 @@ from tpm_viz.app import transitions
 from tpm_viz.classroom.guard import guarded
 from tpm_viz.classroom.session import View
 from tpm_viz.core.errors import TpmVizError
+from tpm_viz.core.markup import Html
 from tpm_viz.core.words import T
 from tpm_viz.viserkit.page import QUEUED, RECONNECT_NOW, key_request
 
@@ -74,12 +75,12 @@ SETTINGS = T("Settings")
 """The name of viser's settings button (an icon only)."""
 
 
-def _marker(nonce: str) -> str:
+def _marker(nonce: str) -> Html:
     """The hidden element of a tab's panel: its nonce, and the words the page script gives the 3D view, the close
     buttons and its *Reconnect now* button (English here; in the tab's language on the wire, :mod:`.language`)."""
     words = "".join(f'<span data-w="{key}">{html.escape(str(text))}</span>' for key, text in WORDS.items())
     words += "".join(f'<span data-en="{html.escape(str(text))}">{html.escape(str(text))}</span>' for text in VISER)
-    return f'<div data-tpmviz-keys="{nonce}" hidden>{words}</div>'
+    return Html(f'<div data-tpmviz-keys="{nonce}" hidden>{words}</div>')
 
 
 WORDS = {"view": LABEL, "close": CLOSE, "settings": SETTINGS, "reconnect": RECONNECT_NOW}

@@ -20,6 +20,7 @@ from typing import Any
 import viser
 
 from tpm_viz.classroom.guard import guarded
+from tpm_viz.core.markup import Html
 from tpm_viz.core.words import Lang, preferred
 from tpm_viz.ui.worded import show_text
 from tpm_viz.viserkit.core import client_request
@@ -28,7 +29,7 @@ __all__ = ["LABEL", "TabWords", "first_language", "show_text"]
 
 LABEL = "Language"
 """The selector's label (shown in the tab's language: 언어). Its options are each language's own name."""
-KEEP_ALL = "<style>.mantine-Paper-root { word-break: keep-all; overflow-wrap: anywhere; }</style>"
+KEEP_ALL = Html("<style>.mantine-Paper-root { word-break: keep-all; overflow-wrap: anywhere; }</style>")
 """Korean typesetting: lines break between words (at spaces), as in English, not inside one; a word longer than
 its line still breaks anywhere. In the page of a tab shown in Korean only."""
 
@@ -51,7 +52,7 @@ class TabWords:
 
     def _typeset(self) -> None:
         """The page's line breaking for the tab's language (:data:`KEEP_ALL` in Korean; created when first needed)."""
-        content = KEEP_ALL if self.view.lang is Lang.KO else ""
+        content = KEEP_ALL if self.view.lang is Lang.KO else Html("")
         if self._style is None and content:
             self._style = self.view.gui.add_html(content)
         elif self._style is not None:

@@ -17,6 +17,8 @@ import viser
 from tpm_viz.app.inputs import MAX_UPLOAD_BYTES
 from tpm_viz.classroom.guard import guarded
 from tpm_viz.classroom.network import is_loopback
+from tpm_viz.core import markup
+from tpm_viz.core.markup import Html
 from tpm_viz.core.words import T
 from tpm_viz.ui.classroom import qr_data_uri
 from tpm_viz.ui.worded import TabGui
@@ -40,15 +42,17 @@ class Lecture(Protocol):
         """End ``view``'s presenter right (and any dropped presenter tab's way back from its address)."""
 
 
+NOTICE = "<p style='margin:0;padding:0 0 4px;font-size:0.875em'><b>Session store</b>: {line}</p>"
+"""The lecturer's line about the session store, its text escaped (:func:`tpm_viz.core.markup.html`)."""
 LOOPBACK_ONLY = T("Served on this computer only: students cannot connect. Restart with --host 0.0.0.0.")
 
 
-def join_html(urls: list[str], loopback: bool = False) -> str:
+def join_html(urls: list[str], loopback: bool = False) -> Html:
     """The URLs students type and a QR code of the first one (HTML for the panel). ``loopback``: the server is bound
     to this computer only (``--classroom`` with ``--host 127.0.0.1``): the room's addresses are listed, but no
     student can connect to them, and the panel says so (as the terminal does)."""
     if not urls:
-        return (
+        return Html(
             "<p><b>No network address found</b>: connect this computer to the room's network "
             "(students use the same wifi), then restart the app.</p>"
         )
@@ -56,7 +60,7 @@ def join_html(urls: list[str], loopback: bool = False) -> str:
     if loopback or all(is_loopback(urlsplit(u).hostname or "") for u in urls):
         links += f"<p style='color:#b91c1c'><b>{LOOPBACK_ONLY.template}</b></p>"
     image = f"<img alt='QR code of {html.escape(urls[0])}' src='{qr_data_uri(urls[0])}' style='width:180px'>"
-    return f"<div>Students open (same network):{links}{image}</div>"
+    return Html(f"<div>Students open (same network):{links}{image}</div>")
 
 
 class LecturerPanel:
@@ -71,7 +75,7 @@ class LecturerPanel:
         with self.folder:
             self.join = gui.add_html(join_html(urls, loopback) if urls is not None else "")
             self.join.visible = urls is not None
-            self.notice = gui.add_markdown("")
+            self.notice = gui.add_html("")
             self.notice.visible = False
             self.open_to_class = gui.add_checkbox(
                 "Let the class change the shared mechanism",
@@ -96,7 +100,7 @@ class LecturerPanel:
 
     def show_notice(self, line: str) -> None:
         """One line about the session store (set aside, not saving, saving again); empty: hidden."""
-        self.notice.content = f"**Session store**: {html.escape(line)}" if line else ""
+        self.notice.content = markup.html(NOTICE, line=line) if line else Html("")
         self.notice.visible = bool(line)
 
     @guarded

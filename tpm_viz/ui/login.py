@@ -17,6 +17,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from tpm_viz.core.markup import Html, Markdown
 from tpm_viz.core.words import Lang, T, say
 from tpm_viz.ui.fields import one_line
 from tpm_viz.ui.worded import TabGui
@@ -25,10 +26,13 @@ from tpm_viz.viserkit.core import widget_uuid
 __all__ = ["LoginPanel", "mask_css"]
 
 
-def mask_css(uuid: str) -> str:
-    """A style rule that draws the characters of the text input labelled by ``uuid`` as dots."""
-    scope = f'div:has(> div > p > label[for="{uuid}"])'
-    return f"<style>{scope} input, {scope} textarea {{ -webkit-text-security: disc; text-security: disc; }}</style>"
+def mask_css(uuid: str) -> Html:
+    """A style rule that draws the characters of the text input labelled by ``uuid`` (viser's uuid: hex digits) as
+    dots."""
+    scope = f'div:has(> div > p > label[for="{"".join(c for c in uuid if c.isalnum() or c == "-")}"])'
+    return Html(
+        f"<style>{scope} input, {scope} textarea {{ -webkit-text-security: disc; text-security: disc; }}</style>"
+    )
 
 
 class LoginPanel:
@@ -37,7 +41,7 @@ class LoginPanel:
     def __init__(self, gui: TabGui, on_login: Callable[[Any], None]) -> None:
         with gui.add_folder("Presenter login", expand_by_default=False):
             self.status = gui.add_markdown(
-                say(Lang.EN, T("Students: you watch the presenter here, or work on your own copy."))
+                Markdown(say(Lang.EN, T("Students: you watch the presenter here, or work on your own copy.")))
             )
             self.token = gui.add_text(
                 "Presenter token",
@@ -62,4 +66,6 @@ class LoginPanel:
         return str(value)
 
     def show(self, text: str) -> None:
-        self.status.content = text
+        """The status line: ``text`` is an English Markdown template of the code (shown in the tab's language by its
+        handle), never a user's words."""
+        self.status.content = Markdown(text)

@@ -16,7 +16,7 @@ folds to its rail (viser's ``minimize``: the 3D canvas is then the whole screen 
 brings it back for the lecturer. A box of live numbers floats over the bottom of the canvas while the panel is folded
 (a separate viser panel, shown by the style sheet only then; the framing keeps its band free): the pose status and
 its warnings at :data:`BANNER_PX`, p, d, τ₁ and τ₂ with their bars at :data:`READOUT_PX` CSS pixels. With the panel
-open, its readout is the same compact one (:data:`~.panels.FOLDED` left out) in large, dark type, the panel wider
+open, its readout is the same compact one (:data:`~.panel_css.FOLDED` left out) in large, dark type, the panel wider
 (:data:`PRESENTATION_WIDTH`); thicker lines and larger labels in 3D (:mod:`.tabscene`), the player's charts with 18 px
 dark axes (:data:`~.teaching.player.charts.LARGE`). All of it is this tab's own: the style sheet is an HTML element of
 the tab's GUI, and every tab's GUI is its own.
@@ -34,11 +34,12 @@ import numpy as np
 import viser
 
 from tpm_viz.classroom.guard import guarded
+from tpm_viz.core.markup import Html, html
 from tpm_viz.core.params import Params
 from tpm_viz.core.words import Lang, T
 from tpm_viz.drawing import meshes
 from tpm_viz.ui.language import KEEP_ALL
-from tpm_viz.ui.panels import FOLDED
+from tpm_viz.ui.panel_css import FOLDED
 from tpm_viz.ui.scene import camera_pose
 from tpm_viz.ui.widgets.framing import LIVE_BAND, frame_box
 from tpm_viz.viserkit.core import point_camera, widget_uuid
@@ -102,7 +103,7 @@ _SHEET_PCT = round(SHEET * 100)
 INSET = 16
 """Room at the right of the readout and the force column [CSS px]: the panel's scroll bar (11 px, drawn over its
 content) and 5 px to spare, so "N" never touches the panel's edge."""
-PHONE_CSS = f"""<style>
+PHONE_CSS = Html(f"""<style>
 div:has(> [data-q="banner"]) {{ padding-right: {INSET}px; }}
 label wbr {{ display: none; }}
 @media {_PHONE} {{
@@ -124,7 +125,7 @@ label wbr {{ display: none; }}
   .mantine-Button-root, .mantine-Tabs-tab {{ min-height: {BUTTON_TOUCH}px !important; }}
   .mantine-ActionIcon-root {{ min-width: {BUTTON_TOUCH}px !important; min-height: {BUTTON_TOUCH}px !important; }}
 }}
-</style>"""
+</style>""")
 """The readout's room at the panel's edge (:data:`INSET`), the phone layout and touch targets (by viewport and
 pointer: no switch), in every tab; labels break at spaces only (viser puts a ``<wbr>`` after each ``_`` and ``/``:
 "F_max" was cut after "F_")."""
@@ -132,7 +133,7 @@ pointer: no switch), in every tab; labels break at spaces only (viser puts a ``<
 BANNER_PX = 20
 """Font size of the pose status and its warnings in the box of live numbers [CSS px]."""
 
-PRESENTATION_CSS = f"""<style>
+PRESENTATION_CSS = Html(f"""<style>
 div:has(> [data-q="banner"]) {{ color: #0f172a; padding-right: {INSET}px; }}
 [data-q="banner"] {{ font-size: {BANNER_PX}px !important; }}
 div:has(> [data-q="banner"]) td {{ font-size: 17px !important; color: #0f172a !important; }}
@@ -154,23 +155,23 @@ body:has([data-dock-rail-root]) [data-floating-window]:has([data-live]) {{ visib
 [data-live] table {{ margin-top: 2px !important; }}
 [data-live] tbody {{ display: flex; flex-wrap: wrap; column-gap: 1.2em; }}
 @media {_PHONE} {{ div:has(> div > [data-live]) {{ display: none !important; }} }}
-</style>"""
+</style>""")
 """Presentation mode: large, dark type (the charts' titles and legends too; their axes are drawn on a canvas, sized by
 :meth:`~.teaching.player.charts.Charts.set_presentation`); the box of banner and forces shown only while the panel is
 collapsed."""
 
 
-def frame_row_css(language: Any, button: Any) -> str:
+def frame_row_css(language: Any, button: Any) -> Html:
     """The panel's first row: the *Language* selector (``language``) and *Frame the mechanism* (``button``, the next
     control) side by side, 45 % and 55 % of the width (the root of the panel is a block: a float), so that the button
     costs no height above the tabs. Empty for a GUI without a page (a test's stand-in)."""
     try:
         selector, uuid = widget_uuid(language), widget_uuid(button)
     except AttributeError:
-        return ""
+        return Html("")
     row = f'div:has(> div > div > p > label[for="{selector}"])'
     wrapper = f'div:has(> button[id="{uuid}"])'
-    return (
+    return Html(
         f"<style>{row} {{ float: left; width: 45%; }}"
         f" {wrapper} {{ margin-left: calc(45% + 4px) !important; }} {wrapper} ~ * {{ clear: both; }}"
         f" {wrapper} > button {{ width: 100%; }}</style>"
@@ -335,7 +336,7 @@ class Look:
         """Copy the panel's dashboard into the box of banner and forces (presentation mode only)."""
         if not self.presentation or self.live_html is None:
             return
-        content = f'<div data-live="1">{self.view.panel.dashboard.content}</div>'
+        content = html('<div data-live="1">{dashboard}</div>', dashboard=self.view.panel.dashboard.content)
         if self.live_html.content != content:
             self.live_html.content = content
         style = PRESENTATION_CSS + (KEEP_ALL if self.view.lang is Lang.KO else "")

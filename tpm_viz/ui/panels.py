@@ -29,13 +29,14 @@ from tpm_viz.app.transitions import MAX_ACCEL, MAX_FORCE, MAX_POSITION, MAX_SPEE
 from tpm_viz.classroom.pacing import LIVE_NUMBERS_INTERVAL
 from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.classroom.text import legend_html
+from tpm_viz.core.markup import Html, Markdown, html
 from tpm_viz.core.params import PARAM_INFO, Params
 from tpm_viz.core.words import Lang
 from tpm_viz.drawing.palette import hex_colour
 from tpm_viz.ui.fields import Note, TypedBox
+from tpm_viz.ui.panel_css import fold_css, slider_css
 from tpm_viz.ui.widgets.typed import QUIET, Quantity, TypedField, TypedGroup, force_note
-from tpm_viz.ui.worded import TabGui, Tabs, Worded
-from tpm_viz.viserkit.core import tab_id, widget_uuid
+from tpm_viz.ui.worded import TabGui, Tabs, Worded, put, stored
 
 __all__ = ["ACTUATOR_HINT", "ACTUATOR_LABELS", "GROUPS", "GUIDE_HTML", "PARAM_LABELS", "Panel", "slider_css"]
 
@@ -85,7 +86,7 @@ GUIDE_COLOURS = (
 )
 """The colours of the 3D view in the guide, by name, from the palette (the legend of the Move tab says more)."""
 _CHIP = "<span style='display:inline-block;width:10px;height:10px;border-radius:2px;background:{}'></span>"
-GUIDE_HTML = (
+GUIDE_HTML = Html(
     "<div data-guide='1' style='font-size:0.85em;line-height:1.35'>"
     + "".join(f"<p style='margin:0 0 3px'>{line}</p>" for line in GUIDE_LINES)
     + "<div style='display:flex;flex-wrap:wrap;gap:2px 10px'>"
@@ -113,6 +114,10 @@ ACTUATOR_HINT = (
     "Actuator position along its rail, from 0 to the stroke Δd: 1.5e2, 150,5 and 0.15 m work; Enter applies "
     "(or stop typing for a moment)"
 )
+MESSAGE = "<p data-q='message' style='margin:0;padding:0 12px 8px;font-size:0.875em'><b>{text}</b></p>"
+"""The tab's message line (:meth:`Panel.tell`), its text escaped (:func:`tpm_viz.core.markup.html`)."""
+CLASS_LINE = "<p data-q='class-line' style='margin:0;padding:0 12px 8px;font-size:0.875em'>{text}</p>"
+"""The classroom line of the *Class & view* tab (:meth:`~.client.ClientView.set_class_info`)."""
 ACTUATOR_RESOLUTION = 1e-5
 """mm: an actuator position closer than this to 0 is shown as 0 (a pose may sit 1e-9 m beyond a stroke end)."""
 
@@ -142,49 +147,6 @@ def _actuators(stroke_mm: float, d_mm) -> TypedGroup:
         },
         quiet=QUIET,
     )
-
-
-def slider_css(handles) -> str:
-    """A style rule that hides viser's number box beside each of these sliders (the slider itself stays): in viser
-    1.1.1 the box is the sibling after the slider's root, whose ``id`` is the handle's uuid."""
-    try:
-        uuids = [widget_uuid(h) for h in handles]
-    except AttributeError:  # a GUI without a page (the tests' stand-in for viser): nothing to hide
-        return ""
-    rules = ", ".join(f'[id="{uuid}"] ~ *' for uuid in uuids)
-    return f"<style>{rules} {{ display: none !important; }}</style>"
-
-
-FOLDED = (
-    'div:has(> [data-q="banner"]) tr:nth-child(n+3)',  # θ, det J_x, det J_q, cond J, assembly mode
-    'div:has(> [data-q="banner"]) > div:last-child > div:first-child',  # the forces' heading and load line
-    'div:has(> [data-q="tau1_ref"])',  # Pinocchio's cross-check of each force
-    'div:has(> [data-q="tau2_ref"])',
-)
-"""What the compact readout leaves out: it keeps the pose status and its warnings, p, d, τ₁ and τ₂ with their bars."""
-
-
-def _tab_selector(tab) -> str:
-    """A CSS selector of a tab's button, on a wide screen (viser's dock tab) and on a phone (a Mantine tab)."""
-    uuid = tab_id(tab)
-    return f':is([data-dock-tab="{uuid}"], [id$="-tab-{uuid}"])' if uuid is not None else ""
-
-
-def fold_css(explore, shown) -> str:
-    """A style sheet that folds the readout to :data:`FOLDED`'s compact form while the guide is open or any tab but
-    ``shown`` (Move, Forces) of the ``explore`` group is open: the first control of every tab stays on screen at 768
-    px."""
-    group, tabs = _tab_selector(explore), [_tab_selector(tab) for tab in shown]
-    if not group or not all(tabs):
-        return ""
-    folded = ", ".join(FOLDED)
-    when = (
-        f'body:not(:has({group}[aria-selected="true"]))',
-        f'body:not(:has(:is({", ".join(tabs)})[aria-selected="true"]))',
-        "body:has([data-guide])",
-    )
-    rules = " ".join(f":is({w}) :is({folded}) {{ display: none; }}" for w in when)
-    return f"<style>{rules}</style>"
 
 
 def _params_group(params: Params) -> TypedGroup:
@@ -221,7 +183,9 @@ class Panel:
             gui.add_html(GUIDE_HTML)
             self.guide_done = gui.add_button("Got it", icon=viser.Icon.CHECK, hint="Not shown again in this browser")
         self.dashboard = gui.add_html("")
-        self.message = gui.add_markdown("")
+        self.message = gui.add_html("")
+        """The tab's message line (:meth:`tell`): text only, however it was made (a share link's label, a file
+        name, what was typed)."""
         self.restore = gui.add_button(
             "Restore my own copy from before the drop",
             icon=viser.Icon.RESTORE,
@@ -258,7 +222,7 @@ class Panel:
             self.dp = _vector_box(gui, "dp")
             self.ddp = _vector_box(gui, "ddp")
             self.forces_note = Note(gui)
-            gui.add_markdown("Trajectories (the paper's line and circle, your CSV): *Player* tab.")
+            gui.add_markdown(Markdown("Trajectories (the paper's line and circle, your CSV): *Player* tab."))
         extra = extra_tabs if extra_tabs is not None else (lambda group, tabs: None)
         extra("explore", tabs)  # the teaching layer's tabs of each group (ui/teaching/tabs.py)
         self.fold = gui.add_html(fold_css(explore, (move, forces)))
@@ -281,7 +245,7 @@ class Panel:
             self.own_copy = gui.add_checkbox(
                 "Work on my own copy", False, hint="Off: everyone shares the lecturer's mechanism"
             )
-            self.class_info = gui.add_markdown("")
+            self.class_info = gui.add_html("")
             self.show_toggles = {k: gui.add_checkbox(label, True) for k, label in SHOW_LABELS.items()}
             self.presentation = gui.add_checkbox(
                 "Presentation mode", False, hint="Large type, thick lines and a wider panel: for a projector"
@@ -337,8 +301,10 @@ class Panel:
             return
         with self.tabs["teach"].add_tab("Equations"):
             self._gui.add_markdown(
-                "The paper's procedure (a)-(e) with the current numbers (refreshed when you release the platform "
-                "and at every trajectory sample you pause on or scrub to)."
+                Markdown(
+                    "The paper's procedure (a)-(e) with the current numbers (refreshed when you release the platform "
+                    "and at every trajectory sample you pause on or scrub to)."
+                )
             )
             self._equations = self._gui.add_html("" if frame is None else frame.equations_in(lang))
 
@@ -367,13 +333,13 @@ class Panel:
             self._written.clear()
 
     def _put(self, handle, value) -> None:
-        """Write a widget value and remember it (see :meth:`is_echo`). The value the server wrote last is not
-        written again over one the page sent since: that input's callback is on its way and applies it (or refuses
-        it and shows the state again); writing first would make it look like an echo and lose it."""
+        """Write a widget value and remember it (see :meth:`is_echo`), never over a value the page sent since
+        (:mod:`tpm_viz.viserkit.inputs`): that input's callback applies it (or refuses it and shows the state
+        again); writing first would make it look like an echo and lose it."""
         if self._written.get(id(handle), _UNSET) == value and handle.value != value:
             return
-        handle.value = value
-        self._written[id(handle)] = handle.value
+        if put(handle, value):
+            self._written[id(handle)] = stored(handle)
 
     def is_echo(self, *handles) -> bool:
         """Whether these widgets still hold the values the server wrote last: then a callback that reads them
@@ -387,8 +353,8 @@ class Panel:
         self.params.show({name: _ui(name, getattr(params, name)) for name in PARAM_LABELS}, force)
 
     def tell(self, text: str) -> None:
-        """Show a message to this tab only (empty text clears it)."""
-        content = f"**{text}**" if text else ""
+        """Show a message to this tab only (empty text clears it), as text: whatever it quotes is never markup."""
+        content = html(MESSAGE, text=text) if text else Html("")
         if self.message.content != content:  # every commit clears it: skip viser's setter when already clear
             self.message.content = content
 

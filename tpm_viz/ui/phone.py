@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from tpm_viz.core.markup import Html
 from tpm_viz.viserkit.page import NOTICE_CSS
 
 __all__ = ["MM_PER_PX", "TOUCH_CSS", "TOUCH_GIZMO_PX", "TOUCH_SQUARE", "drag_gain", "is_touch"]
@@ -41,7 +42,7 @@ MM_PER_PX = 1.0
 """Most platform travel [mm] per CSS px of a finger's drag on a touch tab."""
 _MOBILE = re.compile(r"Mobi|Android|iPhone|iPad|iPod", re.IGNORECASE)
 
-TOUCH_CSS = f"<style>{NOTICE_CSS}</style>"
+TOUCH_CSS = Html(f"<style>{NOTICE_CSS}</style>")
 """viser's software-WebGL notice as a one-line strip at the canvas's top-left corner in a touch tab, whatever its width
 (the page script does the same in every window at most 36em wide or with a coarse pointer)."""
 

@@ -15,22 +15,33 @@ from collections.abc import Callable
 from typing import Any, TypeVar
 
 from tpm_viz.classroom import sessionfile
-from tpm_viz.classroom.away import Away
+from tpm_viz.classroom.away import UPLOAD_NOT_KEPT, Away
 from tpm_viz.classroom.guard import guarded, log
 from tpm_viz.classroom.network import is_loopback
 from tpm_viz.classroom.sessionfile import Document, Saved
 from tpm_viz.core.errors import TpmVizError
-from tpm_viz.core.words import Lang, T, say
+from tpm_viz.core.words import Lang, Phrase, T, say
 from tpm_viz.ui.classroom import Classroom, identity, student_urls
 from tpm_viz.ui.continuity import LectureStore, lecture_store, reload, restore, saved_of
 from tpm_viz.ui.lecturer import LecturerPanel
 from tpm_viz.viserkit.core import connection_request
 
-__all__ = ["BACK", "KEPT", "LOGGED_OUT", "Room"]
+__all__ = ["BACK", "BACK_WITHOUT_UPLOAD", "KEPT", "LOGGED_OUT", "Room"]
 
 V = TypeVar("V")
 
-BACK = "Welcome back: your own copy from before the connection dropped is restored."
+BACK = T("Welcome back: your own copy from before the connection dropped is restored.")
+BACK_WITHOUT_UPLOAD = T(
+    "Welcome back: your own copy from before the connection dropped is restored, without its uploaded trajectory "
+    "(the server keeps only so many for tabs that left): upload the CSV again."
+)
+
+
+def _back(record: dict[str, Any]) -> Phrase:
+    """What a tab that got its own copy back is told (its upload may have been let go: :mod:`.away`)."""
+    return BACK_WITHOUT_UPLOAD if record.get(UPLOAD_NOT_KEPT) else BACK
+
+
 STUDENT = T("Students: you watch the presenter here, or work on your own copy.")
 """The login folder's line for a tab that is not the presenter's (:class:`~.login.LoginPanel`)."""
 LOGGED_OUT = "You logged out as presenter: the shared mechanism is no longer yours to change."
@@ -151,7 +162,7 @@ class Room:
             if record is not None:
                 restore(view, record["saved"], record["private"] and record["saved"] is not None, built=True)
                 if record["private"]:
-                    view.tell(BACK)
+                    view.tell(_back(record))
             elif key is not None and self.away.offer(key) is not None:
                 view.panel.restore.visible = True
                 view.tell(KEPT)
@@ -186,7 +197,7 @@ class Room:
                 view.tell("That copy is no longer kept (30 minutes passed, or another tab took it back).")
                 return
             restore(view, record["saved"], True)
-            view.tell(BACK)
+            view.tell(_back(record))
 
     # -- presenter ----------------------------------------------------------------------------------------------------
     def lecturer(self, view: Any) -> bool:

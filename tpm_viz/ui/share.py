@@ -30,6 +30,7 @@ from tpm_viz.classroom.network import is_loopback
 from tpm_viz.classroom.session import Hub
 from tpm_viz.classroom.sessionfile import Saved
 from tpm_viz.core.errors import TpmVizError
+from tpm_viz.core.markup import Html
 from tpm_viz.core.words import Phrase, T
 from tpm_viz.ui.classroom import PENDING, qr_data_uri, shared_token
 from tpm_viz.ui.continuity import restore, saved_of
@@ -138,13 +139,15 @@ class ShareDesk:
         return share_url(origin, encode_link(saved, None if blobs is None else blobs.put_blob))
 
 
-def qr_html(url: str) -> str:
+def qr_html(url: str) -> Html:
     """The QR code of ``url`` for the panel, or one line when it is too long for one (the link is still there)."""
     try:
         image = qr_data_uri(url)
     except segno.DataOverflowError:
-        return f"<p>{html.escape(str(T('The link is too long for a QR code: copy it from the field above.')))}</p>"
-    return f"<img alt='{html.escape(str(T('QR code of the share link')))}' src='{image}' style='width:200px'>"
+        return Html(
+            f"<p>{html.escape(str(T('The link is too long for a QR code: copy it from the field above.')))}</p>"
+        )
+    return Html(f"<img alt='{html.escape(str(T('QR code of the share link')))}' src='{image}' style='width:200px'>")
 
 
 class ShareBox:

@@ -210,7 +210,7 @@ class TabScene:
         gizmo.disable_axes = self.touch
         gizmo.line_width = 4.0 if self.touch else 2.5
         if self.touch:
-            self._client.gui.add_html(TOUCH_CSS)
+            self._client.gui.add_html(str(TOUCH_CSS))
 
     def geared(self, phase: str, position: object, platform: object) -> object:
         """Where a drag event's gizmo ``position`` [m] moves the platform (at ``platform`` [m] now): on a touch tab the

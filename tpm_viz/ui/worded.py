@@ -5,8 +5,12 @@ HTML, chart titles, series and axis labels). :class:`TabGui` creates each elemen
 them (:func:`show_text`: a whole text of the catalogue with :func:`tpm_viz.core.words.shown`; each text between two tags
 of HTML with :func:`tpm_viz.core.words.shown_html`) and returns a :class:`Worded` handle over viser's own:
 
-- setting a text (``handle.content = "<b>Forces</b>"``, ``label``, ``hint``, ``options``, ``title``, ``series``,
-  ``axes``) keeps the English and writes the shown text to viser's handle; reading it gives the English back;
+- setting a text (``handle.content = Html("<b>Forces</b>")``, ``label``, ``hint``, ``options``, ``title``,
+  ``series``, ``axes``) keeps the English and writes the shown text to viser's handle; reading it gives the English
+  back;
+- an HTML or Markdown element shows as markup only what the code built as such (:class:`~tpm_viz.core.markup.Html`,
+  :class:`~tpm_viz.core.markup.Markdown`); anything else is text, escaped here (:func:`as_html`,
+  :func:`as_markdown`): a share link's label, a file name, a lesson's words are never read as markup by the page;
 - a choice (:class:`Choice`: a dropdown, a button group) reads and writes its English option, whatever the page
   shows; the page's choice, made in the tab's language, is mapped back to the English option at the same place;
 - ``on_update`` / ``on_click`` / ``on_upload`` / ``on_submit`` callbacks get an event whose ``target`` is the
@@ -21,7 +25,6 @@ the callbacks skip the server's own echoes of that). Texts built with numbers ar
 from __future__ import annotations
 
 import dataclasses
-import functools
 import inspect
 import threading
 from collections.abc import Callable, Sequence
@@ -29,39 +32,32 @@ from typing import Any, ClassVar, TypeVar
 
 import viser
 
-from tpm_viz.core.words import Lang, shown, shown_html
+from tpm_viz.core.markup import Html, Markdown
+from tpm_viz.core.words import Lang
+from tpm_viz.ui.shown import as_html, as_markdown, show_text
 from tpm_viz.viserkit.core import relabel_tab, removed
+from tpm_viz.viserkit.inputs import running, sent, writable
 
-__all__ = ["TEXTS", "Choice", "Tab", "TabGui", "Tabs", "Worded", "show_text"]
+__all__ = ["TEXTS", "Choice", "Tab", "TabGui", "Tabs", "Worded", "as_html", "as_markdown", "put", "show_text", "stored"]
 
 TEXTS = frozenset({"label", "hint", "content", "title", "options", "series", "axes"})
 """The text properties of a GUI element that a tab shows in its language."""
 
 
-@functools.lru_cache(maxsize=512)
-def _shown_content(lang: Lang, text: str) -> str:
-    """An HTML or markdown text as ``lang`` shows it (memoised: every tab of a session in one language is sent the
-    same dashboard and equations at each frame)."""
-    whole = shown(lang, text)
-    return whole if whole is not text else shown_html(lang, text)
+def put(handle: Any, value: Any) -> bool:
+    """Write a widget's value unless an input of the browser is on its way to its callback (:meth:`Worded.put`;
+    a handle that is not a :class:`Worded`, e.g. a test's stand-in, likewise). -> whether it was written."""
+    if isinstance(handle, Worded):
+        return handle.put(value)
+    if not writable(handle):
+        return False
+    handle.value = value
+    return True
 
 
-def show_text(lang: Lang, name: str, value: Any) -> Any:
-    """The value of the text property ``name`` as a tab in ``lang`` shows it (see the module docstring)."""
-    if lang is Lang.EN or value is None:
-        return value
-    if name == "content" and isinstance(value, str):
-        return _shown_content(lang, value)
-    if isinstance(value, str):
-        return shown(lang, value)
-    if name in ("series", "axes") and isinstance(value, (tuple, list)):  # uPlot: dictionaries with a "label"
-        return tuple(
-            {**v, "label": shown(lang, v["label"])} if isinstance(v, dict) and isinstance(v.get("label"), str) else v
-            for v in value
-        )
-    if isinstance(value, (tuple, list)):
-        return tuple(shown(lang, v) if isinstance(v, str) else v for v in value)
-    return value
+def stored(handle: Any) -> Any:
+    """A widget's value as viser holds it now (not the one its running callback's event brought)."""
+    return handle.handle.value if isinstance(handle, Worded) else handle.value
 
 
 class Worded:
@@ -69,6 +65,9 @@ class Worded:
 
     _AS: ClassVar[dict[str, str]] = {}
     """Text property -> the name :func:`show_text` translates it as (markdown: a whole text, not HTML)."""
+    _CONTENT: ClassVar[Any] = staticmethod(as_html)
+    """What a ``content`` becomes before it is shown (an HTML element: :func:`as_html`; Markdown:
+    :func:`as_markdown`): no text reaches the page as markup unless the code built it as such."""
 
     def __init__(self, gui: TabGui, handle: Any, texts: dict[str, Any]) -> None:
         object.__setattr__(self, "handle", handle)
@@ -78,16 +77,34 @@ class Worded:
 
     def __getattr__(self, name: str) -> Any:
         texts = self.__dict__.get("_texts", {})
-        return texts[name] if name in texts else getattr(self.__dict__["handle"], name)
+        if name in texts:
+            return texts[name]
+        handle = self.__dict__["handle"]
+        if name == "value":  # in its own callback: the value its event brought (viserkit/inputs.py)
+            return sent(handle, handle.value)
+        return getattr(handle, name)
 
     def __setattr__(self, name: str, value: Any) -> None:
         if isinstance(getattr(type(self), name, None), property):
             object.__setattr__(self, name, value)
         elif name in TEXTS:
+            if name == "content":
+                value = type(self)._CONTENT(value)
             self._texts[name] = value
             setattr(self.handle, name, self._show(name, value))
+        elif name == "value":
+            self.put(value)
         else:
             setattr(self.handle, name, value)
+
+    def put(self, value: Any) -> bool:
+        """Write the widget's value, unless a value the browser sent is on its way to this widget's callback
+        (:mod:`tpm_viz.viserkit.inputs`: a redraw, a deferred build or a restore never writes over an input; its
+        callback applies it, or refuses it and writes the state again). -> whether it was written."""
+        if not writable(self.handle):
+            return False
+        self.handle.value = value
+        return True
 
     def __enter__(self) -> Worded:
         self.handle.__enter__()
@@ -118,12 +135,20 @@ class Worded:
 
             async def run_async(event: Any) -> None:
                 if (ours := event_of(event)) is not None:
+                    if getattr(event, "client", None) is not None:
+                        with running(self.handle):  # awaited by viser on the loop at once: nothing came between
+                            pass
                     await func(ours)
 
             return run_async
 
         def run(event: Any) -> None:
-            if (ours := event_of(event)) is not None:
+            if (ours := event_of(event)) is None:
+                return
+            if getattr(event, "client", None) is None:  # the server's own write, echoed: no input applied
+                func(ours)
+                return
+            with running(self.handle, event):  # the inputs arrived so far are this call's (viserkit/inputs.py)
                 func(ours)
 
         return run
@@ -145,10 +170,11 @@ class Worded:
         return func
 
 
-class Markdown(Worded):
+class MarkdownElement(Worded):
     """A markdown element: its content shown as a whole text of the catalogue, as its label would be."""
 
     _AS: ClassVar[dict[str, str]] = {"content": "label"}
+    _CONTENT: ClassVar[Any] = staticmethod(as_markdown)
 
 
 class Choice(Worded):
@@ -163,8 +189,9 @@ class Choice(Worded):
 
     @property
     def value(self) -> Any:
-        """The English option chosen (the page's choice mapped back; a value of no option as it is)."""
-        raw, english = self.handle.value, tuple(self._texts["options"])
+        """The English option chosen (the page's choice mapped back; a value of no option as it is; in its own
+        callback, the one its event brought)."""
+        raw, english = sent(self.handle, self.handle.value), tuple(self._texts["options"])
         if raw in english and self._gui.lang is Lang.EN:
             return raw
         options = tuple(self.handle.options)
@@ -178,11 +205,15 @@ class Choice(Worded):
 
     @value.setter
     def value(self, value: Any) -> None:
+        self.put(value)
+
+    def put(self, value: Any) -> bool:
+        """Write the English option ``value`` (shown in the tab's language), unless an input is on its way."""
         english = tuple(self._texts["options"])
         options = tuple(self.handle.options)
         if value in english and len(options) == len(english):
             value = options[english.index(value)]
-        self.handle.value = value
+        return super().put(value)
 
     def relabel(self) -> None:
         """Options first, then the value (the same English option), then the other texts."""
@@ -278,10 +309,16 @@ class TabGui:
         return self._new(Tabs, self.gui.add_panel(**kw))
 
     # -- texts and charts ---------------------------------------------------------------------------------------
-    def add_markdown(self, content: str, **kw: Any) -> Markdown:
-        return self._new(Markdown, self.gui.add_markdown(self._show("label", content), **kw), content=content)
+    def add_markdown(self, content: Markdown | str, **kw: Any) -> MarkdownElement:
+        """A Markdown element: ``content`` as Markdown if it is a :class:`~tpm_viz.core.markup.Markdown`, else as
+        text."""
+        content = as_markdown(content)
+        handle = self.gui.add_markdown(self._show("label", content), **kw)
+        return self._new(MarkdownElement, handle, content=content)
 
-    def add_html(self, content: str, **kw: Any) -> Worded:
+    def add_html(self, content: Html | str, **kw: Any) -> Worded:
+        """An HTML element: ``content`` as markup if it is an :class:`~tpm_viz.core.markup.Html`, else as text."""
+        content = as_html(content)
         return self._new(Worded, self.gui.add_html(self._show("content", content), **kw), content=content)
 
     def add_uplot(

@@ -42,7 +42,7 @@ from viser.infra._async_message_buffer import AsyncMessageBuffer
 
 from tpm_viz.core.errors import TpmVizError
 from tpm_viz.viserkit import casts, wire
-from tpm_viz.viserkit.doors import ClientDoor, ServerDoor
+from tpm_viz.viserkit.doors import ClientDoor, ServerDoor, connection_request
 from tpm_viz.viserkit.patches import skipped
 from tpm_viz.viserkit.wire import Malformed
 
@@ -169,15 +169,6 @@ def drop_gizmo_echo(gizmo: Any) -> None:
     aux = getattr(gizmo, "_impl_aux", None)
     if aux is not None and hasattr(aux, "sync_cb"):
         aux.sync_cb = None
-
-
-def connection_request(server: viser.ViserServer, client_id: int) -> tuple[Any, Any] | None:
-    """``(client address as classroom.Handshakes read it, headers)`` of a tab's websocket handshake, or None."""
-    connection = server._websock_server._live_connections.get(client_id)
-    if connection is None or connection.request is None:
-        return None
-    client, remote = getattr(connection, "tpm_viz_client", None), tuple(connection.remote_address or ("", 0))
-    return (remote if client is None else (client, *remote[1:])), connection.request.headers
 
 
 # -- a tab's own words (ui/worded.py) --------------------------------------------------------------------------------

@@ -19,16 +19,36 @@ from tpm_viz.viserkit import wire
 __all__ = ["ClientDoor", "ServerDoor"]
 
 
+def connection_request(server: viser.ViserServer, client_id: int) -> tuple[Any, Any] | None:
+    """``(client address as classroom.Handshakes read it, headers)`` of a tab's websocket handshake, or None."""
+    connection = server._websock_server._live_connections.get(client_id)
+    if connection is None or connection.request is None:
+        return None
+    client, remote = getattr(connection, "tpm_viz_client", None), tuple(connection.remote_address or ("", 0))
+    return (remote if client is None else (client, *remote[1:])), connection.request.headers
+
+
 class ClientDoor:
     """A tab's message handling, for :mod:`.transport`: look up widgets and uploads, replace three handlers."""
 
     def __init__(self, client: viser.ClientHandle) -> None:
         self._conn = client._websock_connection
         self._gui = client.gui
+        self._client_id = client.client_id
+        self.server: viser.ViserServer = client._viser_server
+        """The tab's server (its upload budget: :func:`~.uploads.budget_of`)."""
         self.gui_update: wire.GuiUpdate = cast(wire.GuiUpdate, self._gui._handle_gui_updates)
         """viser's own handler of ``GuiUpdateMessage`` (call it to let a message through)."""
         self.upload_start: wire.Upload = cast(wire.Upload, self._gui._handle_file_transfer_start)
         self.upload_part: wire.Upload = cast(wire.Upload, self._gui._handle_file_transfer_part)
+
+    def address(self) -> str:
+        """The client address of the tab (as :class:`~tpm_viz.ui.classroom.Handshakes` read it), or ``""``."""
+        request = connection_request(self.server, self._client_id)
+        if request is None:
+            return ""
+        address = request[0]
+        return str(address[0] if isinstance(address, tuple) and address else address)
 
     def widget(self, uuid: str) -> Any:
         """The GUI handle with this uuid, or None."""

@@ -2,11 +2,12 @@
 :func:`~.limits.harden_server`).
 
 viser runs every plain ``def`` callback in one thread pool (32 threads), as many at once as a tab sends events: a
-tab that floods clicks holds every thread. Behind the gate a tab's callbacks run one at a time; meanwhile each
-callback has at most one call waiting (repeated clicks on an export coalesce into it, latest event wins) except
-clicks in the 3D view, which each carry their own point and wait in turn; at most ``max_per_tab`` in all, the rest
-are dropped with a rate-limited log line (:func:`~tpm_viz.classroom.guard.log_fault`). Connect and disconnect
-callbacks, and the server's own tasks, are never gated.
+tab that floods clicks holds every thread. Behind the gate a tab's callbacks run one at a time, in the order the tab
+sent its inputs; a call of the same callback as the last one waiting replaces it (repeated clicks on an export, a
+dragged slider: latest event wins) except clicks in the 3D view, which each carry their own point and wait in turn;
+at most ``max_per_tab`` wait, the rest are dropped with a rate-limited log line
+(:func:`~tpm_viz.classroom.guard.log_fault`). Connect and disconnect callbacks, and the server's own tasks, are never
+gated. Each event's value is stamped as it arrives (:func:`~.inputs.stamp`).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from typing import Any
 import viser
 
 from tpm_viz.classroom.guard import log_fault
+from tpm_viz.viserkit.inputs import abandon, stamp
 
 __all__ = ["Gate"]
 
@@ -45,14 +47,17 @@ def _done() -> concurrent.futures.Future:
 
 class Gate:
     """Per-tab admission in front of an executor's ``submit`` (see the module docstring): one call of a tab runs at a
-    time; while it runs, each callback of that tab has at most one call waiting (a repeated call replaces the
-    waiting one's event: latest wins; a click in the 3D view waits as its own call, its point is not another's), at
-    most ``max_per_tab`` waiting in all; waiting calls run in arrival order."""
+    time; the others wait in arrival order. A call of the same callback as the last one waiting replaces it (latest
+    wins: a slider dragged through 30 values, a burst of keystrokes); a call of another callback in between keeps
+    both, so that a tab's inputs are applied in the order it sent them (*Work on my own copy* then ``d1``: ``d1``
+    on the own copy). At most ``max_per_tab`` calls wait: beyond, a call replaces the waiting one of its callback,
+    moved to the end (still latest wins, after the others), or is dropped. A click in the 3D view waits as its own
+    call (its point is not another's)."""
 
     def __init__(self, submit: Callable[..., concurrent.futures.Future[Any]], max_per_tab: int = 8) -> None:
         self._submit, self.max_per_tab = submit, max_per_tab
         self._lock = threading.Lock()
-        self._waiting: dict[int, dict[Any, tuple]] = {}  # tab -> key -> (fn, args, kwargs); present = one running
+        self._waiting: dict[int, list[tuple[Any, Callable[..., Any], tuple, dict]]] = {}  # present = one running
         self._clicks = 0  # numbers the waiting 3D clicks (each its own key)
         self.blocked: set[int] = set()
         self.merged = 0
@@ -65,6 +70,7 @@ class Gate:
                 return self._submit(fn, *args, **kwargs)
             except RuntimeError:  # the pool is shut down (a tab left while the server stops): nothing to run
                 return _done()
+        stamp(args[0])  # the value this event brought, before a later one is stored (viserkit/inputs.py)
         with self._lock:
             waiting = self._waiting.get(client_id)
             if isinstance(args[0], _CLICKS):  # each click its own key: never merged
@@ -72,17 +78,22 @@ class Gate:
                 key: Any = (fn, self._clicks)
             else:
                 key = fn
+            call = (key, fn, args, kwargs)
+            reason = ""
             if client_id in self.blocked:
                 reason = "the tab is not reading what it is sent"
             elif waiting is None:
-                self._waiting[client_id] = {}
-                reason = ""
-            elif key in waiting:
-                waiting[key] = (fn, args, kwargs)
+                self._waiting[client_id] = []
+            elif waiting and waiting[-1][0] == key:
+                waiting[-1] = call
                 self.merged += 1
                 return _done()
             elif len(waiting) < self.max_per_tab:
-                waiting[key] = (fn, args, kwargs)
+                waiting.append(call)
+                return _done()
+            elif any(w[0] == key for w in waiting):
+                waiting[:] = [w for w in waiting if w[0] != key] + [call]
+                self.merged += 1
                 return _done()
             else:
                 reason = "too many of its callbacks are queued"
@@ -90,6 +101,7 @@ class Gate:
                 self.dropped += 1
         if reason:
             log_fault(client_id, "flood", f"callback dropped: {reason}")
+            abandon(getattr(args[0], "target", None))  # that widget is written again from the state
             return _done()
         return self._start(client_id, fn, args, kwargs)
 
@@ -116,7 +128,7 @@ class Gate:
             if not waiting:
                 self._waiting.pop(client_id, None)
                 return
-            fn, args, kwargs = waiting.pop(next(iter(waiting)))
+            _key, fn, args, kwargs = waiting.pop(0)
         self._start(client_id, fn, args, kwargs)
 
     def forget(self, client_id: int) -> None:
@@ -124,7 +136,7 @@ class Gate:
         with self._lock:
             self.blocked.discard(client_id)
             if client_id in self._waiting:
-                self._waiting[client_id] = {}
+                self._waiting[client_id] = []
 
     def pending(self, client_id: int) -> int:
         """Calls of this tab running or waiting."""

@@ -2,18 +2,19 @@
 
 :func:`harden_server` (called once by :func:`~.adapter.install`) installs, on one viser server:
 
-- **Bounded work per tab** (:class:`~.gate.Gate`, in front of viser's callback thread pool): a tab's callbacks run
-  one at a time (a flooding tab holds one pool thread, not 32); meanwhile each callback has at most one call waiting
-  (repeated clicks on an export coalesce into it, latest event wins) except clicks in the 3D view, which each
-  carry their own point and wait in turn; at most :attr:`Limits.max_callbacks_per_tab` in all, the rest are
-  dropped with a rate-limited log line. Connect and disconnect callbacks are never gated.
+- **Bounded work per tab** (:class:`~.gate.Gate`, in front of viser's callback thread pool): a tab's callbacks run one
+  at a time (a flooding tab holds one pool thread, not 32), in the order the tab sent its inputs; a call of the same
+  callback as the last one waiting replaces it (repeated clicks on an export, a dragged slider: latest event wins)
+  except clicks in the 3D view, which each carry their own point and wait in turn; at most
+  :attr:`Limits.max_callbacks_per_tab` wait, the rest are dropped with a rate-limited log line. Connect and disconnect
+  callbacks are never gated.
 - **Bounded memory**: websocket messages over :attr:`Limits.max_frame_bytes` close that connection (viser accepts
   50 MiB; the largest thing a browser sends is a 512 KiB upload part; :class:`~.patches.GuardedProtocol`,
   installed by :mod:`.adapter`); a watchdog thread drops a connection whose
   outgoing backlog (messages queued and not yet written: a tab that stopped reading) stays over
   :attr:`Limits.max_backlog_bytes` for :attr:`Limits.backlog_grace` seconds, and meanwhile runs none of its callbacks;
-  after tabs leave it returns freed heap to the system (``malloc_trim``). Uploads are bounded per tab in
-  :mod:`.transport`.
+  after tabs leave it returns freed heap to the system (``malloc_trim``). Uploads are bounded per tab, per address
+  and per server in :mod:`.transport` and :mod:`.uploads` (a tab's bytes in flight given back when it leaves).
 - **Bounded connections** (:class:`~.admission.Admission`): at most :attr:`Limits.max_connections` tabs, at most
   :attr:`Limits.max_per_address` from one source address, :attr:`Limits.lecturer_slots` kept for the lecturer's
   machine, and a socket that sends nothing within :attr:`Limits.first_message_seconds` is dropped (a refused tab is
@@ -47,6 +48,7 @@ from tpm_viz.viserkit.core import thread_pool
 from tpm_viz.viserkit.doors import ServerDoor
 from tpm_viz.viserkit.gate import Gate
 from tpm_viz.viserkit.transport import message_problem
+from tpm_viz.viserkit.uploads import budget_of
 from tpm_viz.viserkit.wire import Incoming, Wrapper
 
 __all__ = [
@@ -114,6 +116,8 @@ class ServerGuard:
         self._pool = pool = thread_pool(server)
         self._submit = pool.__dict__.get("submit")  # an instance's own (the callbacks' guard), or None: the class's
         self.gate = Gate(pool.submit, limits.max_callbacks_per_tab)
+        self.uploads = budget_of(server)
+        """The server's bytes of uploads in flight (:mod:`.uploads`): a tab's are given back when it leaves."""
         pool.submit = self.gate.submit
         self.admission = Admission(self.door, limits, time.monotonic)
         """Who gets a connection (:mod:`.admission`)."""
@@ -147,6 +151,7 @@ class ServerGuard:
         self.admission.left(client_id)
         self._malformed.pop(client_id, None)
         self.gate.forget(client_id)
+        self.uploads.leave(client_id)
         FAULTS.forget(client_id)
 
     def _wrap(self, log: bool) -> Wrapper:

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from importlib import resources
 from urllib.parse import parse_qs, urlsplit
 
+from tpm_viz.core.markup import Html
 from tpm_viz.viserkit.keys import NONCE_CHARS
 
 __all__ = ["EVERY_MS", "SEEN_PATH", "SEEN_SCRIPT", "SETTINGS", "SeenRequest", "seen_request", "tab_marker"]
@@ -61,12 +62,12 @@ def seen_request(path: str) -> SeenRequest | None:
     return SeenRequest(nonce, what, int(count))
 
 
-def tab_marker(name: str) -> str:
+def tab_marker(name: str) -> Html:
     """The HTML of the marker of a tab of the panel (put inside the tab): ``name`` is what the script tells when the
     tab is shown (lower-case letters)."""
     if not re.fullmatch(r"[a-z]{1,24}", name):
         raise ValueError(f"a tab marker's name is 1-24 lower-case letters, not {name!r}")
-    return f'<div data-tpmviz-tab="{name}" style="height:0;margin:0;overflow:hidden"></div>'
+    return Html(f'<div data-tpmviz-tab="{name}" style="height:0;margin:0;overflow:hidden"></div>')
 
 
 SEEN_SCRIPT = resources.files("tpm_viz.viserkit").joinpath("seen.js").read_text(encoding="utf-8")

@@ -39,7 +39,6 @@ import contextlib
 import dataclasses
 import functools
 import math
-import time
 import types
 import typing
 from collections.abc import Callable
@@ -52,7 +51,9 @@ from tpm_viz.classroom.guard import log_fault
 from tpm_viz.core.words import Lang, Phrase, T, say
 from tpm_viz.viserkit.core import Malformed, widget_value
 from tpm_viz.viserkit.doors import ClientDoor
+from tpm_viz.viserkit.inputs import arrived
 from tpm_viz.viserkit.patches import skipped
+from tpm_viz.viserkit.uploads import UploadBudget, budget_of, expire_later
 
 __all__ = ["MAX_UPLOADS", "UPLOAD_TIMEOUT", "harden", "message_problem", "update_problem"]
 
@@ -81,16 +82,21 @@ def update_problem(current: Any, updates: Any, handle: Any = None, max_text: int
 
 
 def harden(
-    client: viser.ClientHandle, max_upload_bytes: int = MAX_UPLOAD_BYTES, lang: Callable[[], Lang] | None = None
+    client: viser.ClientHandle,
+    max_upload_bytes: int = MAX_UPLOAD_BYTES,
+    lang: Callable[[], Lang] | None = None,
+    budget: UploadBudget | None = None,
 ) -> None:
     """Install the filters of the module docstring on ``client``'s connection (call once, on connect). ``lang``
-    returns the tab's language at the time of a refusal (None: English), e.g. ``lambda: view.lang``. Nothing is
-    installed if the ``transport`` patch is skipped on the client's server (:func:`~.adapter.install`)."""
+    returns the tab's language at the time of a refusal (None: English), e.g. ``lambda: view.lang``; ``budget``: the
+    server's bytes of uploads in flight (default: :func:`~.uploads.budget_of` the client's server; the app gives
+    a tab's back when it leaves). Nothing is installed if the ``transport`` patch is skipped on the client's server
+    (:func:`~.adapter.install`)."""
     if skipped(client, "transport"):
         return
     door = ClientDoor(client)
     cid = client.client_id
-    in_flight: dict[str, tuple[float, str, int]] = {}  # transfer uuid -> (start time, button, size): unfinished
+    uploads = _Uploads(client, door, max_upload_bytes, lang, budget if budget is not None else budget_of(door.server))
 
     async def gui_update(client_id: Any, message: Any) -> None:
         handle = door.widget(message.uuid)
@@ -99,68 +105,101 @@ def harden(
             if problem is not None:
                 log_fault(cid, "gui", f"GUI update dropped: {problem}")
                 return
+            arrived(handle, message.updates)  # its callback will apply it: no redraw writes over it meanwhile
         await door.gui_update(client_id, message)
 
-    def refuse_upload(why: Phrase, button: str | None, transfer: str, size: int) -> None:
-        door.end_upload(str(button), transfer, max(0, size))  # no spinner left, the button free again
-        if log_fault(cid, "upload", f"upload refused: {why}"):  # at most one notification per second as well
+    door.replace(gui_update, uploads.start, uploads.part)
+
+
+class _Uploads:
+    """One tab's uploads in flight (see :mod:`.uploads`): at most :data:`MAX_UPLOADS`, each in the server's budget,
+    each freed after :data:`UPLOAD_TIMEOUT` seconds if unfinished."""
+
+    def __init__(
+        self,
+        client: viser.ClientHandle,
+        door: ClientDoor,
+        max_upload_bytes: int,
+        lang: Callable[[], Lang] | None,
+        budget: UploadBudget,
+    ) -> None:
+        self.client, self.door, self.cid = client, door, client.client_id
+        self.max_upload_bytes, self.lang, self.budget = max_upload_bytes, lang, budget
+        self.address = door.address()
+        self.in_flight: dict[str, tuple[str, int, Any]] = {}  # transfer uuid -> (button, size, timer): unfinished
+
+    def refuse(self, why: Phrase, button: str | None, transfer: str, size: int) -> None:
+        self.door.end_upload(str(button), transfer, max(0, size))  # no spinner left, the button free again
+        if log_fault(self.cid, "upload", f"upload refused: {why}"):  # at most one notification per second as well
             tab = Lang.EN
             with contextlib.suppress(Exception):  # a getter that fails: English
-                tab = Lang.EN if lang is None else Lang(lang())
+                tab = Lang.EN if self.lang is None else Lang(self.lang())
             with contextlib.suppress(Exception):
                 title, text = say(tab, T("Upload refused")), say(tab, why)
-                client.add_notification(title, text, color="red", auto_close_seconds=8.0)
+                self.client.add_notification(title, text, color="red", auto_close_seconds=8.0)
 
-    def expire(transfer: str) -> None:
-        entry = in_flight.pop(transfer, None)
-        if entry is not None and door.upload_state(transfer) is not None:
-            door.drop_upload(transfer)
+    def end(self, transfer: str) -> tuple[str, int, Any] | None:
+        """``transfer`` is over (finished, refused, expired): its timer stopped, its bytes given back."""
+        entry = self.in_flight.pop(transfer, None)
+        if entry is not None and entry[2] is not None:
+            entry[2].cancel()
+        self.budget.give(self.cid, transfer)
+        return entry
+
+    def expire(self, transfer: str) -> None:
+        if transfer in self.in_flight and self.door.upload_state(transfer) is not None:
+            self.door.drop_upload(transfer)
+            button, size, _timer = self.end(transfer) or ("", 0, None)
             late = Phrase("the upload did not finish within {seconds:g} s", seconds=UPLOAD_TIMEOUT)
-            refuse_upload(late, entry[1], transfer, entry[2])
+            self.refuse(late, button, transfer, size)
+        else:
+            self.end(transfer)
 
-    def upload_start(client_id: Any, message: Any) -> None:
+    def start(self, client_id: Any, message: Any) -> None:
         size, parts = message.size_bytes, message.part_count
-        for transfer in [t for t in in_flight if door.upload_state(t) is None]:  # finished ones
-            del in_flight[transfer]
-        if not isinstance(door.widget(message.source_component_uuid), viser.GuiUploadButtonHandle):
-            log_fault(cid, "upload", "upload dropped: not aimed at an upload button")
+        for transfer in [t for t in self.in_flight if self.door.upload_state(t) is None]:  # finished ones
+            self.end(transfer)
+        if not isinstance(self.door.widget(message.source_component_uuid), viser.GuiUploadButtonHandle):
+            log_fault(self.cid, "upload", "upload dropped: not aimed at an upload button")
             return
         button, transfer = message.source_component_uuid, message.transfer_uuid
-        if not (0 <= size <= max_upload_bytes and 0 <= parts <= max(1, size)):
-            refuse_upload(Phrase(TOO_LARGE.template, size=size, most=max_upload_bytes), button, transfer, size)
+        if not (0 <= size <= self.max_upload_bytes and 0 <= parts <= max(1, size)):
+            self.refuse(Phrase(TOO_LARGE.template, size=size, most=self.max_upload_bytes), button, transfer, size)
             return
-        if len(in_flight) >= MAX_UPLOADS or transfer in in_flight:
-            refuse_upload(Phrase("at most {count} uploads at a time", count=MAX_UPLOADS), button, transfer, size)
+        if len(self.in_flight) >= MAX_UPLOADS or transfer in self.in_flight:
+            self.refuse(Phrase("at most {count} uploads at a time", count=MAX_UPLOADS), button, transfer, size)
             return
-        in_flight[transfer] = (time.monotonic(), str(button), size)
+        refusal = self.budget.take(self.cid, self.address, transfer, size)
+        if refusal is not None:
+            self.refuse(refusal.why, button, transfer, size)
+            return
+        timer = None
         with contextlib.suppress(RuntimeError):  # called on the server's event loop
-            asyncio.get_running_loop().call_later(UPLOAD_TIMEOUT, expire, transfer)
+            timer = expire_later(asyncio.get_running_loop(), UPLOAD_TIMEOUT, self, _Uploads.expire, transfer)
+        self.in_flight[transfer] = (str(button), size, timer)
         if parts == 0:  # an empty file: viser finishes it at once
-            door.end_upload(str(button), transfer)
-        door.upload_start(client_id, message)
+            self.door.end_upload(str(button), transfer)
+        self.door.upload_start(client_id, message)
+        if self.door.upload_state(transfer) is None:
+            self.end(transfer)
 
-    def upload_part(client_id: Any, message: Any) -> None:
-        state = door.upload_state(message.transfer_uuid)
-        if state is None or message.transfer_uuid not in in_flight:
+    def part(self, client_id: Any, message: Any) -> None:
+        transfer = message.transfer_uuid
+        state = self.door.upload_state(transfer)
+        if state is None or transfer not in self.in_flight:
             return  # not this tab's upload in progress (or already refused): nothing is buffered
         if state["transferred_bytes"] + len(message.content) > state["total_bytes"]:
-            door.drop_upload(message.transfer_uuid)
-            in_flight.pop(message.transfer_uuid, None)
-            refuse_upload(
-                T("the file sent more bytes than it announced"),
-                message.source_component_uuid,
-                message.transfer_uuid,
-                state["total_bytes"],
-            )
+            self.door.drop_upload(transfer)
+            self.end(transfer)
+            button = message.source_component_uuid
+            self.refuse(T("the file sent more bytes than it announced"), button, transfer, state["total_bytes"])
             return
         parts, count = state["parts"], state["part_count"]
         if message.part_index not in parts and 0 <= message.part_index < count and len(parts) + 1 >= count:
-            door.end_upload(str(message.source_component_uuid), message.transfer_uuid)  # the last part: before its ack
-        door.upload_part(client_id, message)
-        if door.upload_state(message.transfer_uuid) is None:
-            in_flight.pop(message.transfer_uuid, None)
-
-    door.replace(gui_update, upload_start, upload_part)
+            self.door.end_upload(str(message.source_component_uuid), transfer)  # the last part: before its ack
+        self.door.upload_part(client_id, message)
+        if self.door.upload_state(transfer) is None:
+            self.end(transfer)
 
 
 def message_problem(message: Any) -> str | None:

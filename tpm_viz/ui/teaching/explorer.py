@@ -28,7 +28,9 @@ from tpm_viz.classroom.guard import guarded
 from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.classroom.text import num
 from tpm_viz.classroom.worker import Worker
+from tpm_viz.core import markup
 from tpm_viz.core.errors import BusyError
+from tpm_viz.core.markup import Html, Markdown
 from tpm_viz.core.params import Params
 from tpm_viz.core.words import Lang, Phrase, T, say
 from tpm_viz.drawing import meshes
@@ -43,6 +45,10 @@ ELLIPSE_SCALE = 0.12
 ELLIPSE_CAP = 3.0
 ELLIPSE_Z = meshes.PLATFORM_Z[1] + 0.004
 ELLIPSE_COLOURS = {"velocity": (30, 58, 138), "force": (234, 88, 12)}  # dark blue (not the leg circles' blue)
+STATUS = "<p style='margin:0;padding:0 0 4px;font-size:0.875em'>{text}</p>"
+"""The map's status line (why it is unavailable), its text escaped (:func:`tpm_viz.core.markup.html`)."""
+STATUS_BUSY = "<p style='margin:0;padding:0 0 4px;font-size:0.875em'><i>{text}</i></p>"
+"""The map's status line while it is computed."""
 
 
 class MapService:
@@ -121,12 +127,12 @@ def _legend(lang: Lang, text: str | Phrase | None) -> str:
     return html.escape(text.render(lang) if isinstance(text, Phrase) else str(text or ""))
 
 
-def colour_bar_html(kind: str, lang: Lang = Lang.EN) -> str:
+def colour_bar_html(kind: str, lang: Lang = Lang.EN) -> Html:
     """The legend of a map kind: a gradient (or swatches) with labelled stops, in ``lang``."""
     scale = colour_scale(kind)
     if not scale.stops:
         words = html.escape(say(lang, T("No map: the floor shows the in-stroke workspace.")))
-        return f'<div style="font-size:0.8em;color:#64748b">{words}</div>'
+        return Html(f'<div style="font-size:0.8em;color:#64748b">{words}</div>')
 
     def esc(text: str | Phrase | None) -> str:
         return _legend(lang, text)
@@ -144,7 +150,7 @@ def colour_bar_html(kind: str, lang: Lang = Lang.EN) -> str:
             f'<div style="height:12px;border-radius:2px;background:linear-gradient(to right, {stops})"></div>'
             f'<div style="display:flex;justify-content:space-between;font-variant-numeric:tabular-nums">{labels}</div>'
         )
-    return (
+    return Html(
         f'<div data-q="map-legend" style="font-size:0.8em;color:#334155;line-height:1.4">'
         f"<b>{esc(scale.title)}</b>{body}<div style='color:#64748b'>{esc(scale.note)}</div></div>"
     )
@@ -170,12 +176,14 @@ class ExplorerView:
     def build(self, gui: TabGui) -> None:
         """The *Explorer* tab's widgets (inside the tab's context)."""
         gui.add_markdown(
-            "Colour the floor with a map of the workspace and draw the manipulability ellipses at the platform. "
-            "The loci stay on top: red arcs cos(θ1+θ2) = 0 (eq. 12), amber square |p_j| = l_a (eq. 11)."
+            Markdown(
+                "Colour the floor with a map of the workspace and draw the manipulability ellipses at the platform. "
+                "The loci stay on top: red arcs cos(θ1+θ2) = 0 (eq. 12), amber square |p_j| = l_a (eq. 11)."
+            )
         )
         self.map_kind = gui.add_dropdown("Floor map", tuple(MAP_KINDS.values()), initial_value=MAP_KINDS["off"])
         self.legend = gui.add_html(colour_bar_html("off", self.view.lang))
-        self.status = gui.add_markdown("")
+        self.status = gui.add_html("")
         self.ellipses = gui.add_checkbox(
             "Manipulability ellipses", False, hint="Velocity (dark blue) and force (orange) ellipses at the platform"
         )
@@ -245,9 +253,12 @@ class ExplorerView:
         if images is None:
             failure = self.maps.failure(params)
             lang = self.view.lang
-            computing = "*" + say(lang, T("Computing the map for these parameters…")) + "*"
+            computing = T("Computing the map for these parameters…")
             unavailable = Phrase("Map unavailable: {why}", why=failure) if failure else None
-            self.status.content = html.escape(say(lang, unavailable)) if unavailable else computing
+            if unavailable:
+                self.status.content = markup.html(STATUS, text=say(lang, unavailable))
+            else:
+                self.status.content = markup.html(STATUS_BUSY, text=say(lang, computing))
             if self._image is not None:
                 self._image.visible = False
             return
@@ -302,9 +313,9 @@ class ExplorerView:
                     handle.visible = True
         self.readout.content = self._readout_html(frame, drawing)
 
-    def _readout_html(self, frame: Snapshot, drawing) -> str:
+    def _readout_html(self, frame: Snapshot, drawing) -> Html:
         if not self.ellipses_on:
-            return ""
+            return Html("")
         r, lang = frame.readout, self.view.lang
         head = say(
             lang,
@@ -335,7 +346,9 @@ class ExplorerView:
                 else Phrase("drawn at {mm:.0f} mm per unit", mm=ELLIPSE_SCALE * 1e3)
             )
             body = "<br>".join(say(lang, x) for x in (velocity, force, scale))
-        return f'<div data-q="ellipses" style="font-size:0.8em;color:#334155;line-height:1.4">{head}<br>{body}</div>'
+        return Html(
+            f'<div data-q="ellipses" style="font-size:0.8em;color:#334155;line-height:1.4">{head}<br>{body}</div>'
+        )
 
     def retell(self) -> None:
         """The tab's language changed: the legend and the map's status again, in it (under the hub's lock)."""

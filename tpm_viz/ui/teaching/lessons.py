@@ -29,6 +29,7 @@ from tpm_viz.classroom.runhub import RunHub
 from tpm_viz.classroom.session import View
 from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.core.errors import TpmVizError
+from tpm_viz.core.markup import Html, Markdown
 from tpm_viz.core.words import Lang, Phrase, T, say
 from tpm_viz.ui.scene import camera_pose
 from tpm_viz.ui.teaching.explorer import ExplorerView
@@ -46,22 +47,22 @@ def _internal_error(owner, exc: Exception) -> None:
     owner.view.refuse(what, resync=False)
 
 
-def problems_html(problems: Sequence[str], lang: Lang = Lang.EN) -> str:
+def problems_html(problems: Sequence[str], lang: Lang = Lang.EN) -> Html:
     """The lesson files that were refused, one line each (``file:line: what is wrong``), in ``lang`` (a
     :class:`~tpm_viz.app.lesson_toml.Problem` keeps its phrase; any other line is shown as it is)."""
     lines = "".join(f"<li>{html.escape(say(lang, getattr(p, 'phrase', p)))}</li>" for p in problems)
     head = say(lang, "{count} lesson file(s) refused:", count=len(problems))
-    return (
+    return Html(
         f'<div data-q="demo-problems" style="font-size:0.8em;color:#b91c1c"><b>{html.escape(head)}'
         f'</b><ul style="margin:2px 0 0 16px;padding:0">{lines}</ul></div>'
     )
 
 
-def demo_html(demo: Demo, facts: str, lang: Lang = Lang.EN) -> str:
+def demo_html(demo: Demo, facts: str, lang: Lang = Lang.EN) -> Html:
     """The paragraph of a demonstration in ``lang`` (English if the lesson has none in it) and the line of numbers
     that backs it."""
     esc = html.escape
-    return (
+    return Html(
         f'<div data-q="demo" lang="{lang.value}" style="font-size:0.85em;color:#1e293b;line-height:1.45">'
         f"<p style='margin:0 0 6px 0'>{esc(demo.text_in(lang.value))}</p>"
         + (
@@ -104,8 +105,10 @@ class DemosView:
     def build(self, gui: TabGui) -> None:
         """The *Demos* tab's widgets (inside the tab's context)."""
         gui.add_markdown(
-            "A guided tour for a lecture. Each scene sets the mechanism (shared with the class unless you work on "
-            "your own copy), your camera and your floor map; *Play the motion* runs its trajectory in the Player."
+            Markdown(
+                "A guided tour for a lecture. Each scene sets the mechanism (shared with the class unless you work on "
+                "your own copy), your camera and your floor map; *Play the motion* runs its trajectory in the Player."
+            )
         )
         if self.problems:
             self.problems_note = gui.add_html(problems_html(self.problems, self.view.lang))
@@ -120,12 +123,12 @@ class DemosView:
         self.steps.on_click(self._on_step)
         self.play.on_click(self._on_play)
 
-    def _paragraph(self) -> str:
+    def _paragraph(self) -> Html:
         """The current lesson's paragraph and numbers in the tab's language."""
         lang = self.view.lang
         if not self.lessons:
-            return f"<p>{html.escape(say(lang, 'No lessons to show.'))}</p>"
-        return demo_html(self.lessons[self.index], say(lang, self._facts), lang)
+            return Html(f"<p>{html.escape(say(lang, 'No lessons to show.'))}</p>")
+        return Html(demo_html(self.lessons[self.index], say(lang, self._facts), lang))
 
     def retell(self) -> None:
         """The tab's language changed: the paragraph and the refused files again, in it (under the hub's lock)."""

@@ -245,7 +245,15 @@ class Teaching:
         """The tab moved from ``old`` to its current session (own copy on / off)."""
         with self.view.hub.lock:
             self.services.runs.adopt(self.view.session, old)
+            self._abandon(old)
             self.run_changed()
+
+    def _abandon(self, session: Session) -> None:
+        """``session`` lost its last tab: a private copy's pending jobs (a run of a 20,000-row upload) are dropped,
+        not computed for nobody while they keep the copy and its tab's page alive (what the tab had is kept by
+        :class:`~tpm_viz.classroom.away.Away`, its trajectory as a source, loaded again if it comes back)."""
+        if not session.shared and not session.views:
+            self.services.worker.leave(session)
 
     def run_changed(self) -> None:
         """The session's run changed: redraw the player (if its tab exists: it draws the run when built)."""
@@ -314,3 +322,4 @@ class Teaching:
         self._control.player.stop()
         self._planner.player.stop()
         self.services.worker.leave(self.view)  # its pending maps, simulations and plans are dropped
+        self._abandon(self.view.session)

@@ -24,6 +24,7 @@ from typing import Any
 
 from tpm_viz.classroom.guard import guarded
 from tpm_viz.core.errors import TpmVizError
+from tpm_viz.core.markup import Html
 from tpm_viz.ui.fields import TypedBox
 from tpm_viz.ui.widgets.typed import QUIET, Quantity, TypedField, TypedGroup
 from tpm_viz.viserkit.core import widget_uuid
@@ -36,7 +37,7 @@ SLIDER_HINT = "Drag, or type a number (1e3, 0,5 and the unit work); Enter applie
 KEY = "value"
 
 
-def row_css(slider: Any, field: Any) -> str:
+def row_css(slider: Any, field: Any) -> Html:
     """The style sheet of one row: the slider's form as a grid of two columns (the slider, then the typed field in
     :data:`FIELD_WIDTH`), viser's number box beside the slider hidden, the field's own label kept for screen readers
     only (the slider's label names the row). In viser 1.1.1 the slider's root has the handle's uuid as ``id``; a
@@ -44,10 +45,10 @@ def row_css(slider: Any, field: Any) -> str:
     try:
         s, f = widget_uuid(slider), widget_uuid(field)
     except AttributeError:  # a GUI without a page (a test's stand-in): nothing to style
-        return ""
+        return Html("")
     form = f'form:has(label[for="{f}"])'
     row = f'div:has(> div > div > p > label[for="{f}"])'
-    return (
+    return Html(
         "<style>"
         f"{form} {{ display: grid; grid-template-columns: minmax(0, 1fr) {FIELD_WIDTH}; align-items: center; }}"
         f'[id="{s}"] ~ * {{ display: none !important; }}'

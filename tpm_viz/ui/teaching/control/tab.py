@@ -25,6 +25,7 @@ from tpm_viz.classroom.runhub import RunHub
 from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.classroom.worker import Worker
 from tpm_viz.core.errors import InputError, TpmVizError
+from tpm_viz.core.markup import Html, Markdown, html
 from tpm_viz.core.params import Params
 from tpm_viz.core.words import Phrase, T, say
 from tpm_viz.drawing.palette import hex_colour
@@ -98,9 +99,11 @@ class ControlView:
     def build(self, gui: TabGui) -> None:
         """The *Control* tab's widgets (inside the tab's context)."""
         gui.add_markdown(
-            "Track a reference with a controller on the multibody plant (Pinocchio). The green ghost is the "
-            "reference, the mechanism the actual platform; magnify the error to see it. Playback moves the "
-            "mechanism you are on (shared with the class unless you work on your own copy)."
+            Markdown(
+                "Track a reference with a controller on the multibody plant (Pinocchio). The green ghost is the "
+                "reference, the mechanism the actual platform; magnify the error to see it. Playback moves the "
+                "mechanism you are on (shared with the class unless you work on your own copy)."
+            )
         )
         self.controller = gui.add_dropdown("Controller", tuple(CONTROLLERS), initial_value=LABELS[ControllerKind.CTC])
         self.typed: dict[
@@ -360,9 +363,9 @@ class ControlView:
             return
         lang = self.view.lang
         self.summary.content = run_html(self.run, self.seconds, self.busy, self.status, lang) + (
-            f"<div style='font-size:0.85em;color:#334155'>{say(lang, T('playing…'))}</div>"
+            html("<div style='font-size:0.85em;color:#334155'>{text}</div>", text=say(lang, T("playing…")))
             if self.player.playing
-            else ""
+            else Html("")
         )
         self.view.client.flush()
 

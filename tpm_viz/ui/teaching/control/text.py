@@ -9,6 +9,7 @@ import html
 
 from tpm_viz.app.run_names import reference_words
 from tpm_viz.classroom.text import num
+from tpm_viz.core.markup import Html
 from tpm_viz.core.words import Lang, Phrase, T, say
 from tpm_viz.multibody.control import ControlRun
 from tpm_viz.paper.control import ControllerKind, Gains
@@ -30,7 +31,7 @@ def _q(name: str, text: str) -> str:
     return f"<span data-q='{name}'>{text}</span>"
 
 
-def gains_html(kind: ControllerKind, gains: Gains, masses: tuple[float, float], lang: Lang = Lang.EN) -> str:
+def gains_html(kind: ControllerKind, gains: Gains, masses: tuple[float, float], lang: Lang = Lang.EN) -> Html:
     """The gains of the chosen law: ``K_p = ω²``, ``K_d = 2ζω`` and, for the actuator-space loops, the stiffness."""
     text = (
         f"ω = 2π ω_n = {num(gains.omega, '.1f')} rad/s, "
@@ -53,7 +54,7 @@ def gains_html(kind: ControllerKind, gains: Gains, masses: tuple[float, float], 
         if kind is ControllerKind.PDFF:
             feedforward = T("plus the closed-form τ along the reference (eqs. 29-31) as feedforward")
             text += "<br>" + html.escape(say(lang, feedforward))
-    return f'<div data-q="gains" style="{_STYLE}">{text}</div>'
+    return Html(f'<div data-q="gains" style="{_STYLE}">{text}</div>')
 
 
 def setup_phrase(run: ControlRun) -> Phrase:
@@ -80,7 +81,7 @@ def run_html(
     busy: str | Phrase = "",
     status: str | Phrase = "",
     lang: Lang = Lang.EN,
-) -> str:
+) -> Html:
     """The run being played: its figures, how long it took to simulate, what is computing, why it stopped."""
     esc = html.escape
     lines = []
@@ -110,16 +111,16 @@ def run_html(
             saturated=num(run.time_in_saturation, ".1f", 1e3),
         )
         lines.append(say(lang, figures))
-    return f'<div data-q="control-run" style="{_STYLE}">' + "<br>".join(lines) + "</div>"
+    return Html(f'<div data-q="control-run" style="{_STYLE}">' + "<br>".join(lines) + "</div>")
 
 
 _HEADS = (T("controller"), T("RMS error (µm)"), T("max error (µm)"), T("peak |τ| (N)"), T("saturated (ms)"))
 
 
-def comparison_html(runs: dict[ControllerKind, ControlRun], setup: str | Phrase, lang: Lang = Lang.EN) -> str:
+def comparison_html(runs: dict[ControllerKind, ControlRun], setup: str | Phrase, lang: Lang = Lang.EN) -> Html:
     """The controllers on the same run (same reference, mechanism, mismatch, limits and noise)."""
     if not runs:
-        return ""
+        return Html("")
     cell = "padding:2px 4px;text-align:right;font-variant-numeric:tabular-nums"
     head = "".join(f'<th style="{cell}">{html.escape(say(lang, h))}</th>' for h in _HEADS)
     body = []
@@ -136,7 +137,7 @@ def comparison_html(runs: dict[ControllerKind, ControlRun], setup: str | Phrase,
             f'<td style="{cell}" data-q="sat-{v}">{num(run.time_in_saturation, ".1f", 1e3)}</td></tr>'
         )
     title = html.escape(say(lang, T("Same run, each controller")))
-    return (
+    return Html(
         f'<div data-q="control-table" style="{_STYLE}"><b>{title}</b> '
         f'<span style="color:#64748b">({html.escape(say(lang, setup))})</span>'
         f'<div style="overflow-x:auto"><table style="border-collapse:collapse;margin-top:4px">'
@@ -153,11 +154,13 @@ def _ratio(a: float, b: float) -> Phrase | str:
     return Phrase("{ratio}× larger", ratio=num(b / a, ".2g"))
 
 
-def lesson_html(runs: dict[ControllerKind, ControlRun], payload: float, mass_error: float, lang: Lang = Lang.EN) -> str:
+def lesson_html(
+    runs: dict[ControllerKind, ControlRun], payload: float, mass_error: float, lang: Lang = Lang.EN
+) -> Html:
     """The lesson "why computed torque", its claims worded from the three runs' numbers."""
     pd, ff, ctc = (runs.get(k) for k in (ControllerKind.PD, ControllerKind.PDFF, ControllerKind.CTC))
     if pd is None or ff is None or ctc is None:
-        return ""
+        return Html("")
     e = {k: r.rms_error for k, r in runs.items()}
     best = min(e, key=lambda k: e[k])
     payload_words = Phrase("a payload of {mass} kg the controllers do not know", mass=num(payload, ".2f"))
@@ -196,7 +199,7 @@ def lesson_html(runs: dict[ControllerKind, ControlRun], payload: float, mass_err
             best=html.escape(say(lang, label_of(best))),
         ),
     ]
-    return (
+    return Html(
         f'<div data-q="lesson" style="{_STYLE}">'
         + "".join(f"<p style='margin:0 0 4px 0'>{say(lang, p)}</p>" for p in paras)
         + "</div>"

@@ -25,6 +25,7 @@ from tpm_viz.app.readouts import reason
 from tpm_viz.classroom.guard import guarded
 from tpm_viz.classroom.worker import Worker
 from tpm_viz.core.errors import BusyError, InputError, TpmVizError
+from tpm_viz.core.markup import Markdown, escape
 from tpm_viz.core.params import Params
 from tpm_viz.core.words import Phrase, T, say
 from tpm_viz.design.atlas import Row
@@ -36,10 +37,11 @@ from tpm_viz.ui.fields import Note, TypedBox
 from tpm_viz.ui.teaching.design import text
 from tpm_viz.ui.teaching.design.compare import in_turns
 from tpm_viz.ui.teaching.design.compare import start as start_comparison
+from tpm_viz.ui.teaching.design.fields import count_field, length_field
 from tpm_viz.ui.teaching.design.map import CHUNK, INDICES, MAX_COUNT, SWEPT, Axis, MapSpec, best_cell, colours
 from tpm_viz.ui.teaching.design.map import values as map_values
 from tpm_viz.ui.teaching.design.scene import PENDING, DesignScene, comparison_designs
-from tpm_viz.ui.widgets.typed import Quantity, TypedField, TypedGroup
+from tpm_viz.ui.widgets.typed import TypedGroup
 from tpm_viz.ui.worded import TabGui
 
 __all__ = ["DesignView"]
@@ -47,14 +49,6 @@ __all__ = ["DesignView"]
 
 def _internal_error(owner, exc: Exception) -> None:
     owner.view.refuse(Phrase("internal error ({kind}), logged on the server", kind=type(exc).__name__), resync=False)
-
-
-def _length(name: str, value_m: float) -> TypedField:
-    return TypedField(Quantity(name, "mm", 1e-3, -5000.0, 5000.0), value_m)
-
-
-def _count(value: int) -> TypedField:
-    return TypedField(Quantity("count", "", 1.0, 1.0, float(MAX_COUNT)), float(value))
 
 
 class DesignView:
@@ -81,16 +75,12 @@ class DesignView:
     # -- widgets -------------------------------------------------------------------------------------------
     def build(self, gui: TabGui) -> None:
         """The *Design* tab's widgets (inside the tab's context)."""
-        gui.add_markdown(
-            "Size the machine for a task: a map of designs over two dimensions, coloured by an index; click a cell "
-            "(or type its column and row) to load the design. The map and the comparison are drawn in the Design "
-            "area of the scene."
-        )
+        gui.add_markdown(Markdown(text.INTRO))
         self.arrangement = gui.add_dropdown(
             "Arrangement", tuple(a.value for a in Arrangement), initial_value="perpendicular"
         )
         self.task_box = TypedBox(
-            gui, TypedGroup({k: _length(k, v) for k, v in self._task_values().items()}), text.TASK_LABELS
+            gui, TypedGroup({k: length_field(k, v) for k, v in self._task_values().items()}), text.TASK_LABELS
         )
         names = tuple(SWEPT)
         self.x_name = gui.add_dropdown("Across: parameter", names, initial_value="a")
@@ -98,8 +88,8 @@ class DesignView:
         fields = {}
         for axis in ("x", "y"):
             _name, lo, hi, count = self.axes[axis]
-            fields[f"{axis}_from"], fields[f"{axis}_to"] = _length("from", lo), _length("to", hi)
-            fields[f"{axis}_count"] = _count(count)
+            fields[f"{axis}_from"], fields[f"{axis}_to"] = length_field("from", lo), length_field("to", hi)
+            fields[f"{axis}_count"] = count_field(count)
         self.range_box = TypedBox(gui, TypedGroup(fields), text.RANGE_LABELS)
         self.index = gui.add_dropdown(
             "Colour by", tuple(i.label for i in INDICES.values()), initial_value=INDICES["gci"].label
@@ -108,7 +98,7 @@ class DesignView:
         self.note = Note(gui)
         self.progress = gui.add_html("")
         self.legend = gui.add_html("")
-        self.pick_box = TypedBox(gui, TypedGroup({"column": _count(1), "row": _count(1)}), text.PICK_LABELS)
+        self.pick_box = TypedBox(gui, TypedGroup({"column": count_field(1), "row": count_field(1)}), text.PICK_LABELS)
         self.load_cell = gui.add_button("Load this design", icon=viser.Icon.CHECK)
         self.load_best = gui.add_button("Load best design", icon=viser.Icon.STAR)
         self.cell = gui.add_html("")
@@ -335,7 +325,7 @@ class DesignView:
             "Comparing: each arrangement at these dimensions and at its own optimum, found by a global search "
             "(a few minutes; the other tabs keep working meanwhile)…"
         )
-        self.compare_status.content = say(self.view.lang, self.compare_note)
+        self.compare_status.content = escape(say(self.view.lang, self.compare_note))
         self._show_area()
         wanted = lambda: request == self._compare_request and not self.view.closed  # noqa: E731
         evaluate = in_turns(self.worker, self.view, "design-compare", wanted)
@@ -395,6 +385,6 @@ class DesignView:
         """The tab's language changed: every text of the tab again, in it (under the hub's lock)."""
         lang = self.view.lang
         self._redraw()
-        self.compare_status.content = say(lang, self.compare_note) if self.compare_note is not None else ""
+        self.compare_status.content = escape(say(lang, self.compare_note) if self.compare_note is not None else "")
         self.table.content = text.table_html(self.compared, text.HOLDS[self._hold.value], lang) if self.compared else ""
         self._draw_comparison()

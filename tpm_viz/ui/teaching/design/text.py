@@ -10,6 +10,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from tpm_viz.classroom.text import num
+from tpm_viz.core.markup import Html
 from tpm_viz.core.words import Lang, Phrase, T, say
 from tpm_viz.design.atlas import Row
 from tpm_viz.ui.teaching.design.map import INDICES, SWEPT, MapSpec, ramp, value_of
@@ -17,6 +18,7 @@ from tpm_viz.ui.teaching.design.map import INDICES, SWEPT, MapSpec, ramp, value_
 __all__ = [
     "ARRANGEMENTS",
     "HOLDS",
+    "INTRO",
     "PICK_LABELS",
     "RANGE_LABELS",
     "TASK_LABELS",
@@ -26,6 +28,12 @@ __all__ = [
     "table_html",
 ]
 
+INTRO = (
+    "Size the machine for a task: a map of designs over two dimensions, coloured by an index; click a cell "
+    "(or type its column and row) to load the design. The map and the comparison are drawn in the Design "
+    "area of the scene."
+)
+"""The tab's first paragraph (Markdown, translated like every widget text)."""
 TASK_LABELS = {"x0": "Task x0 (mm)", "x1": "Task x1 (mm)", "y0": "Task y0 (mm)", "y1": "Task y1 (mm)"}
 RANGE_LABELS = {
     "x_from": "Across: from (mm)",
@@ -59,20 +67,20 @@ def _esc(lang: Lang, what: object) -> str:
     return html.escape(say(lang, what))
 
 
-def progress_html(done: int, total: int, busy: bool, lang: Lang = Lang.EN, error: object = None) -> str:
+def progress_html(done: int, total: int, busy: bool, lang: Lang = Lang.EN, error: object = None) -> Html:
     """The map's progress line: ``done`` of ``total`` designs, or the error that stopped it."""
     if error is not None:
-        return f'<div data-q="design-progress" style="{_STYLE};color:#991b1b">{_esc(lang, error)}</div>'
+        return Html(f'<div data-q="design-progress" style="{_STYLE};color:#991b1b">{_esc(lang, error)}</div>')
     if total == 0:
-        return ""
+        return Html("")
     if busy:
         text = Phrase("Computing the map: {done} of {total} designs…", done=done, total=total)
     else:
         text = Phrase("Map computed: {total} designs (cycle time included).", total=total)
-    return f'<div data-q="design-progress" style="{_STYLE}">{_esc(lang, text)}</div>'
+    return Html(f'<div data-q="design-progress" style="{_STYLE}">{_esc(lang, text)}</div>')
 
 
-def legend_html(index: str, span: tuple[float, float] | None, feasible: int, total: int, lang: Lang = Lang.EN) -> str:
+def legend_html(index: str, span: tuple[float, float] | None, feasible: int, total: int, lang: Lang = Lang.EN) -> Html:
     """The colour scale of the map (worst to best), and what grey, the ring and the cross mean."""
     info = INDICES[index]
     stops = ", ".join(f"rgb{tuple(int(c) for c in rgb)}" for rgb in ramp(np.linspace(0.0, 1.0, 5)))
@@ -92,7 +100,7 @@ def legend_html(index: str, span: tuple[float, float] | None, feasible: int, tot
         feasible=feasible,
         total=total,
     )
-    return (
+    return Html(
         f'<div data-q="design-legend" style="{_STYLE};padding-right:16px"><b>{_esc(lang, T(info.label))}</b>{scale}'
         f'<div style="color:#64748b">{_esc(lang, keys)}</div></div>'
     )
@@ -102,7 +110,7 @@ def _mm(value: object) -> str:
     return num(value, ".1f", 1e3)
 
 
-def cell_html(spec: MapSpec, k: int, row: Row | None, lang: Lang = Lang.EN) -> str:
+def cell_html(spec: MapSpec, k: int, row: Row | None, lang: Lang = Lang.EN) -> Html:
     """The picked design: its place on the map, its swept values (mm) and its indices, or why it is infeasible."""
     i, j = spec.cell(k)
     where = Phrase(
@@ -126,15 +134,15 @@ def cell_html(spec: MapSpec, k: int, row: Row | None, lang: Lang = Lang.EN) -> s
             for key in INDICES
         ]
         body = "<br>".join(parts)
-    return f'<div style="{_STYLE}">{head}<br>{body}</div>'
+    return Html(f'<div style="{_STYLE}">{head}<br>{body}</div>')
 
 
-def table_html(rows: Sequence[Row], hold: Phrase, lang: Lang = Lang.EN) -> str:
+def table_html(rows: Sequence[Row], hold: Phrase, lang: Lang = Lang.EN) -> Html:
     """The comparison, one column per design (arrangement and case) and one line per quantity: lengths in mm, then
     the indices in their units; an infeasible design says so (and why) instead of numbers. Cell ``data-q``:
     ``compare-<column>-<key>``."""
     if not rows:
-        return ""
+        return Html("")
     td = "<td style='padding:0 4px;text-align:right'>"
     heads = [
         f"{_esc(lang, ARRANGEMENTS.get(str(r.get('arrangement', '')), T('perpendicular')))}<br>"
@@ -166,7 +174,7 @@ def table_html(rows: Sequence[Row], hold: Phrase, lang: Lang = Lang.EN) -> str:
                 cells.append(f"{td}<span data-q='compare-{n}-{key}'>{num(r.get(key), fmt, scale)}</span></td>")
         lines.append(f"<tr><td>{_esc(lang, label)}</td>" + "".join(cells) + "</tr>")
     title = Phrase("Holding the {hold} equal (task of the same size, centred on each home pose):", hold=hold)
-    return (
+    return Html(
         f'<div style="{_STYLE};overflow-x:auto"><div>{_esc(lang, title)}</div>'
         "<table style='border-collapse:collapse;font-variant-numeric:tabular-nums'>" + "".join(lines) + "</table></div>"
     )

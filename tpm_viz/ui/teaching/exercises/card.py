@@ -88,9 +88,12 @@ class Card:
 
     def draw(self, mine: Mine, lang: Lang) -> None:
         """Show ``mine`` (viser gets only what changed)."""
-        for handle, content in ((self.prompt, prompt_html(mine, lang)), (self.result, result_html(mine, lang))):
-            if handle.content != content:
-                handle.content = content
+        prompt = prompt_html(mine, lang)
+        result = result_html(mine, lang)
+        if self.prompt.content != prompt:
+            self.prompt.content = prompt
+        if self.result.content != result:
+            self.result.content = result
         closed = mine.prompt is None or mine.grading or mine.left == 0
         if self.submit.disabled != closed:
             self.submit.disabled = closed

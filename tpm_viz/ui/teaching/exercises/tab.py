@@ -29,6 +29,7 @@ from tpm_viz.classroom.guard import guarded
 from tpm_viz.classroom.results import NO_ATTEMPTS, Submitted
 from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.core.errors import TpmVizError
+from tpm_viz.core.markup import Html, Markdown
 from tpm_viz.core.words import Phrase, T, say
 from tpm_viz.ui.teaching.exercises.card import Card
 from tpm_viz.ui.teaching.exercises.text import NO_EXERCISES, Mine
@@ -103,7 +104,7 @@ class ExercisesView:
             LESSON.template, titles or (NONE.template,), initial_value=shown if shown in titles else None
         )
         self.choice.disabled = not titles
-        gui.add_markdown(INTRO.template if titles else NO_EXERCISES.template)
+        gui.add_markdown(Markdown(INTRO.template if titles else NO_EXERCISES.template))  # the catalogue's words
         self.whoami = gui.add_html(self._whoami())
         self._fill_tab(inside=True)
         self.choice.on_update(self._on_lesson)
@@ -165,11 +166,11 @@ class ExercisesView:
                 card.remove()
             self.cards[key] = [c for c in cards if c.box != box and not c.gone]
 
-    def _whoami(self) -> str:
+    def _whoami(self) -> Html:
         if self.number is None:
-            return ""
+            return Html("")
         line = say(self.view.lang, Phrase("You are Student {number} in the lecturer's table.", number=self.number))
-        return f'<div data-q="exercise-whoami" style="font-size:0.85em;color:#334155">{html.escape(line)}</div>'
+        return Html(f'<div data-q="exercise-whoami" style="font-size:0.85em;color:#334155">{html.escape(line)}</div>')
 
     # -- drawing ---------------------------------------------------------------------------------------------------
     def draw(self, key: str | None = None) -> None:
@@ -179,8 +180,9 @@ class ExercisesView:
             self.cards[name] = [c for c in self.cards[name] if not c.gone]
             for card in self.cards[name]:
                 card.draw(self.mine[name], lang)
-        if self.whoami is not None and self.whoami.content != (content := self._whoami()):
-            self.whoami.content = content
+        whoami = self._whoami()
+        if self.whoami is not None and self.whoami.content != whoami:
+            self.whoami.content = whoami
 
     def render(self, frame: Snapshot) -> None:
         """The lesson changed in *Demos* (shown, or set by the lecture): its exercises under its text."""

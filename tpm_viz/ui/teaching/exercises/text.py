@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from tpm_viz.app.exercises.model import AttemptRule, Exercise, Kind
 from tpm_viz.classroom.resultsdb import Row, Summary
 from tpm_viz.classroom.text import num
+from tpm_viz.core.markup import Html
 from tpm_viz.core.words import Lang, Phrase, T, say
 
 __all__ = ["Mine", "how_phrase", "prompt_html", "result_html", "rule_phrase", "table_html"]
@@ -87,12 +88,12 @@ def rule_phrase(rule: AttemptRule) -> Phrase:
     return Phrase("Exam: {n} attempt(s), worth {worth}; the best counts.", n=len(rule.ladder), worth=worth)
 
 
-def prompt_html(mine: Mine, lang: Lang) -> str:
+def prompt_html(mine: Mine, lang: Lang) -> Html:
     """The card's head: title, prompt with the student's numbers, how to answer, the attempt rule."""
     ex = mine.exercise
     body = mine.problem or mine.prompt or WAITING
     how = f"{say(lang, how_phrase(ex))} {say(lang, rule_phrase(ex.attempts))}"
-    return (
+    return Html(
         f'<div data-q="exercise-prompt" data-x="{html.escape(ex.id)}" lang="{lang.value}" style="{_HEAD}">'
         f"<b>{html.escape(ex.title.get(lang))}</b>"
         f'<p style="margin:2px 0 4px 0">{html.escape(say(lang, body))}</p>'
@@ -113,16 +114,16 @@ def _attempts_line(mine: Mine) -> Phrase | None:
     return Phrase("{n} attempt(s), best score {best}; {left} attempt(s) left.", n=n, best=best, left=left)
 
 
-def _answers(mine: Mine, lang: Lang) -> str:
+def _answers(mine: Mine, lang: Lang) -> Html:
     shown = mine.attempts[-SHOWN_ANSWERS:]
     if not shown:
-        return ""
+        return Html("")
     items = "; ".join(f"{r.attempt}) {r.answer} → {num(r.score, '.2f')}" for r in shown)
     line = say(lang, Phrase("Your answers: {items}", items=items))
-    return f'<div style="color:{_SLATE};font-size:0.9em">{html.escape(line)}</div>'
+    return Html(f'<div style="color:{_SLATE};font-size:0.9em">{html.escape(line)}</div>')
 
 
-def result_html(mine: Mine, lang: Lang) -> str:
+def result_html(mine: Mine, lang: Lang) -> Html:
     """The card's result: grading, the score and feedback (or the format error: no attempt used), the attempts."""
     lines: list[str] = []
     if mine.grading:
@@ -146,7 +147,9 @@ def result_html(mine: Mine, lang: Lang) -> str:
     lines.append(_answers(mine, lang))
     say_it = f' data-say="{html.escape(mine.stamp)}"' if mine.stamp else ""
     body = "".join(lines)
-    return f'<div data-q="exercise-result" data-x="{html.escape(mine.exercise.id)}"{say_it} style="{_BOX}">{body}</div>'
+    return Html(
+        f'<div data-q="exercise-result" data-x="{html.escape(mine.exercise.id)}"{say_it} style="{_BOX}">{body}</div>'
+    )
 
 
 def student_phrase(number: int) -> Phrase:
@@ -154,11 +157,11 @@ def student_phrase(number: int) -> Phrase:
     return Phrase("Student {number}", number=number)
 
 
-def table_html(lines: Sequence[Summary], total: int, status: Phrase, lang: Lang) -> str:
+def table_html(lines: Sequence[Summary], total: int, status: Phrase, lang: Lang) -> Html:
     """The lecturer's table: one line per student, exercise and variant, the latest answered first."""
     head = f'<div data-q="results-status" style="color:{_SLATE}">{html.escape(say(lang, status))}</div>'
     if not lines:
-        return f'<div data-q="results" style="{_BOX}">{head}<div>{html.escape(say(lang, NONE_YET))}</div></div>'
+        return Html(f'<div data-q="results" style="{_BOX}">{head}<div>{html.escape(say(lang, NONE_YET))}</div></div>')
     cells = "".join(f"<th{_NOWRAP}>{html.escape(say(lang, h))}</th>" for h in HEADERS)
     rows = []
     for line in lines:
@@ -179,4 +182,6 @@ def table_html(lines: Sequence[Summary], total: int, status: Phrase, lang: Lang)
     table = (
         f'<table style="border-collapse:collapse;font-size:0.92em;font-variant-numeric:tabular-nums"><tr>{cells}</tr>'
     )
-    return f'<div data-q="results" style="{_BOX};overflow-x:auto">{head}{table}{"".join(rows)}</table>{more}</div>'
+    return Html(
+        f'<div data-q="results" style="{_BOX};overflow-x:auto">{head}{table}{"".join(rows)}</table>{more}</div>'
+    )

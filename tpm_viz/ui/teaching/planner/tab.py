@@ -22,6 +22,7 @@ from tpm_viz.classroom.guard import guarded
 from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.classroom.worker import Worker
 from tpm_viz.core.errors import InputError, TpmVizError
+from tpm_viz.core.markup import Markdown
 from tpm_viz.core.params import Params
 from tpm_viz.core.words import Phrase, T
 from tpm_viz.drawing import meshes
@@ -121,8 +122,10 @@ class PlannerView:
     def build(self, gui: TabGui) -> None:
         """The *Planner* tab's widgets (inside the tab's context)."""
         gui.add_markdown(
-            "The fastest cycle the motors allow: the platform runs the path there and back (the circle: one turn), "
-            "one actuator at its force limit almost all the time (toppra). Move a limit: the cycle time follows."
+            Markdown(
+                "The fastest cycle the motors allow: the platform runs the path there and back (the circle: one turn), "
+                "one actuator at its force limit almost all the time (toppra). Move a limit: the cycle time follows."
+            )
         )
         self.path = gui.add_dropdown("Path", tuple(PATH_KINDS), initial_value="pick-and-place")
         self.waypoints = gui.add_text(

@@ -9,6 +9,7 @@ import html
 
 from tpm_viz.app.planning import INDUSTRY, PlanResult
 from tpm_viz.classroom.text import num
+from tpm_viz.core.markup import Html
 from tpm_viz.core.words import Lang, Phrase, T, say
 
 __all__ = ["industry_html", "result_html", "sizing_html"]
@@ -48,7 +49,7 @@ def result_html(
     busy: bool,
     error: str | Phrase = "",
     lang: Lang = Lang.EN,
-) -> str:
+) -> Html:
     """The live line: cycle time and cycles (picks) per minute at the limits it was solved for."""
     esc = html.escape
     lines = []
@@ -90,13 +91,13 @@ def result_html(
         lines.append(esc(say(lang, cubic)))
         if busy:
             lines.append(f"<i>{esc(say(lang, T('updating…')))}</i>")
-    return f'<div data-q="plan-result" style="{_STYLE}">' + "<br>".join(lines) + "</div>"
+    return Html(f'<div data-q="plan-result" style="{_STYLE}">' + "<br>".join(lines) + "</div>")
 
 
-def sizing_html(result: PlanResult | None, lang: Lang = Lang.EN) -> str:
+def sizing_html(result: PlanResult | None, lang: Lang = Lang.EN) -> Html:
     """The sizing table of the planned cycle beside the cubic law's (same peak force), per actuator."""
     if result is None:
-        return ""
+        return Html("")
     esc = html.escape
     cell = "padding:1px 5px;text-align:right;font-variant-numeric:tabular-nums"
     act1, act2 = esc(say(lang, T("act. 1"))), esc(say(lang, T("act. 2")))
@@ -124,20 +125,20 @@ def sizing_html(result: PlanResult | None, lang: Lang = Lang.EN) -> str:
         "Cubic law: the paper's time law s = L(3u² − 2u³) on the same strokes, slowed until its peak force equals "
         "the plan's. No dwell, no friction, horizontal plane."
     )
-    return (
+    return Html(
         f'<div data-q="sizing" style="{_STYLE}"><b>{title}</b>'
         f'<table style="border-collapse:collapse;margin-top:4px">{head}{"".join(body)}</table>'
         f"<div style='color:#64748b'>{esc(say(lang, note))}</div></div>"
     )
 
 
-def industry_html() -> str:
+def industry_html() -> Html:
     """Other robots' catalogue values, labelled as such."""
     rows = "".join(
         f"<li>{html.escape(robot)}: {html.escape(cycle)}, {html.escape(figure)}</li>"
         for robot, cycle, figure in INDUSTRY
     )
-    return (
+    return Html(
         f'<div data-q="industry" style="{_STYLE}"><b>For orientation: other robots\' catalogue values</b> '
         f"(not this mechanism, not computed here)<ul style='margin:2px 0 0 16px;padding:0'>{rows}</ul></div>"
     )

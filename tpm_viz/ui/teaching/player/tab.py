@@ -27,6 +27,7 @@ from tpm_viz.classroom.runhub import RunHub, following
 from tpm_viz.classroom.snapshot import Snapshot
 from tpm_viz.core.csvio import format_columns
 from tpm_viz.core.errors import InputError, TpmVizError
+from tpm_viz.core.markup import Markdown
 from tpm_viz.core.words import Phrase, T
 from tpm_viz.drawing.figures import force_plot_png, force_plot_svg
 from tpm_viz.paper.trajectories import DEFAULT_DURATIONS
@@ -38,7 +39,7 @@ from tpm_viz.ui.teaching.player.trace import PathTrace
 from tpm_viz.ui.teaching.stage import PLAYER, bring, front, show
 from tpm_viz.ui.widgets.typed import QUIET, Quantity, TypedField, TypedGroup, duration_note, force_note
 from tpm_viz.ui.widgets.typed_sliders import TypedSlider
-from tpm_viz.ui.worded import TabGui
+from tpm_viz.ui.worded import TabGui, put, stored
 
 __all__ = ["CHART_HZ", "SPEEDS", "PlayerView", "time_quantity"]
 
@@ -85,9 +86,11 @@ class PlayerView:
     def build(self, gui: TabGui) -> None:
         """The *Player* tab's widgets (inside the tab's context)."""
         gui.add_markdown(
-            "Play a trajectory: the platform follows it, leaves a trace, and the charts mark the current time. "
-            "Your own CSV needs the columns `t,p1,p2` (s, m), at least 4 rows, at most "
-            f"{MAX_UPLOAD_BYTES / 2**20:g} MiB; it must stay inside the stroke and clear of the singularities."
+            Markdown(
+                "Play a trajectory: the platform follows it, leaves a trace, and the charts mark the current time. "
+                "Your own CSV needs the columns `t,p1,p2` (s, m), at least 4 rows, at most "
+                f"{MAX_UPLOAD_BYTES / 2**20:g} MiB; it must stay inside the stroke and clear of the singularities."
+            )
         )
         self.choice = gui.add_dropdown("Trajectory", (NONE, *PAPER), initial_value=NONE)
         quantity = Quantity("T", "s", 1.0, MIN_DURATION, MAX_DURATION)
@@ -129,9 +132,10 @@ class PlayerView:
         return self.view.session
 
     def _put(self, handle, value) -> None:
-        if handle.value != value:
-            handle.value = value
-        self._written[id(handle)] = handle.value
+        """Write a widget value and remember it (see :meth:`_is_echo`), never over an input on its way
+        (:mod:`tpm_viz.viserkit.inputs`)."""
+        if stored(handle) == value or put(handle, value):
+            self._written[id(handle)] = stored(handle)
 
     def _is_echo(self, *handles) -> bool:
         return all(self._written.get(id(h), _UNSET) == h.value for h in handles)

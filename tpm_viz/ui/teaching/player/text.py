@@ -8,6 +8,7 @@ import html
 
 from tpm_viz.app.run_names import label_words
 from tpm_viz.classroom.text import num
+from tpm_viz.core.markup import Html
 from tpm_viz.core.words import Lang, Phrase, T, say
 
 __all__ = ["summary_html"]
@@ -19,7 +20,7 @@ _WHERE = {
 }
 
 
-def summary_html(ps, run, t, lang: Lang = Lang.EN) -> str:
+def summary_html(ps, run, t, lang: Lang = Lang.EN) -> Html:
     """The player's summary: what is loaded or computing, its peak force and Pinocchio difference, the
     previous run's peak, and where the playback is (``t`` [s], None when the platform left the path)."""
     esc = html.escape
@@ -63,4 +64,4 @@ def summary_html(ps, run, t, lang: Lang = Lang.EN) -> str:
                 ),
             )
         )
-    return '<div style="font-size:0.85em;color:#334155;line-height:1.45">' + "<br>".join(lines) + "</div>"
+    return Html('<div style="font-size:0.85em;color:#334155;line-height:1.45">' + "<br>".join(lines) + "</div>")

@@ -20,6 +20,7 @@ import viser
 
 from tpm_viz.classroom.guard import guarded
 from tpm_viz.core.errors import InputError, TpmVizError
+from tpm_viz.core.markup import html
 from tpm_viz.core.words import Phrase, T, say
 from tpm_viz.media.clips import DEFAULT_FPS, SIZE_PRESETS
 from tpm_viz.media.report import report_html
@@ -85,7 +86,7 @@ class TakeOut:
         with self.view.hub.lock:
             if self.line is not None and not self.view.closed:
                 text = "" if phrase is None else say(self.view.lang, phrase)
-                self.line.content = f'<p style="margin:0;font-size:0.85em">{text}</p>' if text else ""
+                self.line.content = html('<p style="margin:0;font-size:0.85em">{text}</p>', text=text) if text else ""
 
     def _refuse(self, what) -> None:
         with self.view.hub.lock:
