@@ -1,11 +1,10 @@
-"""Trimesh parts of the parallel 2-PPa (both rails on the X axis, ``docs/parallel.md``), metres, Z up.
+"""Parts of the parallel 2-PPa (both rails on the X axis, facing each other, ``docs/parallel.md``), metres, Z up.
 
-The same part vocabulary, heights and frames as :mod:`tpm_viz.drawing.meshes` (the perpendicular mechanism), so that a
-drawing code places them alike: sliders in a frame at ``A_i`` (``A_1 = (d_1 - a, 0)``, ``A_2 = (a - d_2, 0)``),
-links along their local +x from the slider-side pivot (:func:`tpm_viz.drawing.meshes.link` and
-:func:`tpm_viz.drawing.meshes.link_instances` serve both arrangements), the platform in a frame at ``P``. The second
-link of each parallelogram is offset by the pivot spacing ``s`` along +Y on both legs. :func:`posed_parts` returns every
-part already placed, for a still picture or a side-by-side comparison.
+The same part vocabulary, heights and frames as :mod:`.perpendicular`, so that :func:`.base.posed_parts` places
+them alike: sliders in a frame at ``A_i`` (eq. P1: ``A_1 = (d_1 - a, 0)``, ``A_2 = (a - d_2, 0)``), links along
+their local +x from the slider-side pivot (:func:`.base.link`, :func:`.base.link_instances`), the platform in a
+frame at ``P`` (``B_1 = P - (b, 0)``, ``B_2 = P + (b, 0)``). The second link of each parallelogram is offset by the
+pivot spacing ``s`` along +Y on both legs.
 """
 
 from __future__ import annotations
@@ -16,18 +15,7 @@ import numpy as np
 import trimesh
 
 from tpm_viz.core.params import Params
-from tpm_viz.drawing.meshes import (
-    PLATFORM_Z,
-    RAIL_Z,
-    SLIDER_LENGTH,
-    SLIDER_MARGIN,
-    SLIDER_Z,
-    link,
-    link_instances,
-    pin,
-    tool_marker,
-)
-from tpm_viz.paper import parallel as par
+from tpm_viz.drawing.meshes.base import PLATFORM_Z, RAIL_Z, SLIDER_LENGTH, SLIDER_MARGIN, SLIDER_Z, box
 
 __all__ = [
     "base_extent",
@@ -35,7 +23,6 @@ __all__ = [
     "end_stops",
     "platform",
     "platform_pin_offsets",
-    "posed_parts",
     "rail",
     "rail_span",
     "slider",
@@ -44,11 +31,6 @@ __all__ = [
 
 _PLATFORM_MARGIN = 0.018  # m, beyond the platform-side pivots
 _RAIL_OVERHANG = 0.02  # m, beyond the slider at either end of the stroke
-
-
-def _box(lo, hi) -> trimesh.Trimesh:
-    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
-    return trimesh.creation.box(extents=hi - lo, transform=trimesh.transformations.translation_matrix((lo + hi) / 2))
 
 
 def rail_span(params: Params, i: int) -> tuple[float, float]:
@@ -61,7 +43,7 @@ def rail(params: Params, i: int) -> trimesh.Trimesh:
     """Rail ``i`` on the X axis, long enough for the slider at both ends of its stroke."""
     lo, hi = rail_span(params, i)
     reach = SLIDER_LENGTH / 2 + _RAIL_OVERHANG
-    return _box((lo - reach, -0.011, RAIL_Z[0]), (hi + reach, 0.011, RAIL_Z[1]))
+    return box((lo - reach, -0.011, RAIL_Z[0]), (hi + reach, 0.011, RAIL_Z[1]))
 
 
 def end_stops(params: Params, i: int) -> trimesh.Trimesh:
@@ -70,14 +52,14 @@ def end_stops(params: Params, i: int) -> trimesh.Trimesh:
     parts = []
     for face, sign in ((lo - SLIDER_LENGTH / 2, -1.0), (hi + SLIDER_LENGTH / 2, 1.0)):
         x0, x1 = sorted((face, face + sign * 0.012))
-        parts.append(_box((x0, -0.026, RAIL_Z[0]), (x1, 0.026, SLIDER_Z[1] + 0.004)))
+        parts.append(box((x0, -0.026, RAIL_Z[0]), (x1, 0.026, SLIDER_Z[1] + 0.004)))
     return cast(trimesh.Trimesh, trimesh.util.concatenate(parts))
 
 
 def slider(params: Params, i: int) -> trimesh.Trimesh:
     """Slider ``i`` in its frame at ``A_i``: a carriage carrying both link pivots (``0`` and ``s e_2``)."""
     half = SLIDER_LENGTH / 2
-    return _box((-half, -SLIDER_MARGIN, SLIDER_Z[0]), (half, params.pivot_spacing + SLIDER_MARGIN, SLIDER_Z[1]))
+    return box((-half, -SLIDER_MARGIN, SLIDER_Z[0]), (half, params.pivot_spacing + SLIDER_MARGIN, SLIDER_Z[1]))
 
 
 def slider_pin_offsets(params: Params, i: int) -> np.ndarray:
@@ -95,7 +77,7 @@ def platform_pin_offsets(params: Params) -> np.ndarray:
 def platform(params: Params) -> trimesh.Trimesh:
     """The platform in its frame at ``P``: a plate covering the four pivots (wide along X, the legs' axis)."""
     m, hx = _PLATFORM_MARGIN, params.b + _PLATFORM_MARGIN
-    return _box((-hx, -m, PLATFORM_Z[0]), (hx, params.pivot_spacing + m, PLATFORM_Z[1]))
+    return box((-hx, -m, PLATFORM_Z[0]), (hx, params.pivot_spacing + m, PLATFORM_Z[1]))
 
 
 def base_extent(params: Params) -> tuple[np.ndarray, np.ndarray]:
@@ -108,42 +90,4 @@ def base_extent(params: Params) -> tuple[np.ndarray, np.ndarray]:
 def base_plate(params: Params) -> trimesh.Trimesh:
     """A rectangular base plate under the mechanism, top face at z = 0."""
     lo, hi = base_extent(params)
-    return _box((lo[0], lo[1], -0.012), (hi[0], hi[1], 0.0))
-
-
-def _quat_matrix(position, wxyz) -> np.ndarray:
-    w, x, y, z = wxyz
-    m = trimesh.transformations.quaternion_matrix([w, x, y, z])
-    m[:3, 3] = position
-    return m
-
-
-def posed_parts(params: Params, p, d=None) -> dict[str, trimesh.Trimesh]:
-    """Every part of the parallel mechanism placed at platform position ``p`` [m] (working mode unless ``d``):
-    ``base, rail1, rail2, stops1, stops2, slider1, slider2, link1_0, link1_1, link2_0, link2_1, platform, pins,
-    tool`` (world coordinates, metres). Raises as :func:`tpm_viz.paper.parallel.inverse_kinematics`."""
-    pose = par.mechanism_pose(params, p, d)
-    parts: dict[str, trimesh.Trimesh] = {"base": base_plate(params)}
-    for i in (0, 1):
-        parts[f"rail{i + 1}"] = rail(params, i)
-        parts[f"stops{i + 1}"] = end_stops(params, i)
-        moved = slider(params, i)
-        moved.apply_translation((*pose.A[i], 0.0))
-        parts[f"slider{i + 1}"] = moved
-    positions, quats = link_instances(pose)
-    for k, name in enumerate(("link1_0", "link1_1", "link2_0", "link2_1")):
-        mesh = link(params)
-        mesh.apply_transform(_quat_matrix(positions[k], quats[k]))
-        parts[name] = mesh
-    plate = platform(params)
-    plate.apply_translation((*pose.p, 0.0))
-    parts["platform"] = plate
-    pins = []
-    for i in (0, 1):
-        for offset in slider_pin_offsets(params, i):
-            pins.append(pin().apply_translation(offset + np.array([*pose.A[i], 0.0])))
-    for offset in platform_pin_offsets(params):
-        pins.append(pin().apply_translation(offset + np.array([*pose.p, 0.0])))
-    parts["pins"] = cast(trimesh.Trimesh, trimesh.util.concatenate(pins))
-    parts["tool"] = tool_marker().apply_translation((*pose.p, 0.0))
-    return parts
+    return box((lo[0], lo[1], -0.012), (hi[0], hi[1], 0.0))
