@@ -4,7 +4,8 @@ item 2): ``export --output /dev/full`` replaced the machine's ``/dev/full`` with
 
 The options are enumerated from the parser: every option that takes free text is either a path (attacked here, by
 its role) or listed in :data:`NOT_PATHS`, so a new path option cannot be missed. Each attack runs the command in this
-process under a timer (a hang is interrupted and fails the test); ``serve`` runs in a subprocess with a timeout. Each
+process under a timer (a hang is interrupted and fails the test); ``serve`` (which would serve, not return, if it did
+not refuse) runs in child processes forked from one driver, each under a deadline. Each
 must exit 2 with one line saying the node is not a regular file, and the node must still be what it was, with nothing
 left beside it. The device is a copy of ``/dev/null`` (``mknod``, root only) or ``/dev/zero`` (inputs), made in a
 temporary folder: the machine's own nodes are never offered to the code under test.
@@ -14,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import json
 import os
 import signal
 import stat
@@ -23,6 +25,7 @@ from pathlib import Path
 
 import pytest
 
+from tests.support import cli
 from tpm_viz.cli import build_parser, main
 
 NOT_PATHS = {
@@ -272,34 +275,89 @@ def test_a_node_where_a_folders_file_goes_is_refused(argv, first, kind, tmp_path
 
 
 # -- serve, and the issue's own commands as a user types them ---------------------------------------------------------
-def _run(*argv: str, timeout: float = SECONDS) -> subprocess.CompletedProcess:
-    """``python -m tpm_viz ARGV`` with a timeout (a hang fails the test, the child is killed by subprocess.run)."""
-    return subprocess.run(
-        [sys.executable, "-m", "tpm_viz", *argv],
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-        stdin=subprocess.DEVNULL,
-    )
+_DRIVER = r"""
+import json, os, signal, sys, time
+import tpm_viz.cli, tpm_viz.ui.app  # the imports every case shares, made once before the forks
+cases, deadline = json.loads(sys.argv[1]), float(sys.argv[2])
+results = {}
+for key, (argv, out, err) in cases.items():
+    pid = os.fork()
+    if pid == 0:  # the child: the case as a process of its own, its streams in two files, no stdin
+        os.dup2(os.open(os.devnull, os.O_RDONLY), 0)
+        os.dup2(os.open(out, os.O_WRONLY | os.O_CREAT | os.O_TRUNC), 1)
+        os.dup2(os.open(err, os.O_WRONLY | os.O_CREAT | os.O_TRUNC), 2)
+        try:
+            status = tpm_viz.cli.main(argv)
+        finally:
+            sys.stdout.flush()
+            sys.stderr.flush()
+        os._exit(status)
+    end = time.monotonic() + deadline
+    while time.monotonic() < end:  # bounded: a case that serves instead of refusing is killed at the deadline
+        done, code = os.waitpid(pid, os.WNOHANG)
+        if done:
+            results[key] = os.waitstatus_to_exitcode(code)
+            break
+        time.sleep(0.05)
+    else:
+        os.kill(pid, signal.SIGKILL)
+        os.waitpid(pid, 0)
+        results[key] = "hung"
+print(json.dumps(results))
+"""
+
+SERVE_CASES = [(o, k) for o in ("--session", "--lessons") for k in KINDS if (o, k) != ("--lessons", "folder")]
+"""``serve``'s file options against each node (a folder is what ``--lessons`` takes: its files are read)."""
+
+
+@pytest.fixture(scope="module")
+def serve_refusals(tmp_path_factory) -> dict[tuple[str, str], tuple | str]:
+    """Every ``serve`` case, each a child process forked from one driver (``python -c``, the imports made once): per
+    case ``(status, stdout, stderr, snapshot before, snapshot after, node)``, or why it was skipped (no ``mknod``)."""
+    out: dict[tuple[str, str], tuple | str] = {}
+    cases, folders = {}, {}
+    for option, kind in SERVE_CASES:
+        key, folder = f"{option}-{kind}", tmp_path_factory.mktemp(f"serve{option}-{kind}")
+        name = "node.toml" if option == "--lessons" else "node.sqlite3"
+        try:
+            make(kind, folder / name, "input")
+        except pytest.skip.Exception as exc:
+            out[option, kind] = str(exc)
+            continue
+        argv = ["serve", *BASE["serve"], option, str(folder / name)]
+        cases[key] = (argv, str(folder / "stdout.txt"), str(folder / "stderr.txt"))
+        folders[key] = (option, kind, folder, snapshot(folder))
+    if cases:
+        done = subprocess.run(
+            [sys.executable, "-c", _DRIVER, json.dumps(cases), str(SECONDS / 2)],
+            capture_output=True,
+            text=True,
+            timeout=SECONDS * len(cases),
+        )
+        assert done.returncode == 0, done.stderr
+        statuses = json.loads(done.stdout)
+        for key, (option, kind, folder, before) in folders.items():
+            streams = [(folder / f).read_text() for f in ("stdout.txt", "stderr.txt")]
+            for f in ("stdout.txt", "stderr.txt"):
+                (folder / f).unlink()
+            out[option, kind] = (statuses[key], *streams, before, snapshot(folder), cases[key][0][-1])
+    return out
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("kind", KINDS)
-@pytest.mark.parametrize("option", ["--session", "--lessons"])
-def test_serve_refuses_a_node_as_its_store_or_lessons_before_serving(option, kind, tmp_path):
-    name = "node.toml" if option == "--lessons" else "node.sqlite3"
-    if option == "--lessons" and kind == "folder":
-        pytest.skip("a folder is what --lessons takes (its files are read by the lesson reader)")
-    make(kind, tmp_path / name, "input")
-    before = snapshot(tmp_path)
-    res = _run("serve", *BASE["serve"], option, str(tmp_path / name))
-    assert res.returncode == 2 and res.stdout == "", (res.stdout, res.stderr)
-    _one_line_refusal(res.stderr, str(tmp_path / name))
-    assert snapshot(tmp_path) == before
+@pytest.mark.parametrize(("option", "kind"), SERVE_CASES)
+def test_serve_refuses_a_node_as_its_store_or_lessons_before_serving(option, kind, serve_refusals):
+    result = serve_refusals[option, kind]
+    if isinstance(result, str):
+        pytest.skip(result)
+    status, stdout, stderr, before, after, node = result
+    assert status == 2 and stdout == "", (status, stdout, stderr)
+    _one_line_refusal(stderr, node)
+    assert after == before
 
 
 @pytest.mark.slow
-def test_the_issues_commands_exit_2_at_once_and_leave_the_nodes(tmp_path):
+def test_the_issues_commands_exit_2_at_once_and_leave_the_nodes(tmp_path, capsys):
     os.mkfifo(tmp_path / "pipe.csv")
     os.mkfifo(tmp_path / "pipe.html")
     make("device", tmp_path / "full.xml", "output")
@@ -311,18 +369,15 @@ def test_the_issues_commands_exit_2_at_once_and_leave_the_nodes(tmp_path):
         ["report", "--trajectory", str(tmp_path / "pipe.csv"), "--output", str(tmp_path / "r.html")],
         ["report", "--trajectory", "line", "--output", str(tmp_path / "pipe.html")],
     ):
-        res = _run(*argv)
+        with bounded(SECONDS):
+            res = cli.run(capsys, *argv)
         assert res.returncode == 2, (argv, res.stderr)
         _one_line_refusal(res.stderr, "not a regular file")
     assert snapshot(tmp_path) == before
 
 
-def test_stdin_and_stdout_still_work(tmp_path):
-    res = subprocess.run(
-        [sys.executable, "-m", "tpm_viz", "kinematics", "--input", "-", "--output", "-"],
-        input="p1,p2\n0,0\n",
-        capture_output=True,
-        text=True,
-        timeout=SECONDS,
-    )
+@pytest.mark.end_to_end
+def test_stdin_and_stdout_still_work():
+    """The installed command in a child process whose stdin and stdout are pipes (not refused as nodes)."""
+    res = cli.run_installed("kinematics", "--input", "-", "--output", "-", stdin="p1,p2\n0,0\n", timeout=SECONDS)
     assert res.returncode == 0 and res.stdout.startswith("p1,p2,d1,d2"), res.stderr

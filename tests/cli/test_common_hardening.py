@@ -18,6 +18,7 @@ import time
 import numpy as np
 import pytest
 
+from tests.support import cli
 from tpm_viz.cli import main
 from tpm_viz.cli.common import write_output
 from tpm_viz.cli.serve import check_bind
@@ -29,13 +30,13 @@ pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this
 POSES = "p1,p2\n0.05,-0.02\n0,0\n"
 
 
-def run(*args: str, stdin: bytes | None = None, timeout: float = 120) -> subprocess.CompletedProcess:
-    res = subprocess.run([sys.executable, "-m", "tpm_viz", *args], input=stdin, capture_output=True, timeout=timeout)
-    res.stdout, res.stderr = res.stdout.decode(), res.stderr.decode()
-    return res
+@pytest.fixture
+def run(capsys):
+    """``tpm-viz ARGS`` in this process: ``run(*args, stdin=...)`` -> status, stdout, stderr."""
+    return lambda *args, stdin=None: cli.run(capsys, *args, stdin=stdin)
 
 
-def one_line_error(res: subprocess.CompletedProcess, text: str = "", limit: int = 320) -> None:
+def one_line_error(res: cli.Ran | subprocess.CompletedProcess, text: str = "", limit: int = 320) -> None:
     assert res.returncode == 2, res.stderr
     assert text in res.stderr, res.stderr
     assert res.stderr.count("\n") == 1 and "Traceback" not in res.stderr and len(res.stderr) <= limit
@@ -48,7 +49,7 @@ def rows(text: str) -> list[dict[str, str]]:
 # --- outputs: never the input, atomic ---------------------------------------------------------------------------
 
 
-def test_output_that_is_the_input_is_refused_by_any_path(tmp_path):
+def test_output_that_is_the_input_is_refused_by_any_path(tmp_path, run):
     src = tmp_path / "poses.csv"
     src.write_text(POSES)
     (tmp_path / "sub").mkdir()
@@ -56,14 +57,12 @@ def test_output_that_is_the_input_is_refused_by_any_path(tmp_path):
     for out in (src, tmp_path / "sub" / ".." / "poses.csv", tmp_path / "link.csv"):
         one_line_error(run("kinematics", "--input", str(src), "--output", str(out)), "is the input file")
         assert src.read_text() == POSES
-    with open(src, "rb") as fh:  # --input - reading the output file through stdin
-        res = subprocess.run(
-            [sys.executable, "-m", "tpm_viz", "kinematics", "--input", "-", "--output", str(src)],
-            stdin=fh,
-            capture_output=True,
-            text=True,
-            timeout=120,
-        )
+    with open(src, encoding="utf-8") as fh:  # --input - reading the output file through stdin
+        saved, sys.stdin = sys.stdin, fh
+        try:
+            res = run("kinematics", "--input", "-", "--output", str(src))
+        finally:
+            sys.stdin = saved
     assert res.returncode == 2 and "is the input file" in res.stderr and src.read_text() == POSES
 
 
@@ -104,9 +103,11 @@ def test_disk_full_is_one_line_naming_the_output(tmp_path, monkeypatch, capsys):
     assert os.listdir(tmp_path) == ["poses.csv"]
 
 
+@pytest.mark.end_to_end
 def test_a_closed_pipe_stops_quietly():
+    """The installed command in a child process whose reader goes away: status 141, nothing on stderr."""
     proc = subprocess.Popen(
-        [sys.executable, "-m", "tpm_viz", "trajectory", "--kind", "circle", "--samples", "100000"],
+        [*cli.installed(), "trajectory", "--kind", "circle", "--samples", "100000"],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
     )
@@ -124,29 +125,29 @@ def test_a_closed_pipe_stops_quietly():
 # --- inputs: streaming with stated caps, forgiving decoding --------------------------------------------------------
 
 
-def test_a_file_over_the_size_cap_is_refused_at_once(tmp_path):
+def test_a_file_over_the_size_cap_is_refused_at_once(tmp_path, run):
     big = tmp_path / "big.csv"
     with open(big, "wb") as fh:
         fh.truncate(MAX_BYTES + 1)  # sparse: no disk space used
     start = time.monotonic()
-    one_line_error(run("kinematics", "--input", str(big), timeout=30), "limited to 256 MiB")
+    one_line_error(run("kinematics", "--input", str(big)), "limited to 256 MiB")
     assert time.monotonic() - start < 10
 
 
 @pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="needs /dev/zero")
-def test_dev_zero_is_refused_at_once():
-    one_line_error(run("kinematics", "--input", "/dev/zero", timeout=30), "a system file, not a data file")
+def test_dev_zero_is_refused_at_once(run):
+    one_line_error(run("kinematics", "--input", "/dev/zero"), "a system file, not a data file")
 
 
-def test_rows_beyond_the_cap_are_refused_while_streaming():
+def test_rows_beyond_the_cap_are_refused_while_streaming(run):
     data = b"p1,p2\n" + b"0,0\n" * (MAX_ROWS + 10)
     start = time.monotonic()
-    one_line_error(run("kinematics", "--input", "-", stdin=data, timeout=60), f"more than {MAX_ROWS} data rows")
+    one_line_error(run("kinematics", "--input", "-", stdin=data), f"more than {MAX_ROWS} data rows")
     assert time.monotonic() - start < 40
 
 
 @pytest.mark.parametrize("encoding", ["utf-16", "utf-16-le", "latin-1", "utf-8-sig"])
-def test_other_encodings_are_read(tmp_path, encoding):
+def test_other_encodings_are_read(tmp_path, encoding, run):
     src = tmp_path / "poses.csv"
     src.write_bytes("p1 [\u00b5m];p2 [mm]\r\n50000;-20\r\n".encode(encoding))
     res = run("kinematics", "--input", str(src))
@@ -160,13 +161,13 @@ def test_other_encodings_are_read(tmp_path, encoding):
     [("1" * 140_000, "longer than 65536 characters"), ("1" * 60_000, "too large"), ("x" * 60_000, "too long")],
     ids=["140kB", "60k-digits", "60k-letters"],
 )
-def test_huge_cells_give_short_messages(tmp_path, cell, text):
+def test_huge_cells_give_short_messages(tmp_path, cell, text, run):
     src = tmp_path / "poses.csv"
     src.write_text(f"p1,p2\n{cell},0\n")
     one_line_error(run("kinematics", "--input", str(src)), text)
 
 
-def test_multi_line_quoted_cell_is_a_one_line_csv_error(tmp_path):
+def test_multi_line_quoted_cell_is_a_one_line_csv_error(tmp_path, run):
     src = tmp_path / "poses.csv"
     src.write_text('p1,p2\n"' + "1\n" * 70_000 + '",0\n')
     one_line_error(run("kinematics", "--input", str(src)), "not valid CSV")
@@ -186,11 +187,11 @@ def test_multi_line_quoted_cell_is_a_one_line_csv_error(tmp_path):
     ],
     ids=["duration", "replay-duration", "replay-dt", "samples", "set"],
 )
-def test_extreme_numbers_are_one_short_line(args):
+def test_extreme_numbers_are_one_short_line(args, run):
     one_line_error(run(*args, stdin=POSES.encode()))
 
 
-def test_numbers_as_typed_on_the_command_line():
+def test_numbers_as_typed_on_the_command_line(run):
     res = run("trajectory", "--kind", "line", "--duration", "0,4", "--samples", "5", "--fext", "1,5;-2")
     assert res.returncode == 0, res.stderr
     assert float(rows(res.stdout)[-1]["t"]) == pytest.approx(0.4)
@@ -198,7 +199,7 @@ def test_numbers_as_typed_on_the_command_line():
     assert res.returncode == 0, res.stderr
 
 
-def test_extreme_forces_get_a_plausibility_note_and_overflow_is_refused():
+def test_extreme_forces_get_a_plausibility_note_and_overflow_is_refused(run):
     head = "p1,p2,dp1,dp2,ddp1,ddp2\n"
     res = run("dynamics", "--input", "-", stdin=(head + "0,0,0,0,5e6,0\n").encode())  # mm/s^2 typed as m/s^2
     assert res.returncode == 0 and "note:" in res.stderr and "units" in res.stderr and res.stderr.count("\n") == 1
@@ -209,7 +210,7 @@ def test_extreme_forces_get_a_plausibility_note_and_overflow_is_refused():
 # --- real-world CSVs through the command line ----------------------------------------------------------------------
 
 
-def test_dynamics_accepts_what_trajectory_writes(tmp_path):
+def test_dynamics_accepts_what_trajectory_writes(tmp_path, run):
     traj = tmp_path / "traj.csv"
     assert run("trajectory", "--kind", "circle", "--samples", "21", "--output", str(traj)).returncode == 0
     res = run("dynamics", "--input", str(traj))
@@ -218,7 +219,7 @@ def test_dynamics_accepts_what_trajectory_writes(tmp_path):
     assert [float(r["tau1"]) for r in got] == pytest.approx([float(r["tau1"]) for r in ref], rel=1e-12)
 
 
-def test_spreadsheet_trajectory_in_milliseconds_and_millimetres(tmp_path):
+def test_spreadsheet_trajectory_in_milliseconds_and_millimetres(tmp_path, run):
     src = tmp_path / "path.csv"
     src.write_bytes(
         b'\xef\xbb\xbfsep=;\r\n"t [ms]";"p1 (mm)";"p2 (mm)";\r\n0;0;0;\r\n100;10;5;\r\n200;20;10;\r\n300;30;15;\r\n'
@@ -230,14 +231,14 @@ def test_spreadsheet_trajectory_in_milliseconds_and_millimetres(tmp_path):
     assert float(r[-1]["p1"]) == pytest.approx(0.03)
 
 
-def test_plain_t_in_milliseconds_gets_a_hint(tmp_path):
+def test_plain_t_in_milliseconds_gets_a_hint(tmp_path, run):
     src = tmp_path / "path.csv"
     src.write_text("t;p1;p2\n0;0;0\n100;0,01;0\n200;0,02;0\n300;0,03;0\n")
     res = run("trajectory", "--input", str(src))
     assert res.returncode == 0 and "t_ms" in res.stderr and res.stderr.count("\n") == 1
 
 
-def test_refusal_quotes_the_header_found(tmp_path):
+def test_refusal_quotes_the_header_found(tmp_path, run):
     src = tmp_path / "path.csv"
     src.write_text("time;x;y\n0;0;0\n")
     one_line_error(
@@ -259,9 +260,11 @@ def test_refusal_quotes_the_header_found(tmp_path):
         (["--host", "192.0.2.1", "--port", "0"], "not an address of this machine"),
     ],
 )
+@pytest.mark.end_to_end
 def test_serve_fails_fast_with_one_line(args, text):
+    """In a child process (the installed command): a bad address must be refused before anything is served."""
     start = time.monotonic()
-    one_line_error(run("serve", *args, timeout=30), text)
+    one_line_error(cli.run_installed("serve", *args), text)
     assert time.monotonic() - start < 5
 
 

@@ -6,11 +6,10 @@ import csv
 import io
 import json
 import re
-import subprocess
-import sys
 
 import pytest
 
+from tests.support import cli
 from tpm_viz.app.exercises.catalogue import listed
 from tpm_viz.cli import main
 from tpm_viz.core.params import PARAM_INFO
@@ -155,19 +154,10 @@ def test_selftest_on_a_lecturer_s_folder(tmp_path, capsys):
     assert status == 1 and "01-mine.toml:" in err and "unknown key" in err
 
 
+@pytest.mark.end_to_end
 def test_the_installed_command(tmp_path):
-    """The real entry point: ``python -m tpm_viz`` (a subprocess), JSON on stdout, status 0 and 2."""
-    done = subprocess.run(
-        [sys.executable, "-m", "tpm_viz", "exercise", "grade", "leg-angle", "--seed", "4", "--answer", "0.3 rad"],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    """The real entry point: the installed ``tpm-viz`` (a child process), JSON on stdout, status 0 and 2."""
+    done = cli.run_installed("exercise", "grade", "leg-angle", "--seed", "4", "--answer", "0.3 rad")
     assert done.returncode == 0 and set(json.loads(done.stdout)) == GRADE_KEYS
-    done = subprocess.run(
-        [sys.executable, "-m", "tpm_viz", "exercise", "show", "leg-angle", "--seed", "x"],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    done = cli.run_installed("exercise", "show", "leg-angle", "--seed", "x")
     assert done.returncode == 2 and done.stdout == "" and "seed" in done.stderr

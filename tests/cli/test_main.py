@@ -1,32 +1,33 @@
-"""The tpm-viz command line end to end (subprocess), including every kind of bad input."""
+"""The tpm-viz command line (``kinematics``, ``dynamics``, ``trajectory``) in this process, including every kind of bad
+input; one test runs the installed entry point end to end."""
 
 from __future__ import annotations
 
 import csv
+import importlib.metadata
 import io
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
+from tests.support import cli
 from tests.support.reference import ik_quadratic, minimal_coordinate_forces
 from tpm_viz import Params
 
 P = Params.paper()
 
 
-def run(*args: str, stdin: str | None = None) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "tpm_viz", *args], input=stdin, capture_output=True, text=True, timeout=120
-    )
+@pytest.fixture
+def run(capsys):
+    """``tpm-viz ARGS`` in this process: ``run(*args, stdin=...)`` -> status, stdout, stderr."""
+    return lambda *args, stdin=None: cli.run(capsys, *args, stdin=stdin)
 
 
 def rows(text: str) -> list[dict[str, str]]:
     return list(csv.DictReader(io.StringIO(text)))
 
 
-def test_kinematics_keeps_unreachable_rows_flagged(tmp_path):
+def test_kinematics_keeps_unreachable_rows_flagged(tmp_path, run):
     src = tmp_path / "poses.csv"
     src.write_text("p1,p2\n0.05,-0.02\n0.3,0\n-0.135,0\n")
     out = tmp_path / "out.csv"
@@ -40,7 +41,7 @@ def test_kinematics_keeps_unreachable_rows_flagged(tmp_path):
     assert r[1]["d1"] == ""  # no value for an unreachable pose, never NaN
 
 
-def test_dynamics_matches_the_minimal_coordinate_reference_and_set_overrides(tmp_path):
+def test_dynamics_matches_the_minimal_coordinate_reference_and_set_overrides(tmp_path, run):
     src = tmp_path / "states.csv"
     src.write_text("p1,p2,dp1,dp2,ddp1,ddp2\n0.04,0.03,0.5,-0.7,8,3\n")
     res = run("dynamics", "--input", str(src), "--set", "m_p=3.0", "--set", "l_a=0.3", "--fext", "5,-2")
@@ -51,7 +52,7 @@ def test_dynamics_matches_the_minimal_coordinate_reference_and_set_overrides(tmp
     assert [float(r["tau1"]), float(r["tau2"])] == pytest.approx(ref, rel=1e-6)
 
 
-def test_trajectory_samples_the_cubic_line(tmp_path):
+def test_trajectory_samples_the_cubic_line(tmp_path, run):
     res = run("trajectory", "--kind", "line", "--duration", "0.4", "--samples", "5")
     assert res.returncode == 0, res.stderr
     r = rows(res.stdout)
@@ -67,7 +68,7 @@ def test_trajectory_samples_the_cubic_line(tmp_path):
 
 
 @pytest.mark.slow
-def test_trajectory_from_a_users_csv_matches_the_paper_circle(tmp_path):
+def test_trajectory_from_a_users_csv_matches_the_paper_circle(tmp_path, run):
     """Timed positions of the paper's circle in, spline derivatives and forces out (vs the exact trajectory)."""
     t = np.linspace(0, 0.5, 401)
     phi = 2 * np.pi * (3 * (t / 0.5) ** 2 - 2 * (t / 0.5) ** 3)
@@ -104,7 +105,7 @@ def test_trajectory_from_a_users_csv_matches_the_paper_circle(tmp_path):
         (["dynamics", "--fext", "1"], "p1,p2,dp1,dp2,ddp1,ddp2\n0,0,0,0,0,0\n", "--fext"),
     ],
 )
-def test_bad_input_exits_2_with_one_line(tmp_path, args, content, message):
+def test_bad_input_exits_2_with_one_line(tmp_path, args, content, message, run):
     src = tmp_path / "in.csv"
     src.write_text(content)
     res = run(*args, "--input", str(src))
@@ -114,14 +115,29 @@ def test_bad_input_exits_2_with_one_line(tmp_path, args, content, message):
 
 
 @pytest.mark.parametrize("duration", ["0", "-1", "nan", "soon"])
-def test_bad_duration_exits_2(duration):
+def test_bad_duration_exits_2(duration, run):
     res = run("trajectory", "--kind", "circle", "--duration", duration)
     assert res.returncode == 2 and "duration" in res.stderr and res.stderr.count("\n") == 1
 
 
-def test_missing_file_and_stdin():
+def test_missing_file_and_stdin(run):
     res = run("kinematics", "--input", "/nonexistent/poses.csv")
     assert res.returncode == 2 and "No such file" in res.stderr and "Traceback" not in res.stderr
     res = run("kinematics", "--input", "-", stdin="p1,p2\n0,0\n")
     assert res.returncode == 0, res.stderr
     assert float(rows(res.stdout)[0]["d1"]) == pytest.approx(0.482 - 0.092 - 0.260, abs=1e-15)
+
+
+@pytest.mark.end_to_end
+def test_the_installed_command_reads_stdin_writes_stdout_and_exits_0_or_2(tmp_path):
+    """The console script of ``[project.scripts]`` in a child process: a pipe in, CSV out, status 0; a missing file,
+    status 2 with one line; a usage error, status 2."""
+    (script,) = [e for e in importlib.metadata.entry_points(group="console_scripts") if e.name == "tpm-viz"]
+    assert script.value == "tpm_viz.cli:main"
+    res = cli.run_installed("kinematics", "--input", "-", "--output", "-", stdin="p1,p2\n0,0\n")
+    assert res.returncode == 0 and res.stderr == "", res.stderr
+    assert float(rows(res.stdout)[0]["d1"]) == pytest.approx(0.482 - 0.092 - 0.260, abs=1e-15)
+    res = cli.run_installed("kinematics", "--input", str(tmp_path / "missing.csv"))
+    assert res.returncode == 2 and res.stdout == "" and res.stderr.count("\n") == 1 and "No such file" in res.stderr
+    res = cli.run_installed("kinematics", "--no-such-option")
+    assert res.returncode == 2 and res.stderr.startswith("tpm-viz: error:") and res.stderr.count("\n") == 1

@@ -1,4 +1,5 @@
-"""``tpm-viz replay | crosscheck | figures``: register() on a plain parser, then end to end (subprocess)."""
+"""``tpm-viz replay | crosscheck | figures``: register() on a plain parser, then the command in this process; one test
+runs the installed entry point end to end (statuses 0, 1 and 2)."""
 
 from __future__ import annotations
 
@@ -6,13 +7,12 @@ import argparse
 import csv
 import io
 import struct
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 import tpm_viz as tv
+from tests.support import cli
 from tests.support.cli import parser_for
 from tpm_viz.cli import multibody as cli_multibody
 
@@ -21,8 +21,10 @@ pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this
 P = tv.Params.paper()
 
 
-def run(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "tpm_viz", *args], capture_output=True, text=True, timeout=120)
+@pytest.fixture
+def run(capsys):
+    """``tpm-viz ARGS`` in this process -> status, stdout, stderr."""
+    return lambda *args: cli.run(capsys, *args)
 
 
 def table(text: str) -> dict[str, np.ndarray]:
@@ -53,7 +55,7 @@ def test_register_works_on_a_plain_argparse_parser(tmp_path):
         assert callable(parser.parse_args(argv).func)
 
 
-def test_replay_end_to_end_prints_csv_that_tracks_the_closed_form():
+def test_replay_prints_csv_that_tracks_the_closed_form(run):
     res = run("replay", "--trajectory", "circle", "--duration", "0.25")
     assert res.returncode == 0, res.stderr
     cols = table(res.stdout)
@@ -67,7 +69,7 @@ def test_replay_end_to_end_prints_csv_that_tracks_the_closed_form():
     assert np.max(np.abs(tau - tv.inverse_dynamics(P, p, dp, ddp))) < 1e-9
 
 
-def test_crosscheck_passes_with_the_paper_tolerances_and_fails_with_impossible_ones():
+def test_crosscheck_passes_with_the_paper_tolerances_and_fails_with_impossible_ones(run):
     ok = run("crosscheck", "--random", "50")
     assert ok.returncode == 0, ok.stderr + ok.stdout
     assert "line T=0.2 s" in ok.stdout and "circle T=0.5 s" in ok.stdout and "random, seed 0" in ok.stdout
@@ -79,7 +81,7 @@ def test_crosscheck_passes_with_the_paper_tolerances_and_fails_with_impossible_o
     assert "FAIL" in bad.stdout and bad.stdout.strip().endswith("result: FAIL")
 
 
-def test_figures_writes_two_small_pngs(tmp_path):
+def test_figures_writes_two_small_pngs(tmp_path, run):
     res = run("figures", "--output-dir", str(tmp_path / "figs"), "--duration-line", "0.3", "--samples", "101")
     assert res.returncode == 0, res.stderr
     for name in ("fig4_line.png", "fig5_circle.png"):
@@ -108,8 +110,22 @@ def test_figures_writes_two_small_pngs(tmp_path):
         ["figures", "--output-dir", "/dev/null/x"],
     ],
 )
-def test_bad_input_exits_2_with_one_line(argv):
+def test_bad_input_exits_2_with_one_line(argv, run):
     res = run(*argv)
     assert res.returncode == 2, res.stdout + res.stderr
     assert res.stderr.count("\n") == 1 and res.stderr.startswith("tpm-viz: error:")
     assert "Traceback" not in res.stderr and res.stdout == ""
+
+
+@pytest.mark.end_to_end
+def test_the_installed_command_exits_0_1_or_2(tmp_path):
+    """The console script in a child process: a replay (0), a cross-check that fails (1), a usage error (2)."""
+    ok = cli.run_installed("replay", "--trajectory", "line", "--duration", "0.05", "--output", str(tmp_path / "r.csv"))
+    assert ok.returncode == 0 and ok.stderr == "", ok.stderr
+    assert list(table((tmp_path / "r.csv").read_text())) == cli_multibody.REPLAY_COLUMNS
+    bad = cli.run_installed(
+        "crosscheck", "--random", "1", "--duration-line", "0.05", "--duration-circle", "0.05", "--rel-tol", "1e-20"
+    )
+    assert bad.returncode == 1 and bad.stdout.strip().endswith("result: FAIL")
+    usage = cli.run_installed("replay")
+    assert usage.returncode == 2 and usage.stdout == "" and usage.stderr.count("\n") == 1

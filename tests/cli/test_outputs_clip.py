@@ -10,14 +10,13 @@ import io
 import json
 import pathlib
 import re
-import subprocess
-import sys
 
 import av
 import numpy as np
 import pytest
 from PIL import Image
 
+from tests.support import cli
 from tpm_viz.cli import main
 
 pytestmark = pytest.mark.slow  # the one-minute loop (-m "not slow") leaves this file out
@@ -108,11 +107,15 @@ def test_mp4_of_the_circle_decoded_back(tmp_path, capsys):
     check_forces(frames, side, t_ref, tau_ref, tol_px=3.0)
 
 
+@pytest.mark.end_to_end
 @pytest.mark.parametrize("name", ["a.gif", "a.mp4"])
 def test_the_same_inputs_give_the_same_bytes(tmp_path, name):
+    """The installed command in a child process and the command in this one (two processes: hash seeds, caches and
+    threads of their own) write the same bytes."""
     argv = ["clip", "--trajectory", "line", "--samples", "16", "--size", "320x180", "--set", "l_a=0.27"]
-    for run in ("1", "2"):  # two processes (hash seeds, caches and threads of their own)
-        subprocess.run([sys.executable, "-m", "tpm_viz", *argv, "--output", str(tmp_path / (run + name))], check=True)
+    done = cli.run_installed(*argv, "--output", str(tmp_path / ("1" + name)))
+    assert done.returncode == 0, done.stderr
+    assert main([*argv, "--output", str(tmp_path / ("2" + name))]) == 0
     assert (tmp_path / ("1" + name)).read_bytes() == (tmp_path / ("2" + name)).read_bytes()
 
 

@@ -7,13 +7,12 @@ import csv
 import io
 import math
 import re
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 import tpm_viz as tv
+from tests.support import cli
 from tests.support.cli import parser_for
 from tpm_viz.cli import plan as cli_plan
 from tpm_viz.core.errors import TpmVizError
@@ -176,21 +175,13 @@ def _registered() -> bool:
 
 
 @pytest.mark.slow
+@pytest.mark.end_to_end
 @pytest.mark.skipif(not _registered(), reason="tpm_viz.cli does not register plan/size yet")
 def test_end_to_end_through_tpm_viz_main(tmp_path):
-    ok = subprocess.run(
-        [sys.executable, "-m", "tpm_viz", "plan", "--path", "line", "--force-limit", "100"],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    """The installed ``tpm-viz`` in a child process: a plan (status 0, the table, the cycle time), a bad limit (2)."""
+    ok = cli.run_installed("plan", "--path", "line", "--force-limit", "100")
     assert ok.returncode == 0, ok.stderr
     assert list(table(ok.stdout)) == cli_plan.PLAN_COLUMNS
     assert math.isfinite(float(re.search(r"cycle time ([\d.]+) s", ok.stderr).group(1)))
-    bad = subprocess.run(
-        [sys.executable, "-m", "tpm_viz", "plan", "--path", "line", "--force-limit", "-5"],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    bad = cli.run_installed("plan", "--path", "line", "--force-limit", "-5")
     assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1

@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 
 from tests.lti.conftest import launch, login, start_tool
 from tests.lti.platform import LTI, Key
+from tests.support.hypo import examples
 from tpm_viz.lti.bounds import Rate
 
 WORD = re.compile(r'data-why="([^"]+)"')
@@ -226,7 +227,7 @@ VALUES = st.one_of(
 )
 
 
-@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=examples(40), deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(changes=st.dictionaries(st.sampled_from(CLAIMS), VALUES, min_size=1, max_size=3))
 def test_any_tampered_claim_is_refused_or_harmless_and_never_a_500(roomy, platform, changes):
     """Whatever a forger puts in the signed claims: a 4xx with a known word and nothing created, or (when the

@@ -4,12 +4,10 @@ arrivals and departures (150 tabs leaving at once must not redraw 150 lines 150 
 from __future__ import annotations
 
 import re
-import time
 
 from tests.support.fixtures import open_tab
 from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz.core.words import Lang
-from tpm_viz.ui import app as app_module
 
 HANGUL = re.compile("[\uac00-\ud7a3]")
 
@@ -28,14 +26,22 @@ def test_the_class_line_counts_tabs_and_is_redrawn_once_per_burst(app, connect, 
     for client in leaving:  # three tabs leave at once, one switches to its own copy
         client.close()
     wait_for(lambda: len(app.views) == 3, what="three tabs gone")
-    wait_for(lambda: "3 tabs connected, 2 on the shared mechanism" in first.panel.class_info.content, what="3")
-    time.sleep(3 * app_module.CLASS_INFO_DELAY)
-    # the redraw runs on its own timer, not in a hub step: the last lines of the six-tab redraw may still be written
-    # after every tab shows it; the burst's own redraws are the ones after it
+    three = "3 tabs connected, 2 on the shared mechanism"
+    remaining = [view for _c, view in tabs[:3]]
+    # the redraw runs on its own timer, not in a hub step: wait until no redraw is pending and every remaining tab
+    # shows the burst's outcome (the last lines of the six-tab redraw may still be written after every tab shows it;
+    # the burst's own redraws are the ones after it)
+    wait_for(
+        lambda: (
+            app._class_info_timer is None
+            and all(three in view.panel.class_info.content for view in remaining)
+            and "You see your own copy." in tabs[1][1].panel.class_info.content
+            and "You see the shared mechanism." in first.panel.class_info.content
+        ),
+        what="the burst's redraw on every remaining tab, and no redraw pending",
+    )
     burst = [text for text in writes if six not in text]
     assert burst and len(burst) <= 2 * 3  # each remaining tab written once or twice, not once per change (4 changes)
-    assert "You see your own copy." in tabs[1][1].panel.class_info.content
-    assert "You see the shared mechanism." in first.panel.class_info.content
 
 
 def test_the_class_line_follows_the_tab_language(connect):

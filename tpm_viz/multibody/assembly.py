@@ -21,6 +21,8 @@ from tpm_viz.core.numbers import fixed
 from tpm_viz.core.params import Params
 from tpm_viz.core.words import Phrase
 from tpm_viz.multibody.locking import locked
+from tpm_viz.paper.kinematics import PERPENDICULAR
+from tpm_viz.paper.legs import Legs, unreachable
 
 __all__ = ["DOF", "NEWTON_FLOOR", "NEWTON_MAX_ITER", "NEWTON_TOL", "ClosedLoopAssembly", "ThreeArrays"]
 
@@ -34,7 +36,15 @@ ThreeArrays = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64
 
 
 class ClosedLoopAssembly:
-    """Mixin: the closed-loop kinematics of :class:`~tpm_viz.multibody.model.MultibodyModel`."""
+    """Mixin: the closed-loop kinematics of :class:`~tpm_viz.multibody.model.MultibodyModel`.
+
+    The arrangement's own parts are :attr:`legs` (its reachability and refusal, :mod:`tpm_viz.paper.legs`), the
+    starting guesses (:meth:`_guess_from_platform`, :meth:`_guess_from_both`, :meth:`_assembly_guesses`) and
+    :meth:`_mode` (the sign of ``det J_x``); another arrangement overrides them.
+    """
+
+    legs: Legs = PERPENDICULAR
+    """The arrangement's legs: which poses are reachable and how an unreachable one is refused."""
 
     # What the model provides (built in MultibodyModel.__init__):
     params: Params
@@ -132,17 +142,11 @@ class ClosedLoopAssembly:
         return self._configure(p, None if d is None else self._one(d, "d"))[0]
 
     def _configure(self, p: np.ndarray, d: np.ndarray | None) -> ThreeArrays:
-        """``(q, J_c, J_P)`` at the closed-loop configuration of platform position ``p``."""
-        la, (p1, p2) = self.params.l_a, p.tolist()
-        if max(abs(p1), abs(p2)) >= la:
-            raise UnreachablePoseError(
-                Phrase(
-                    "platform position ({x}, {y}) mm is unreachable: each |p_j| must be below l_a = {l_a:.1f} mm",
-                    x=fixed(p1, ".1f", 1e3),
-                    y=fixed(p2, ".1f", 1e3),
-                    l_a=la * 1e3,
-                )
-            )
+        """``(q, J_c, J_P)`` at the closed-loop configuration of platform position ``p`` (refused, as the
+        arrangement's inverse kinematics refuses it, where unreachable)."""
+        if not bool(self.legs.reachable(self.params, p)):
+            x, y = (fixed(v, ".1f", 1e3) for v in p.tolist())
+            raise UnreachablePoseError(unreachable(self.legs, self.params, x, y))
         return self._assembled(p, d)
 
     def _assembled(self, p: np.ndarray, d: np.ndarray | None) -> ThreeArrays:
@@ -170,30 +174,39 @@ class ClosedLoopAssembly:
             )
         )
 
-    @locked
-    def configuration_from_actuators(self, d: ArrayLike, mode: int = +1) -> np.ndarray:
-        """Full configuration ``q`` (7,) for actuator positions ``d`` (2,) [m] in assembly ``mode``
-        (+1: ``cos(θ1 + θ2) > 0``, the home mode; -1: the other), by Newton on the closures."""
-        if mode not in (1, -1):
-            raise InputError(f"assembly mode must be +1 or -1, got {mode!r}")
-        d = self._one(d, "d")
+    def _assembly_guesses(self, d: np.ndarray) -> list[np.ndarray] | None:
+        """Platform positions [m] to start Newton from for actuator positions ``d``, one on each side of the line
+        of the leg circles' centres ``C_1 = (d_1 - a + b) e_1``, ``C_2 = (d_2 - a + b) e_2``; None where the
+        circles do not meet."""
         k, la = self.params.a - self.params.b, self.params.l_a
         c1, c2 = np.array([d[0] - k, 0.0]), np.array([0.0, d[1] - k])  # leg circle centres
         gap = math.hypot(float(d[0] - k), float(d[1] - k))  # |C_2 - C_1|, no overflow for huge d
         if not gap < 2 * la or gap == 0:
+            return None
+        normal = np.array([c1[1] - c2[1], c2[0] - c1[0]]) / gap
+        return [(c1 + c2) / 2 + side * (la / np.sqrt(2.0)) * normal for side in (1.0, -1.0)]
+
+    def _mode(self, q: np.ndarray) -> float:
+        """The assembly mode of a closed configuration: the sign of ``det J_x = cos(θ1 + θ2)`` (eq. 12)."""
+        return float(np.sign(np.cos(np.subtract(*self._link_angles(self._wrap(q))))))
+
+    @locked
+    def configuration_from_actuators(self, d: ArrayLike, mode: int = +1) -> np.ndarray:
+        """Full configuration ``q`` (7,) for actuator positions ``d`` (2,) [m] in assembly ``mode`` (+1: ``det J_x >
+        0``, perpendicular ``cos(θ1 + θ2) > 0``, the home mode; -1: the other), by Newton on the closures from each
+        of the arrangement's guesses (:meth:`_assembly_guesses`) in turn."""
+        if mode not in (1, -1):
+            raise InputError(f"assembly mode must be +1 or -1, got {mode!r}")
+        d = self._one(d, "d")
+        guesses = self._assembly_guesses(d)
+        if guesses is None:
             raise UnreachablePoseError(
                 Phrase("actuator positions cannot be assembled: the leg circles are more than 2 l_a apart")
             )
-        normal = np.array([c1[1] - c2[1], c2[0] - c1[0]]) / gap
-        found = []
-        for side in (1.0, -1.0):  # a guess on each side of the line of centres
-            p0 = (c1 + c2) / 2 + side * (la / np.sqrt(2.0)) * normal
+        for p0 in guesses:  # guesses only: Newton on Pinocchio's closures decides
             q, ok, _, _ = self._newton(self._guess_from_both(p0, d), d, "actuators")
-            if ok and self._is_parallelogram(q):
-                found.append(self._wrap(q))
-        for q in found:
-            if np.sign(np.cos(np.subtract(*self._link_angles(q)))) == mode:  # det J_x = cos(θ1 + θ2), eq. 12
-                return q
+            if ok and self._is_parallelogram(q) and self._mode(q) == mode:
+                return self._wrap(q)
         raise SingularConfigurationError(
             Phrase("assembly mode {mode} not found: d is at or near the direct singularity", mode=f"{mode:+d}")
         )

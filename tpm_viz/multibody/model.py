@@ -62,7 +62,7 @@ from tpm_viz.multibody.rank import RankedSvd, ranked_svd
 from tpm_viz.multibody.tree import Built, closed_tree, point_mass, rod, se3
 from tpm_viz.paper.kinematics import as_xy
 
-__all__ = ["PART_NAMES", "MultibodyModel", "inverse_dynamics", "model_for"]
+__all__ = ["PART_NAMES", "MultibodyModel", "checked_model", "inverse_dynamics", "model_for"]
 
 PART_NAMES = ("slider1", "slider2", "link1_0", "link1_1", "link2_0", "link2_1", "platform")
 """Keys of :meth:`MultibodyModel.placements`, also the Pinocchio joint names (and frame names)."""
@@ -350,11 +350,17 @@ def model_for(params: Params) -> MultibodyModel:
     return MultibodyModel(params)
 
 
+def checked_model(factory: Callable[[Params], MultibodyModel], params: object) -> MultibodyModel:
+    """``factory(params)`` (a cached model of either arrangement), or :class:`InputError` where ``params`` is not a
+    :class:`~tpm_viz.Params` (what :func:`inverse_dynamics` was given)."""
+    if not isinstance(params, Params):
+        raise InputError(f"inverse_dynamics needs a tpm_viz.Params, got {type(params).__name__}")
+    return factory(params)
+
+
 def inverse_dynamics(
     params: Params, p: ArrayLike, dp: ArrayLike, ddp: ArrayLike, f_ext: ArrayLike | None = None
 ) -> np.ndarray:
     """Actuator forces ``τ`` [N], shape ``(..., 2)``, from the Pinocchio model (see
     :meth:`MultibodyModel.inverse_dynamics`); one cached model per ``params``."""
-    if not isinstance(params, Params):
-        raise InputError(f"inverse_dynamics needs a tpm_viz.Params, got {type(params).__name__}")
-    return model_for(params).inverse_dynamics(p, dp, ddp, f_ext)
+    return checked_model(model_for, params).inverse_dynamics(p, dp, ddp, f_ext)

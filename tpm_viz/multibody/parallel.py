@@ -1,8 +1,10 @@
 """The parallel 2-PPa as its own closed-loop Pinocchio model (``docs/parallel.md``, ``docs/pinocchio.md``).
 
 Same construction, mass model and solves as :class:`~tpm_viz.multibody.model.MultibodyModel` (it subclasses it:
-the rank-revealing inverse and forward dynamics, the Newton assembly and the lock are the perpendicular model's);
-only the tree, the closures and the starting guesses differ. Depth-first tree, ``q = (d_1, φ_10, φ_p, φ_11, d_2,
+the rank-revealing inverse and forward dynamics, the Newton assembly, the reachability refusal and the assembly from
+actuator positions, and the lock are the perpendicular model's); only the tree, the closures, the legs (which poses
+are reachable, :data:`tpm_viz.paper.parallel.kinematics.PARALLEL`), the starting guesses and the sign of
+``det J_x`` that names an assembly mode differ. Depth-first tree, ``q = (d_1, φ_10, φ_p, φ_11, d_2,
 φ_20, φ_21)`` (read :attr:`index`)::
 
     universe ─PX─ slider1 (origin A_1 = (d_1 - a, 0)) ─RZ─ link1_0 (pivot A_1) ─RZ─ platform (pivot B_1)
@@ -26,14 +28,13 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from tpm_viz.core.errors import InputError, SingularConfigurationError, UnreachablePoseError
-from tpm_viz.core.numbers import fixed
+from tpm_viz.core.errors import SingularConfigurationError
 from tpm_viz.core.params import Params
 from tpm_viz.core.words import Phrase
-from tpm_viz.multibody.locking import locked
-from tpm_viz.multibody.model import MultibodyModel
+from tpm_viz.multibody.model import MultibodyModel, checked_model
 from tpm_viz.multibody.tree import Built, closed_tree, point_mass, rod, se3
 from tpm_viz.paper import parallel as par
+from tpm_viz.paper.parallel.kinematics import PARALLEL
 
 __all__ = ["ParallelMultibodyModel", "inverse_dynamics", "parallel_model_for"]
 
@@ -62,6 +63,7 @@ class ParallelMultibodyModel(MultibodyModel):
     methods are :class:`MultibodyModel`'s (``inverse_dynamics``, ``configuration``, ``placements``, ...)."""
 
     _build_model = staticmethod(_build_parallel)
+    legs = PARALLEL
 
     def _guess_from_platform(self, p: np.ndarray, d: np.ndarray | None) -> np.ndarray:
         """Working mode (eq. P3), ``sin θ_i = p_2 / l_a``, or links pointing at the pivots from given ``d``."""
@@ -77,21 +79,6 @@ class ParallelMultibodyModel(MultibodyModel):
         u = b - pose_a
         return self._pack(d, math.atan2(u[0, 1], u[0, 0]), math.atan2(-u[1, 1], -u[1, 0]))
 
-    def _configure(self, p: np.ndarray, d: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(q, J_c, J_P)`` at the closed-loop configuration of ``p``: Newton from the working-mode guess
-        (or from ``d``'s branch), then the last pose as a continuation start."""
-        la, (p1, p2) = self.params.l_a, p.tolist()
-        if not abs(p2) < la:
-            raise UnreachablePoseError(
-                Phrase(
-                    "platform position ({x}, {y}) mm is unreachable: |p2| must be below l_a = {l_a:.1f} mm",
-                    x=fixed(p1, ".1f", 1e3),
-                    y=fixed(p2, ".1f", 1e3),
-                    l_a=la * 1e3,
-                )
-            )
-        return self._assembled(p, d)
-
     def _tau(
         self, q: np.ndarray, v: np.ndarray, a: np.ndarray, n: np.ndarray, jp: np.ndarray, f_ext: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:
@@ -102,26 +89,16 @@ class ParallelMultibodyModel(MultibodyModel):
             raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq="sin(θ1 + θ2) = 0"))
         return super()._tau(q, v, a, n, jp, f_ext)
 
-    @locked
-    def configuration_from_actuators(self, d: ArrayLike, mode: int = +1) -> np.ndarray:
-        """Full ``q`` (7,) for actuator positions ``d`` (2,) [m] in assembly ``mode`` (+1: ``det J_x =
-        sin(θ1 + θ2) > 0``, the upper one with the legs inwards), by Newton on the closures."""
-        if mode not in (1, -1):
-            raise InputError(f"assembly mode must be +1 or -1, got {mode!r}")
-        d = self._one(d, "d")
+    def _assembly_guesses(self, d: np.ndarray) -> list[np.ndarray] | None:
+        """Both assembly modes of the closed form (eq. P7) as Newton's starting points; None where the leg circles
+        do not meet."""
         sol = par.forward_kinematics_both(self.params, d)
-        if not bool(sol.exists):
-            raise UnreachablePoseError(
-                Phrase("actuator positions cannot be assembled: the leg circles are more than 2 l_a apart")
-            )
-        for p0 in (sol.plus, sol.minus):  # guesses only: Newton on Pinocchio's closures decides
-            q, ok, _, _ = self._newton(self._guess_from_both(p0, d), d, "actuators")
-            f1, f2 = self._link_angles(q)  # (θ_1, -θ_2)
-            if ok and self._is_parallelogram(q) and np.sign(math.sin(f1 - f2)) == mode:
-                return self._wrap(q)
-        raise SingularConfigurationError(
-            Phrase("assembly mode {mode} not found: d is at or near the direct singularity", mode=f"{mode:+d}")
-        )
+        return [sol.plus, sol.minus] if bool(sol.exists) else None
+
+    def _mode(self, q: np.ndarray) -> float:
+        """The sign of ``det J_x = sin(θ1 + θ2)`` (eq. P4; +1: the upper mode with the legs inwards)."""
+        f1, f2 = self._link_angles(q)  # (θ_1, -θ_2)
+        return float(np.sign(math.sin(f1 - f2)))
 
 
 @functools.lru_cache(maxsize=16)
@@ -134,6 +111,4 @@ def inverse_dynamics(
     params: Params, p: ArrayLike, dp: ArrayLike, ddp: ArrayLike, f_ext: ArrayLike | None = None
 ) -> np.ndarray:
     """Actuator forces ``τ`` [N], shape ``(..., 2)``, from the parallel Pinocchio model (one cached per params)."""
-    if not isinstance(params, Params):
-        raise InputError(f"inverse_dynamics needs a tpm_viz.Params, got {type(params).__name__}")
-    return parallel_model_for(params).inverse_dynamics(p, dp, ddp, f_ext)
+    return checked_model(parallel_model_for, params).inverse_dynamics(p, dp, ddp, f_ext)

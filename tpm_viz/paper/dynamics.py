@@ -146,7 +146,8 @@ def _procedure(
 
 SINGULAR_TOL = 1e-12
 """The closed form refuses a pose with ``|c_1 c_2| < SINGULAR_TOL l_a²`` (``|cos θ1 cos θ2|`` below it, eq. 11)
-or ``|c_1 c_2 - p_1 p_2| < SINGULAR_TOL l_a²`` (``|cos(θ1 + θ2)|`` below it, eq. 12); the generated C too."""
+or ``|c_1 c_2 - p_1 p_2| < SINGULAR_TOL l_a²`` (``|cos(θ1 + θ2)|`` below it, eq. 12); the generated C too, and the
+parallel closed form on ``|c_1 c_2|`` and ``|p_2 (c_1 + c_2)|`` (``|sin(θ1 + θ2)|``, eq. P12)."""
 
 
 _EQ11 = "cos θ1 cos θ2 = 0 (eq. 11)"

@@ -6,7 +6,9 @@ inverse kinematics (eq. 4).
 
 Velocity relation (eqs. 6-10): ``J_x ṗ = J_q ḋ`` with
 ``J_x = [[cos θ1, sin θ1], [sin θ2, cos θ2]]``, ``J_q = diag(cos θ1, cos θ2)`` and
-``J = J_q^{-1} J_x = [[1, tan θ1], [tan θ2, 1]]``.
+``J = J_q^{-1} J_x = [[1, tan θ1], [tan θ2, 1]]``. Both arrangements' Jacobians (eq. P4 for the parallel one) are
+built by :func:`jacobians_of` from their legs (:class:`~tpm_viz.paper.legs.Legs`), and both share the statuses
+(:func:`classify_of`, :func:`pose_status`), the condition number and the statics through the ``*_through`` functions.
 
 Erratum (eq. 15): the paper prints ``J̇_q = diag(+sin θ_i θ̇_i)``; the time derivative of
 ``cos θ_i`` is ``-sin θ_i θ̇_i``. :func:`actuator_acceleration` uses the corrected sign; the
@@ -23,7 +25,9 @@ from numpy.typing import ArrayLike, NDArray
 from tpm_viz.core.errors import SingularConfigurationError
 from tpm_viz.core.params import Params
 from tpm_viz.core.words import Phrase, T
-from tpm_viz.paper.kinematics import as_xy, finite_result, in_stroke, inverse_kinematics, leg_components, reachable
+from tpm_viz.paper import legs as shared
+from tpm_viz.paper.kinematics import PERPENDICULAR
+from tpm_viz.paper.legs import Legs, as_xy, finite_result, in_stroke
 from tpm_viz.paper.status import STATUS_LABELS, WARN, PoseStatus, SingularityThresholds
 
 __all__ = [
@@ -36,10 +40,13 @@ __all__ = [
     "actuator_velocity",
     "check_regular",
     "classify",
+    "classify_of",
     "condition_number",
     "condition_of",
+    "cos_sin",
     "eq14_row",
     "jacobians",
+    "jacobians_of",
     "platform_force_from_actuator_forces",
     "platform_force_through",
     "platform_velocity",
@@ -64,28 +71,49 @@ class Jacobians(NamedTuple):
     det_jq: np.ndarray  # (...,) cos θ1 cos θ2, inverse singularity at 0
 
 
-def _cos_sin(
-    params: Params, p: ArrayLike, d: ArrayLike | None
+def cos_sin(
+    legs: Legs, params: Params, p: ArrayLike, d: ArrayLike | None
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """``(p, d, cos θ, sin θ)`` of either arrangement: ``cos θ_i = c_i / l_a``, ``sin θ_i = s_i / l_a`` (eq. 23 /
+    P2), ``d`` the working mode's (eq. 4 / P3) unless given; ``p``, ``d`` checked (:func:`as_xy`)."""
     p = as_xy(p)
-    d = inverse_kinematics(params, p) if d is None else as_xy(d, "d")
-    c, s = leg_components(params, p, d)
+    d = shared.inverse_kinematics(legs, params, p) if d is None else as_xy(d, "d")
+    c, s = legs.components(params, p, d)
     return p, d, c / params.l_a, s / params.l_a
 
 
-def jacobians(params: Params, p: ArrayLike, d: ArrayLike | None = None) -> Jacobians:
-    """The Jacobian matrices of eqs. (8) and (10) at ``p`` [m] (dimensionless)."""
-    _, _, cos, sin = _cos_sin(params, p, d)
-    jx = np.stack([np.stack([cos[..., 0], sin[..., 0]], -1), np.stack([sin[..., 1], cos[..., 1]], -1)], -2)
+def _row(legs: Legs, i: int, first: np.ndarray, second: np.ndarray, zero: np.ndarray) -> np.ndarray:
+    """Row ``i`` with ``σ_i first`` in column ``a_i`` and ``second`` in column ``b_i``."""
+    entries = [zero, zero]
+    entries[legs.along[i]] = first if legs.sign[i] > 0 else -first
+    entries[legs.across[i]] = second
+    return np.stack(entries, -1)
+
+
+def jacobians_of(legs: Legs, params: Params, p: ArrayLike, d: ArrayLike | None = None) -> Jacobians:
+    """The Jacobians of either arrangement at ``p`` [m] (dimensionless). Differentiating ``c_i² + s_i² = l_a²``
+    (:mod:`tpm_viz.paper.legs`) gives ``J_x ṗ = J_q ḋ`` with row ``i`` of ``J_x`` holding ``σ_i cos θ_i`` in
+    column ``a_i`` and ``sin θ_i`` in column ``b_i``, ``J_q = diag(cos θ_i)``, ``J = J_q⁻¹ J_x`` (``σ_i`` and
+    ``tan θ_i``): eqs. (8) and (10), ``[[cos θ1, sin θ1], [sin θ2, cos θ2]]``, or eq. (P4),
+    ``[[cos θ1, sin θ1], [-cos θ2, sin θ2]]``. ``det J_x`` (eq. 12: ``cos(θ1 + θ2)``; P4: ``sin(θ1 + θ2)``) and
+    ``det J_q = cos θ1 cos θ2`` (eq. 11) are the singularity measures."""
+    _, _, cos, sin = cos_sin(legs, params, p, d)
     zero = np.zeros_like(cos[..., 0])
+    jx = np.stack([_row(legs, i, cos[..., i], sin[..., i], zero) for i in (0, 1)], -2)
     jq = np.stack([np.stack([cos[..., 0], zero], -1), np.stack([zero, cos[..., 1]], -1)], -2)
     with np.errstate(divide="ignore", invalid="ignore"):
         tan = sin / cos
     one = np.ones_like(zero)
-    j = np.stack([np.stack([one, tan[..., 0]], -1), np.stack([tan[..., 1], one], -1)], -2)
-    det_jx = cos[..., 0] * cos[..., 1] - sin[..., 0] * sin[..., 1]
+    j = np.stack([_row(legs, i, one, tan[..., i], zero) for i in (0, 1)], -2)
+    det_jx = jx[..., 0, 0] * jx[..., 1, 1] - jx[..., 0, 1] * jx[..., 1, 0]
     det_jq = cos[..., 0] * cos[..., 1]
     return Jacobians(jx, jq, j, det_jx, det_jq)
+
+
+def jacobians(params: Params, p: ArrayLike, d: ArrayLike | None = None) -> Jacobians:
+    """The Jacobian matrices of eqs. (8) and (10) at ``p`` [m] (dimensionless): ``J_x = [[cos θ1, sin θ1],
+    [sin θ2, cos θ2]]``, ``J_q = diag(cos θ_i)``, ``J = [[1, tan θ1], [tan θ2, 1]]`` (:func:`jacobians_of`)."""
+    return jacobians_of(PERPENDICULAR, params, p, d)
 
 
 def condition_number(params: Params, p: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
@@ -103,20 +131,26 @@ def condition_of(j: np.ndarray) -> np.ndarray:
     return np.where(bad | ~np.isfinite(cond), np.inf, cond)
 
 
+def classify_of(legs: Legs, params: Params, p: ArrayLike, thresholds: SingularityThresholds = WARN) -> np.ndarray:
+    """Status per pose of either arrangement (:func:`pose_status` of its Jacobians at the working mode's ``d``);
+    non-finite poses count as unreachable."""
+    p = np.asarray(p, dtype=float)
+    ok = legs.reachable(params, p)
+    safe = np.where(ok[..., None], p, 0.0)
+    d = legs.ik(params, safe)
+    return pose_status(ok, jacobians_of(legs, params, safe, d), in_stroke(params, d), thresholds)
+
+
 def classify(params: Params, p: ArrayLike, thresholds: SingularityThresholds = WARN) -> np.ndarray:
     """Status per pose (values of :class:`~tpm_viz.paper.status.PoseStatus`); the most severe condition wins.
 
     Working-mode inverse kinematics (eq. 4). Non-finite poses count as unreachable.
     """
-    p = np.asarray(p, dtype=float)
-    ok = reachable(params, p)
-    safe = np.where(ok[..., None], p, 0.0)
-    d = inverse_kinematics(params, safe)
-    return pose_status(ok, jacobians(params, safe, d), in_stroke(params, d), thresholds)
+    return classify_of(PERPENDICULAR, params, p, thresholds)
 
 
 #: the singularity equations named in a refusal, (inverse, direct), of the paper's arrangement
-SINGULARITIES = ("cos θ1 cos θ2 = 0 (eq. 11)", "cos(θ1 + θ2) = 0 (eq. 12)")
+SINGULARITIES = PERPENDICULAR.singularities
 
 
 def pose_status(
@@ -188,7 +222,7 @@ def platform_velocity(params: Params, p: ArrayLike, dd: ArrayLike, d: ArrayLike 
 
 def theta_dot(params: Params, p: ArrayLike, dp: ArrayLike, d: ArrayLike | None = None) -> np.ndarray:
     """Leg angular rates ``θ̇_i = ṗ_j / (l_a cos θ_i)`` [rad/s], eq. (24)."""
-    _, _, cos, _ = _cos_sin(params, p, d)
+    _, _, cos, _ = cos_sin(PERPENDICULAR, params, p, d)
     if np.any(np.abs(cos) < 1e-12):
         raise SingularConfigurationError("singular configuration: cos θ1 cos θ2 = 0 (eq. 11)")
     with np.errstate(over="ignore", invalid="ignore"):
@@ -231,7 +265,7 @@ def actuator_acceleration(
     ``J̇_x = [[-sin θ1 θ̇1, cos θ1 θ̇1], [cos θ2 θ̇2, -sin θ2 θ̇2]]`` and
     ``J̇_q = diag(-sin θ1 θ̇1, -sin θ2 θ̇2)`` (the paper prints ``+sin``: erratum). See :func:`eq14_row`.
     """
-    p, d, cos, _ = _cos_sin(params, p, d)
+    p, d, cos, _ = cos_sin(PERPENDICULAR, params, p, d)
     dp, ddp = as_xy(dp, "dp"), as_xy(ddp, "ddp")
     if np.any(np.abs(cos) < 1e-12):
         raise SingularConfigurationError("singular configuration: cos θ1 cos θ2 = 0 (eq. 11)")

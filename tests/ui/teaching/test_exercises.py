@@ -39,7 +39,9 @@ def _ready(client, view, ident: str, box: bool = False):
     return mine, card
 
 
-def _answer(client, card, text: str, enter: bool = False) -> None:
+def _answer(client, card, text: str, enter: bool = False, shows: str | None = None) -> None:
+    """Type ``text`` and submit it; back once the result changed (``shows``: once it shows that, for a tab whose
+    result may also be redrawn meanwhile by something else, e.g. a language change)."""
     stamp = card.result.content
     if enter:  # Enter reaches the server as a line break at the end of the whole text
         client.set_value(card.answer, text + "\n")
@@ -47,7 +49,14 @@ def _answer(client, card, text: str, enter: bool = False) -> None:
         client.set_value(card.answer, text)
         wait_for(lambda: card.answer.value == text, what="the text at the server")
         client.click(card.submit)
-    wait_for(lambda: card.result.content != stamp and "Grading" not in card.result.content, what="the result")
+    wait_for(
+        lambda: (
+            card.result.content != stamp
+            and "Grading" not in card.result.content
+            and (shows is None or shows in card.result.content)
+        ),
+        what=f"the result{'' if shows is None else ' showing ' + shows}",
+    )
 
 
 def _tau1(mine) -> float:
@@ -175,9 +184,9 @@ def test_a_korean_tab_shows_the_prompt_and_the_result_in_korean(app, connect):
     mine, card = _ready(client, view, FORCE)
     view.words.set(Lang.KO)
     wait_for(lambda: mine.exercise.prompt.ko.split("{")[0] in card.prompt.content, what="the Korean prompt")
-    _answer(client, card, "1 kg")
+    _answer(client, card, "1 kg", shows="읽을 수 없음")  # the result was also retold in Korean meanwhile
     assert "읽을 수 없음" in card.result.content and "시도 횟수를 쓰지 않았습니다" in card.result.content
-    _answer(client, card, f"{_tau1(mine):.3f}")
+    _answer(client, card, f"{_tau1(mine):.3f}", shows="점수")
     assert "점수 1.00: 정답" in card.result.content and "남은 시도 2번" in card.result.content
 
 

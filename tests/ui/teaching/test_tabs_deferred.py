@@ -125,8 +125,12 @@ def test_a_deferred_tab_once_opened_is_the_tab_an_eager_build_gives(app):
             assert lazy.teaching.open(group)
             assert not lazy.teaching.open(group)  # once
         _quiet(app, (lazy, eager))
-        # the tree read when both agree (the classroom line is written again on a timer of its own meanwhile)
-        lazy_tree = wait_for(lambda: (t := lazy_client.tree()) == eager_client.tree() and t, 30, what="the same tab")
+        # Both tabs' classroom lines are redrawn by a timer (a tab arrived): the trees are compared as they stand at
+        # one moment, until they agree, and what follows reads that moment's tree (a second reading may fall between
+        # the timer's writes to the two tabs).
+        lazy_tree = wait_for(
+            lambda: (tree := lazy_client.tree()) == eager_client.tree() and tree, timeout=30, what="the same tab"
+        )
         paths = {p for p, *_ in lazy_tree}
         assert {("Teach", "Player"), ("Teach", "Equations"), ("Lab", "Control"), ("Lab", "Planner")} <= paths
         groups = {tabs for *_, tabs in lazy_tree if tabs}

@@ -11,7 +11,9 @@ prints what they compute, operation by operation:
   ``h = τ(p, ṗ, 0)`` and the columns of ``M = τ(p, 0, e_j)`` are ``_procedure`` again; a 2x2 solve gives ``p̈``;
 - computed torque: :func:`tpm_viz.paper.control.task_space_command` then ``_procedure`` at the measurement.
 
-The checks are a short C skeleton per function (:mod:`.text`, the shape they share in :mod:`.blocks`) with
+The symbols, ``J`` and the forward dynamics' ``h`` and ``M`` are traced alike for both arrangements
+(:mod:`.tracing`). The checks are a short C skeleton per function (:mod:`.text`, the shape they share in
+:mod:`.blocks`) with
 the Python's own thresholds (:data:`tpm_viz.paper.dynamics.SINGULAR_TOL`, :data:`tpm_viz.paper.control.CTC_DIRECT_TOL`,
 the default tolerance of :func:`tpm_viz.paper.kinematics.in_stroke`) and a margin in ``tpm_params`` (``min_cos``,
 ``min_det``: the rules of :func:`tpm_viz.app.moves.margins`, by default the app's move limits
@@ -24,16 +26,15 @@ from __future__ import annotations
 
 import inspect
 from types import SimpleNamespace
-from typing import Any
 
 import numpy as np
 
 from tpm_viz.core.params import Params
 from tpm_viz.exchange.c.blocks import Stages, traced_block
-from tpm_viz.exchange.c.expr import Graph
 from tpm_viz.exchange.c.parallel import parallel_fields
 from tpm_viz.exchange.c.stamp import stamped
 from tpm_viz.exchange.c.text import HEADER, SOURCE
+from tpm_viz.exchange.c.tracing import Forces, forward_dynamics_stages, jacobian_entries, symbols
 from tpm_viz.paper.control import CTC_DIRECT_TOL, task_space_command
 from tpm_viz.paper.dynamics import SINGULAR_TOL, _procedure
 from tpm_viz.paper.kinematics import _ik_unchecked, in_stroke
@@ -54,21 +55,9 @@ _STAGES = (  # (slice of _procedure's outputs, names, comment)
 )
 
 
-def _symbols(g: Graph) -> SimpleNamespace:
-    """The C locals the skeletons declare, as symbols."""
-    names = "p1 p2 dp1 dp2 ddp1 ddp2 c1 c2 f1 f2 l_a offset m_a m_b m_p a1 a2".split()
-    return SimpleNamespace(**{n: g.var(n) for n in names})
-
-
-def _params(s: SimpleNamespace) -> Any:
-    """A stand-in for :class:`~tpm_viz.core.params.Params` whose fields are the C locals (duck-typed: ``Any``)."""
-    return SimpleNamespace(l_a=s.l_a, offset=s.offset, m_a=s.m_a, m_b=s.m_b, m_p=s.m_p)
-
-
 def _ik_body() -> str:
-    g = Graph()
-    s = _symbols(g)
-    d = _ik_unchecked(_params(s), np.array([s.p1, s.p2], dtype=object))
+    s = symbols()
+    d = _ik_unchecked(s.params, np.array([s.p1, s.p2], dtype=object))
     return traced_block(
         [
             (
@@ -79,15 +68,23 @@ def _ik_body() -> str:
     )
 
 
+def _forces(s: SimpleNamespace) -> Forces:
+    """``(τ_1, τ_2)`` of :func:`~tpm_viz.paper.dynamics._procedure` at the state's ``p`` and ``c``."""
+    return lambda dp, ddp, f: _procedure(s.params, s.p1, s.p2, *dp, *ddp, s.c1, s.c2, *f)[10:12]
+
+
 def _jacobian_body() -> str:
-    g = Graph()
-    s = _symbols(g)
-    prm = _params(s)
-    cols = [_procedure(prm, s.p1, s.p2, e1, e2, 0.0, 0.0, s.c1, s.c2, 0.0, 0.0) for e1, e2 in ((1.0, 0.0), (0.0, 1.0))]
-    entries = [("J11", cols[0][0]), ("J12", cols[1][0]), ("J21", cols[0][1]), ("J22", cols[1][1])]
+    s = symbols()
+    entries = jacobian_entries(
+        lambda e1, e2: _procedure(s.params, s.p1, s.p2, e1, e2, 0.0, 0.0, s.c1, s.c2, 0.0, 0.0)[0:2]
+    )
     return traced_block(
         [("J = dd/dp, eqs. (9)-(10): [[1, tan theta_1], [tan theta_2, 1]], tan theta_i = p_j / c_i", entries)]
     )
+
+
+_CTC_ARRAYS = (("pr", "p_ref"), ("vr", "dp_ref"), ("ar", "ddp_ref"), ("kp", "kp"), ("kd", "kd"))
+"""The control lab's C arrays and the locals of their components (``pr1`` is ``p_ref[0]``)."""
 
 
 def _procedure_stages(out: tuple, suffix: str = "") -> Stages:
@@ -98,56 +95,30 @@ def _procedure_stages(out: tuple, suffix: str = "") -> Stages:
 
 
 def _id_body() -> str:
-    g = Graph()
-    s = _symbols(g)
-    out = _procedure(_params(s), s.p1, s.p2, s.dp1, s.dp2, s.ddp1, s.ddp2, s.c1, s.c2, s.f1, s.f2)
+    s = symbols()
+    out = _procedure(s.params, s.p1, s.p2, s.dp1, s.dp2, s.ddp1, s.ddp2, s.c1, s.c2, s.f1, s.f2)
     return traced_block(_procedure_stages(out))
 
 
 def _fd_body() -> str:
-    g = Graph()
-    s = _symbols(g)
-    prm = _params(s)
-    h = _procedure(prm, s.p1, s.p2, s.dp1, s.dp2, 0.0, 0.0, s.c1, s.c2, s.f1, s.f2)
-    m1 = _procedure(prm, s.p1, s.p2, 0.0, 0.0, 1.0, 0.0, s.c1, s.c2, 0.0, 0.0)
-    m2 = _procedure(prm, s.p1, s.p2, 0.0, 0.0, 0.0, 1.0, s.c1, s.c2, 0.0, 0.0)
-    return traced_block(
-        [
-            (
-                "velocity and external-force terms h = tau(p, dp, ddp = 0), eqs. (9)-(31) [N]",
-                [("h1", h[10]), ("h2", h[11])],
-            ),
-            (
-                "mass matrix M = [tau(p, 0, e_1), tau(p, 0, e_2)], eqs. (14)-(31) [kg]",
-                [("M11", m1[10]), ("M21", m1[11]), ("M12", m2[10]), ("M22", m2[11])],
-            ),
-        ]
+    s = symbols()
+    comments = (
+        "velocity and external-force terms h = tau(p, dp, ddp = 0), eqs. (9)-(31) [N]",
+        "mass matrix M = [tau(p, 0, e_1), tau(p, 0, e_2)], eqs. (14)-(31) [kg]",
     )
+    return traced_block(forward_dynamics_stages(s, _forces(s), comments))
 
 
 def _ctc_body() -> str:
-    g = Graph()
-    s = _symbols(g)
-    refs = {n: g.var(n) for n in "pr1 pr2 vr1 vr2 ar1 ar2 kp1 kp2 kd1 kd2".split()}
-    a1 = task_space_command(refs["pr1"], refs["vr1"], refs["ar1"], s.p1, s.dp1, refs["kp1"], refs["kd1"])
-    a2 = task_space_command(refs["pr2"], refs["vr2"], refs["ar2"], s.p2, s.dp2, refs["kp2"], refs["kd2"])
-    out = _procedure(_params(s), s.p1, s.p2, s.dp1, s.dp2, a1, a2, s.c1, s.c2, 0.0, 0.0)
+    s = symbols("pr1 pr2 vr1 vr2 ar1 ar2 kp1 kp2 kd1 kd2")
+    a1 = task_space_command(s.pr1, s.vr1, s.ar1, s.p1, s.dp1, s.kp1, s.kd1)
+    a2 = task_space_command(s.pr2, s.vr2, s.ar2, s.p2, s.dp2, s.kp2, s.kd2)
+    out = _procedure(s.params, s.p1, s.p2, s.dp1, s.dp2, a1, a2, s.c1, s.c2, 0.0, 0.0)
     stages = [
         ("the control lab's command, e = p_ref - p: a = ddp_ref + K_d de + K_p e [m/s^2]", [("a1", a1), ("a2", a2)])
     ]
     stages += _procedure_stages(out)
-    extra = {
-        "pr1": "p_ref[0]",
-        "pr2": "p_ref[1]",
-        "vr1": "dp_ref[0]",
-        "vr2": "dp_ref[1]",
-        "ar1": "ddp_ref[0]",
-        "ar2": "ddp_ref[1]",
-        "kp1": "kp[0]",
-        "kp2": "kp[1]",
-        "kd1": "kd[0]",
-        "kd2": "kd[1]",
-    }
+    extra = {f"{n}{i}": f"{array}[{i - 1}]" for n, array in _CTC_ARRAYS for i in (1, 2)}
     return traced_block(stages, extra)
 
 

@@ -2,7 +2,8 @@
 
 The arithmetic comes from :mod:`tpm_viz.paper.parallel.kinematics` (eq. P3: ``_ik_unchecked``, then
 ``leg_components``) and :mod:`tpm_viz.paper.parallel.dynamics` (``_procedure``, eqs. P4-P14), called on symbols
-held in object arrays; the refusals are the Python's: ``|p_2| >= l_a`` unreachable, ``|c_1 c_2| < tol l_a²``
+held in object arrays (the symbols, ``J`` and ``h``, ``M`` traced as the perpendicular ones, :mod:`.tracing`); the
+refusals are the Python's: ``|p_2| >= l_a`` unreachable, ``|c_1 c_2| < tol l_a²``
 (``cos θ1 cos θ2 = 0``) and ``|p_2 (c_1 + c_2)| < tol l_a²`` (``sin(θ1 + θ2) = 0``, eq. P6) singular.
 """
 
@@ -10,7 +11,6 @@ from __future__ import annotations
 
 from string import Template
 from types import SimpleNamespace
-from typing import Any
 
 import numpy as np
 
@@ -33,31 +33,22 @@ from tpm_viz.exchange.c.blocks import (
     traced_block,
     unpack,
 )
-from tpm_viz.exchange.c.expr import Graph
+from tpm_viz.exchange.c.tracing import Component, Pair, forward_dynamics_stages, jacobian_entries, symbols
 from tpm_viz.paper.parallel import dynamics as parallel_dynamics
 from tpm_viz.paper.parallel import kinematics as parallel_kinematics
 
 __all__ = ["parallel_fields"]
 
 
-def _setup() -> tuple[SimpleNamespace, Any]:
-    """The symbols, and a duck-typed stand-in for :class:`~tpm_viz.core.params.Params` (``Any`` for the type
-    checker)."""
-    g = Graph()
-    v = SimpleNamespace(**{n: g.var(n) for n in "p1 p2 dp1 dp2 ddp1 ddp2 c1 c2 f1 f2 l_a offset m_a m_b m_p".split()})
-    prm = SimpleNamespace(l_a=v.l_a, offset=v.offset, m_a=v.m_a, m_b=v.m_b, m_p=v.m_p)
-    return v, prm
-
-
-def _pair(x, y) -> np.ndarray:
+def _pair(x: Component, y: Component) -> np.ndarray:
     return np.array([x, y], dtype=object)
 
 
 def _legs_body() -> str:
-    v, prm = _setup()
-    p = _pair(v.p1, v.p2)
-    d = parallel_kinematics._ik_unchecked(prm, p)
-    c = np.stack([p[..., 0] - d[..., 0], -p[..., 0] - d[..., 1]], axis=-1) + prm.offset  # as leg_components
+    s = symbols()
+    p = _pair(s.p1, s.p2)
+    d = parallel_kinematics._ik_unchecked(s.params, p)
+    c = np.stack([p[..., 0] - d[..., 0], -p[..., 0] - d[..., 1]], axis=-1) + s.params.offset  # as leg_components
     return traced_block(
         [
             (
@@ -69,20 +60,22 @@ def _legs_body() -> str:
     )
 
 
-def _procedure(v, prm, dp, ddp, f):
-    return parallel_dynamics._procedure(prm, _pair(v.p1, v.p2), _pair(*dp), _pair(*ddp), _pair(v.c1, v.c2), _pair(*f))
+def _procedure(s: SimpleNamespace, dp: Pair, ddp: Pair, f: Pair) -> tuple[np.ndarray, ...]:
+    """:func:`tpm_viz.paper.parallel.dynamics._procedure` on the symbols: ``(dd, ddd, v, w, lam, tau)``, pairs."""
+    return parallel_dynamics._procedure(
+        s.params, _pair(s.p1, s.p2), _pair(*dp), _pair(*ddp), _pair(s.c1, s.c2), _pair(*f)
+    )
 
 
 def _jacobian_body() -> str:
-    v, prm = _setup()
-    cols = [_procedure(v, prm, e, (0.0, 0.0), (0.0, 0.0))[0] for e in ((1.0, 0.0), (0.0, 1.0))]
-    entries = [("J11", cols[0][0]), ("J12", cols[1][0]), ("J21", cols[0][1]), ("J22", cols[1][1])]
+    s = symbols()
+    entries = jacobian_entries(lambda e1, e2: _procedure(s, (e1, e2), (0.0, 0.0), (0.0, 0.0))[0])
     return traced_block([("J = dd/dp, eq. (P4): [[1, tan th1], [-1, tan th2]]", entries)])
 
 
 def _id_body() -> str:
-    v, prm = _setup()
-    _, ddd, vv, w, lam, tau = _procedure(v, prm, (v.dp1, v.dp2), (v.ddp1, v.ddp2), (v.f1, v.f2))  # ḋ: not needed
+    s = symbols()
+    _, ddd, vv, w, lam, tau = _procedure(s, (s.dp1, s.dp2), (s.ddp1, s.ddp2), (s.f1, s.f2))  # ḋ: not needed
     return traced_block(
         [
             ("(c) actuator accelerations, eq. (P5) [m/s^2]", [("ddd1", ddd[0]), ("ddd2", ddd[1])]),
@@ -95,19 +88,9 @@ def _id_body() -> str:
 
 
 def _fd_body() -> str:
-    v, prm = _setup()
-    h = _procedure(v, prm, (v.dp1, v.dp2), (0.0, 0.0), (v.f1, v.f2))[5]
-    m1 = _procedure(v, prm, (0.0, 0.0), (1.0, 0.0), (0.0, 0.0))[5]
-    m2 = _procedure(v, prm, (0.0, 0.0), (0.0, 1.0), (0.0, 0.0))[5]
-    return traced_block(
-        [
-            ("h = tau(p, dp, ddp = 0), eqs. (P4)-(P14) [N]", [("h1", h[0]), ("h2", h[1])]),
-            (
-                "M = [tau(p, 0, e_1), tau(p, 0, e_2)] [kg]",
-                [("M11", m1[0]), ("M21", m1[1]), ("M12", m2[0]), ("M22", m2[1])],
-            ),
-        ]
-    )
+    s = symbols()
+    comments = ("h = tau(p, dp, ddp = 0), eqs. (P4)-(P14) [N]", "M = [tau(p, 0, e_1), tau(p, 0, e_2)] [kg]")
+    return traced_block(forward_dynamics_stages(s, lambda dp, ddp, f: _procedure(s, dp, ddp, f)[5], comments))
 
 
 _PAR = ("tpm_par_inverse_kinematics", "tpm_par_jacobian", "tpm_par_inverse_dynamics", "tpm_par_forward_dynamics")

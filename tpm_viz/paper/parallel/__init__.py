@@ -3,8 +3,9 @@
 The one import for the parallel arrangement: kinematics, Jacobians, singularities, statics and status from
 :mod:`tpm_viz.paper.parallel.kinematics`, the closed-form inverse dynamics from
 :mod:`tpm_viz.paper.parallel.dynamics`. Names, shapes, units and returned types mirror the perpendicular
-arrangement's (:mod:`tpm_viz.paper.kinematics`, :mod:`tpm_viz.paper.jacobians`, :mod:`tpm_viz.paper.dynamics`);
-equations P1-P15 are derived in ``docs/parallel.md``.
+arrangement's (:mod:`tpm_viz.paper.kinematics`, :mod:`tpm_viz.paper.jacobians`, :mod:`tpm_viz.paper.dynamics`),
+whose code it shares where the equations share their shape (:mod:`tpm_viz.paper.legs`,
+:func:`~tpm_viz.paper.jacobians.jacobians_of`); equations P1-P15 are derived in ``docs/parallel.md``.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from tpm_viz.paper.parallel.dynamics import (
     mass_matrix,
 )
 from tpm_viz.paper.parallel.kinematics import (
+    PARALLEL,
     actuator_acceleration,
     actuator_forces_from_platform_force,
     actuator_velocity,
@@ -40,6 +42,7 @@ from tpm_viz.paper.parallel.kinematics import (
 )
 
 __all__ = [
+    "PARALLEL",
     "actuator_acceleration",
     "actuator_forces_from_platform_force",
     "actuator_velocity",

@@ -25,13 +25,11 @@ from numpy.typing import ArrayLike, NDArray
 from tpm_viz.core.errors import SingularConfigurationError
 from tpm_viz.core.params import Params
 from tpm_viz.core.words import Phrase, T
-from tpm_viz.paper.dynamics import DynamicsResult
-from tpm_viz.paper.kinematics import as_xy, finite_result
+from tpm_viz.paper.dynamics import SINGULAR_TOL, DynamicsResult
+from tpm_viz.paper.legs import as_xy, finite_result
 from tpm_viz.paper.parallel.kinematics import actuator_velocity, inverse_kinematics, jacobians, leg_components
 
 __all__ = ["coordinate_mass_matrix", "inverse_dynamics", "inverse_dynamics_detail", "kinetic_energy", "mass_matrix"]
-
-_SINGULAR_TOL = 1e-12
 
 
 def coordinate_mass_matrix(params: Params) -> np.ndarray:
@@ -79,9 +77,9 @@ def _procedure(
 
 def _check_regular(params: Params, p: np.ndarray, c: np.ndarray) -> None:
     l2 = params.l_a**2
-    if np.any(np.abs(c[..., 0] * c[..., 1]) < _SINGULAR_TOL * l2):
+    if np.any(np.abs(c[..., 0] * c[..., 1]) < SINGULAR_TOL * l2):
         raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq="cos θ1 cos θ2 = 0"))
-    if np.any(np.abs(p[..., 1] * (c[..., 0] + c[..., 1])) < _SINGULAR_TOL * l2):
+    if np.any(np.abs(p[..., 1] * (c[..., 0] + c[..., 1])) < SINGULAR_TOL * l2):
         raise SingularConfigurationError(Phrase("singular configuration: {eq}", eq="sin(θ1 + θ2) = 0"))
 
 

@@ -1,10 +1,9 @@
 """Still 3D drawings of either 2-PPa arrangement for the *Design* view: the paper's perpendicular mechanism and the
 parallel one (``docs/parallel.md``), each beside the other with the task rectangle it must cover.
 
-:func:`posed_parts` places every part of a mechanism at a platform position ``p`` [m]: the parallel parts of
-:mod:`tpm_viz.drawing.meshes_parallel` (its own ``posed_parts``) and, for the perpendicular arrangement, the frame-based
-parts of :mod:`tpm_viz.drawing.meshes` put where :class:`~tpm_viz.ui.scene.MechanismScene` puts them (sliders at
-``A_i``, links by :func:`tpm_viz.drawing.meshes.link_instances`, the platform at ``P``). :class:`ArrangementDrawing`
+:func:`tpm_viz.drawing.meshes.posed_parts` places every part of either mechanism at a platform position ``p`` [m],
+where :class:`~tpm_viz.ui.scene.MechanismScene` puts the live one's (sliders at ``A_i``, links by
+:func:`tpm_viz.drawing.meshes.link_instances`, the platform at ``P``). :class:`ArrangementDrawing`
 draws one such mechanism in a tab's own scene under its own root, moved by ``offset`` (the Design view's area, away from
 the live mechanism), with the task rectangle as lines at the tool's height; it keeps the joints it drew (``joints``).
 """
@@ -20,12 +19,12 @@ import trimesh
 from tpm_viz.core.errors import TpmVizError
 from tpm_viz.core.params import Params
 from tpm_viz.design.indices import Task
-from tpm_viz.drawing import meshes, meshes_parallel
+from tpm_viz.drawing import meshes
 from tpm_viz.drawing.palette import PALETTE
 from tpm_viz.paper import arrangement as arr
 from tpm_viz.paper.arrangement import Arrangement
 
-__all__ = ["TASK_COLOUR", "TASK_Z", "ArrangementDrawing", "drawn_pose", "extent", "posed_parts", "task_segments"]
+__all__ = ["TASK_COLOUR", "TASK_Z", "ArrangementDrawing", "drawn_pose", "extent", "task_segments"]
 
 TASK_Z = meshes.PLATFORM_Z[1] + 0.004
 """Height [m] of the task rectangle's lines: at the tool's height, over the platform (which would hide it)."""
@@ -53,56 +52,16 @@ GROUPS = {
     "pins": ("pins",),
     "tool": ("tool",),
 }
-"""The parts of :func:`posed_parts` drawn as one mesh per colour."""
-
-
-def _placed(mesh: trimesh.Trimesh, position, wxyz=(1.0, 0.0, 0.0, 0.0)) -> trimesh.Trimesh:
-    matrix = trimesh.transformations.quaternion_matrix(list(wxyz))
-    matrix[:3, 3] = position
-    out = mesh.copy()
-    out.apply_transform(matrix)
-    return out
-
-
-def _perpendicular_parts(params: Params, p, d=None) -> dict[str, trimesh.Trimesh]:
-    """The perpendicular mechanism's parts at ``p`` [m] (same names as
-    :func:`tpm_viz.drawing.meshes_parallel.posed_parts`)."""
-    pose = arr.mechanism_pose(Arrangement.PERPENDICULAR, params, p, d)
-    parts: dict[str, trimesh.Trimesh] = {"base": meshes.base_plate(params)}
-    pins = []
-    for i in (0, 1):
-        a_i = np.array([*pose.A[i], 0.0])
-        parts[f"rail{i + 1}"] = meshes.rail(params, i)
-        parts[f"stops{i + 1}"] = meshes.end_stops(params, i)
-        parts[f"slider{i + 1}"] = _placed(meshes.slider(params, i), a_i)
-        pins += [_placed(meshes.pin(), a_i + offset) for offset in meshes.slider_pin_offsets(params, i)]
-    positions, quats = meshes.link_instances(pose)
-    for k, name in enumerate(("link1_0", "link1_1", "link2_0", "link2_1")):
-        parts[name] = _placed(meshes.link(params), positions[k], quats[k])
-    centre = np.array([*pose.p, 0.0])
-    parts["platform"] = _placed(meshes.platform(params), centre)
-    pins += [_placed(meshes.pin(), centre + offset) for offset in meshes.platform_pin_offsets(params)]
-    parts["pins"] = cast(trimesh.Trimesh, trimesh.util.concatenate(pins))
-    parts["tool"] = _placed(meshes.tool_marker(), centre)
-    return parts
+"""The parts of :func:`tpm_viz.drawing.meshes.posed_parts` drawn as one mesh per colour."""
 
 
 @functools.lru_cache(maxsize=16)
 def _grouped(arrangement: Arrangement, params: Params, p: tuple[float, float]) -> dict[str, trimesh.Trimesh]:
-    parts = posed_parts(arrangement, params, np.asarray(p))
+    parts = meshes.posed_parts(arrangement, params, np.asarray(p))
     return {
         group: cast(trimesh.Trimesh, trimesh.util.concatenate([parts[name] for name in names]))
         for group, names in GROUPS.items()
     }
-
-
-def posed_parts(arrangement: Arrangement, params: Params, p, d=None) -> dict[str, trimesh.Trimesh]:
-    """Every part of ``arrangement`` placed at platform position ``p`` [m] (working mode unless ``d``), world
-    coordinates: ``base, rail1, rail2, stops1, stops2, slider1, slider2, link1_0, link1_1, link2_0, link2_1,
-    platform, pins, tool``. Raises as the arrangement's inverse kinematics."""
-    if Arrangement.parse(arrangement) is Arrangement.PARALLEL:
-        return meshes_parallel.posed_parts(params, p, d)
-    return _perpendicular_parts(params, p, d)
 
 
 def drawn_pose(arrangement: Arrangement, params: Params, task: Task | None) -> np.ndarray:
@@ -122,7 +81,7 @@ def drawn_pose(arrangement: Arrangement, params: Params, task: Task | None) -> n
 def extent(arrangement: Arrangement, params: Params) -> tuple[np.ndarray, np.ndarray]:
     """Lower and upper XY corners [m] of the arrangement's base plate."""
     if Arrangement.parse(arrangement) is Arrangement.PARALLEL:
-        return meshes_parallel.base_extent(params)
+        return meshes.parallel.base_extent(params)
     lo, hi = meshes.base_extent(params)
     return np.array([lo, lo]), np.array([hi, hi])
 

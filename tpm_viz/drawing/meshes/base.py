@@ -1,40 +1,44 @@
-"""Parametric trimesh parts of the 2-PPa TPM, sized from a :class:`~tpm_viz.Params` (metres, Z up).
+"""The parts both arrangements of the 2-PPa share, and how a mechanism's parts are placed at a pose (metres, Z up).
 
 The mechanism is planar (the XY plane of the paper's frame OXY); parts are stacked in Z only so that they never
-intersect visually. Each moving part is built in its own frame so that a drawing needs only its pose:
-
-- sliders in a frame at the slider joint ``A_i = (d_i - a) e_i`` (they translate);
-- links along their local +x from the slider-side pivot (they rotate about Z, see :func:`link_instances`);
-- the platform (and its pins) in a frame at ``P`` (it translates).
-
-Only trimesh and numpy here; the browser app turns these meshes into scene nodes once per parameter set.
+intersect visually (the heights below). Each moving part is built in its own frame so that a drawing needs only its
+pose: sliders in a frame at the slider joint ``A_i`` (they translate), links along their local +x from the
+slider-side pivot (they rotate about Z, :func:`link_instances`), the platform (and its pins) in a frame at ``P`` (it
+translates). Here: the link, the pin and the tool marker of both arrangements, the scene's line and region helpers,
+and :func:`posed_parts`, which places an arrangement's :class:`Parts` (:mod:`.perpendicular`, :mod:`.parallel`) at a
+:class:`~tpm_viz.paper.legs.MechanismPose`.
 """
 
 from __future__ import annotations
 
-from typing import cast
+from typing import Protocol, cast
 
 import numpy as np
 import trimesh
+from numpy.typing import ArrayLike
 
 from tpm_viz.core.params import Params
-from tpm_viz.paper.kinematics import MechanismPose
+from tpm_viz.paper.legs import MechanismPose
 
 __all__ = [
+    "LINK_NAMES",
     "LINK_Z",
-    "base_plate",
+    "PIN_Z",
+    "PLATFORM_Z",
+    "RAIL_Z",
+    "SLIDER_LENGTH",
+    "SLIDER_MARGIN",
+    "SLIDER_Z",
+    "Parts",
+    "box",
     "circle_segments",
-    "end_stops",
     "link",
     "link_instances",
     "pin",
-    "platform",
-    "platform_pin_offsets",
+    "placed",
     "polyline_segments",
-    "rail",
+    "posed_parts",
     "region_mesh",
-    "slider",
-    "slider_pin_offsets",
     "tool_marker",
 ]
 
@@ -48,74 +52,31 @@ PIN_Z = (0.012, 0.082)  # m
 PIN_RADIUS = 0.005  # m
 SLIDER_LENGTH = 0.05  # m, along the rail
 SLIDER_MARGIN = 0.022  # m, beyond the outer pivots across the rail
+LINK_NAMES = ("link1_0", "link1_1", "link2_0", "link2_1")
+"""The four links of :func:`posed_parts`, leg-major (as :func:`link_instances` orders them)."""
 
 
-def _box(lo, hi) -> trimesh.Trimesh:
+class Parts(Protocol):
+    """An arrangement's own parts, each in its frame (a module: :mod:`.perpendicular`, :mod:`.parallel`)."""
+
+    def base_plate(self, params: Params) -> trimesh.Trimesh: ...
+    def rail(self, params: Params, i: int) -> trimesh.Trimesh: ...
+    def end_stops(self, params: Params, i: int) -> trimesh.Trimesh: ...
+    def slider(self, params: Params, i: int) -> trimesh.Trimesh: ...
+    def slider_pin_offsets(self, params: Params, i: int) -> np.ndarray: ...
+    def platform(self, params: Params) -> trimesh.Trimesh: ...
+    def platform_pin_offsets(self, params: Params) -> np.ndarray: ...
+
+
+def box(lo: ArrayLike, hi: ArrayLike) -> trimesh.Trimesh:
     """Axis-aligned box between corners ``lo`` and ``hi`` (3,) [m]."""
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
     return trimesh.creation.box(extents=hi - lo, transform=trimesh.transformations.translation_matrix((lo + hi) / 2))
 
 
-def _axes(i: int) -> tuple[int, int]:
-    """World axis index along rail ``i`` (0 or 1) and across it."""
-    return i, 1 - i
-
-
-def base_extent(params: Params) -> tuple[float, float]:
-    """Lower and upper corner coordinate of the square base plate [m] (same in x and y)."""
-    half = platform_half_size(params)
-    return -params.a - SLIDER_LENGTH - 0.03, params.l_a + half + 0.03
-
-
-def base_plate(params: Params) -> trimesh.Trimesh:
-    """A square base plate under the whole mechanism, top face at z = 0."""
-    lo, hi = base_extent(params)
-    return _box((lo, lo, -0.012), (hi, hi, 0.0))
-
-
-def rail(params: Params, i: int) -> trimesh.Trimesh:
-    """Rail ``i`` along ``e_i`` at the line of the joints ``A_i``, long enough for the slider at both ends."""
-    along, across = _axes(i)
-    lo, hi = np.zeros(3), np.zeros(3)
-    lo[along], hi[along] = -params.a - SLIDER_LENGTH / 2 - 0.02, -params.a + params.stroke + SLIDER_LENGTH / 2 + 0.02
-    lo[across], hi[across] = -0.011, 0.011
-    lo[2], hi[2] = RAIL_Z
-    return _box(lo, hi)
-
-
-def end_stops(params: Params, i: int) -> trimesh.Trimesh:
-    """The two end-stops of rail ``i``: the slider touches them at ``d_i = 0`` and ``d_i = Δd``."""
-    along, across = _axes(i)
-    parts = []
-    for face, sign in ((-params.a - SLIDER_LENGTH / 2, -1.0), (-params.a + params.stroke + SLIDER_LENGTH / 2, 1.0)):
-        lo, hi = np.zeros(3), np.zeros(3)
-        lo[along], hi[along] = sorted((face, face + sign * 0.012))
-        lo[across], hi[across] = -0.026, 0.026
-        lo[2], hi[2] = RAIL_Z[0], SLIDER_Z[1] + 0.004
-        parts.append(_box(lo, hi))
-    return cast(trimesh.Trimesh, trimesh.util.concatenate(parts))
-
-
-def slider(params: Params, i: int) -> trimesh.Trimesh:
-    """Slider ``i`` in its frame at ``A_i``: a carriage on the rail carrying both link pivots (0 and ``s e_j``)."""
-    along, across = _axes(i)
-    lo, hi = np.zeros(3), np.zeros(3)
-    lo[along], hi[along] = -SLIDER_LENGTH / 2, SLIDER_LENGTH / 2
-    lo[across], hi[across] = -SLIDER_MARGIN, params.pivot_spacing + SLIDER_MARGIN
-    lo[2], hi[2] = SLIDER_Z
-    return _box(lo, hi)
-
-
-def slider_pin_offsets(params: Params, i: int) -> np.ndarray:
-    """Pivot positions on slider ``i`` relative to ``A_i`` [m], shape (2, 3): ``0`` and ``s e_j``."""
-    out = np.zeros((2, 3))
-    out[1, 1 - i] = params.pivot_spacing
-    return out
-
-
 def link(params: Params) -> trimesh.Trimesh:
     """One parallelogram link along local +x from 0 to ``l_a``, rounded ends, centred on z = 0."""
-    bar = _box((0.0, -LINK_WIDTH / 2, -LINK_THICKNESS / 2), (params.l_a, LINK_WIDTH / 2, LINK_THICKNESS / 2))
+    bar = box((0.0, -LINK_WIDTH / 2, -LINK_THICKNESS / 2), (params.l_a, LINK_WIDTH / 2, LINK_THICKNESS / 2))
     ends = [
         trimesh.creation.cylinder(
             radius=LINK_WIDTH / 2,
@@ -153,23 +114,6 @@ def pin() -> trimesh.Trimesh:
     )
 
 
-def platform_half_size(params: Params) -> float:
-    """Half the side of the square platform [m]: it covers all four platform-side pivots."""
-    return max(params.b, params.pivot_spacing) + 0.018
-
-
-def platform(params: Params) -> trimesh.Trimesh:
-    """The square platform in its frame at ``P``."""
-    h = platform_half_size(params)
-    return _box((-h, -h, PLATFORM_Z[0]), (h, h, PLATFORM_Z[1]))
-
-
-def platform_pin_offsets(params: Params) -> np.ndarray:
-    """Platform-side pivots relative to ``P`` [m], shape (4, 3): ``B_i = P - b e_i`` and ``B_i + s e_j``."""
-    b, s = params.b, params.pivot_spacing
-    return np.array([[-b, 0.0, 0.0], [-b, s, 0.0], [0.0, -b, 0.0], [s, -b, 0.0]])
-
-
 def tool_marker() -> trimesh.Trimesh:
     """A small disc on top of the platform marking the point ``P``."""
     return trimesh.creation.cylinder(
@@ -178,6 +122,38 @@ def tool_marker() -> trimesh.Trimesh:
         sections=32,
         transform=trimesh.transformations.translation_matrix((0.0, 0.0, PLATFORM_Z[1] + 0.004)),
     )
+
+
+def placed(mesh: trimesh.Trimesh, position: ArrayLike, wxyz: ArrayLike = (1.0, 0.0, 0.0, 0.0)) -> trimesh.Trimesh:
+    """A copy of ``mesh`` turned by the quaternion ``wxyz`` and moved to ``position`` (3,) [m]."""
+    matrix = trimesh.transformations.quaternion_matrix(list(np.asarray(wxyz, dtype=float)))
+    matrix[:3, 3] = position
+    out = mesh.copy()
+    out.apply_transform(matrix)
+    return out
+
+
+def posed_parts(parts: Parts, params: Params, pose: MechanismPose) -> dict[str, trimesh.Trimesh]:
+    """Every part of an arrangement placed at ``pose`` (world coordinates, metres): ``base, rail1, rail2, stops1,
+    stops2, slider1, slider2, link1_0, link1_1, link2_0, link2_1, platform, pins, tool``; the sliders and their pins
+    at ``A_i``, the links by :func:`link_instances`, the platform, its pins and the tool at ``P``."""
+    out: dict[str, trimesh.Trimesh] = {"base": parts.base_plate(params)}
+    pins = []
+    for i in (0, 1):
+        a_i = np.array([*pose.A[i], 0.0])
+        out[f"rail{i + 1}"] = parts.rail(params, i)
+        out[f"stops{i + 1}"] = parts.end_stops(params, i)
+        out[f"slider{i + 1}"] = placed(parts.slider(params, i), a_i)
+        pins += [placed(pin(), a_i + offset) for offset in parts.slider_pin_offsets(params, i)]
+    positions, quats = link_instances(pose)
+    for k, name in enumerate(LINK_NAMES):
+        out[name] = placed(link(params), positions[k], quats[k])
+    centre = np.array([*pose.p, 0.0])
+    out["platform"] = placed(parts.platform(params), centre)
+    pins += [placed(pin(), centre + offset) for offset in parts.platform_pin_offsets(params)]
+    out["pins"] = cast(trimesh.Trimesh, trimesh.util.concatenate(pins))
+    out["tool"] = placed(tool_marker(), centre)
+    return out
 
 
 def circle_segments(radius: float, z: float, n: int = 96) -> np.ndarray:

@@ -1,4 +1,5 @@
-"""Parametric parts (tpm_viz.drawing.meshes): sizes follow the parameters, poses put the links on their pivots."""
+"""The parts both arrangements share (tpm_viz.drawing.meshes.base): sizes follow the parameters, the links sit on
+their pivots wherever posed_parts places either mechanism, the parts are stacked in Z, the scene's helpers."""
 
 from __future__ import annotations
 
@@ -7,6 +8,8 @@ import pytest
 
 from tpm_viz import Params, mechanism_pose
 from tpm_viz.drawing import meshes as m
+from tpm_viz.paper import arrangement as arr
+from tpm_viz.paper.arrangement import Arrangement
 
 P = Params.paper()
 
@@ -25,26 +28,7 @@ def _quat_rotate(wxyz: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 def test_link_length_is_l_a():
     bounds = m.link(P.replace(l_a=0.3, pivot_spacing=0.05)).bounds
-    assert bounds[1, 0] - bounds[0, 0] == pytest.approx(0.3 + m.LINK_WIDTH)
-
-
-@pytest.mark.parametrize("i", [0, 1])
-def test_rail_spans_the_stroke_and_stops_touch_the_slider_at_its_ends(i):
-    rail = m.rail(P, i).bounds
-    stops = m.end_stops(P, i).bounds
-    assert rail[0, i] < -P.a - m.SLIDER_LENGTH / 2 and rail[1, i] > -P.a + P.stroke + m.SLIDER_LENGTH / 2
-    assert stops[0, i] == pytest.approx(-P.a - m.SLIDER_LENGTH / 2 - 0.012)
-    assert stops[1, i] == pytest.approx(-P.a + P.stroke + m.SLIDER_LENGTH / 2 + 0.012)
-
-
-def test_slider_carries_both_pivots_and_the_platform_covers_its_pins():
-    for i in range(2):
-        lo, hi = m.slider(P, i).bounds
-        for pin in m.slider_pin_offsets(P, i):
-            assert np.all(lo[:2] < pin[:2]) and np.all(pin[:2] < hi[:2])
-    lo, hi = m.platform(P).bounds
-    for pin in m.platform_pin_offsets(P):
-        assert np.all(lo[:2] < pin[:2]) and np.all(pin[:2] < hi[:2])
+    assert bounds[1, 0] - bounds[0, 0] == pytest.approx(0.3 + m.base.LINK_WIDTH)
 
 
 def test_link_instances_run_from_slider_pivot_to_platform_pivot():
@@ -57,11 +41,46 @@ def test_link_instances_run_from_slider_pivot_to_platform_pivot():
         np.testing.assert_allclose(tip[:2], ends[k, 1], atol=1e-12)
 
 
+@pytest.mark.parametrize(
+    ("arrangement", "p"),
+    [
+        (Arrangement.PERPENDICULAR, (0.0, 0.0)),
+        (Arrangement.PERPENDICULAR, (0.06, -0.04)),
+        (Arrangement.PARALLEL, (0.0, 0.1)),
+        (Arrangement.PARALLEL, (0.1, 0.2)),
+        (Arrangement.PARALLEL, (-0.12, 0.05)),
+    ],
+)
+def test_posed_links_run_between_their_pins(arrangement, p):
+    """Each posed link spans its two pivots of the arrangement's pose (eq. 1 / P1), a pin stands on every pivot."""
+    parts = m.posed_parts(arrangement, P, p)
+    pose = arr.mechanism_pose(arrangement, P, p)
+    pins = parts["pins"].vertices
+    for k, name in enumerate(m.LINK_NAMES):
+        start, end = pose.links.reshape(4, 2, 2)[k]
+        axis = (end - start) / np.linalg.norm(end - start)
+        rel = parts[name].vertices[:, :2] - start
+        along = rel @ axis
+        across = rel @ np.array([-axis[1], axis[0]])
+        assert along.min() == pytest.approx(-m.base.LINK_WIDTH / 2, abs=1e-9)
+        assert along.max() == pytest.approx(P.l_a + m.base.LINK_WIDTH / 2, abs=1e-9)
+        assert np.abs(across).max() <= m.base.LINK_WIDTH / 2 + 1e-9
+        for pivot in (start, end):  # a pin stands on each pivot
+            assert np.min(np.linalg.norm(pins[:, :2] - pivot, axis=1)) <= m.base.PIN_RADIUS + 1e-9
+    for i in (0, 1):  # the sliders at A_i, the platform and the tool at P
+        np.testing.assert_allclose(
+            parts[f"slider{i + 1}"].bounds.mean(axis=0)[:2] - pose.A[i],
+            m.parts_of(arrangement).slider(P, i).bounds.mean(axis=0)[:2],
+            atol=1e-12,
+        )
+    np.testing.assert_allclose(parts["tool"].bounds.mean(axis=0)[:2], p, atol=1e-12)
+
+
 def test_parts_are_stacked_in_z_without_overlap():
     assert m.RAIL_Z[1] <= m.SLIDER_Z[0]
-    assert m.SLIDER_Z[1] < min(m.LINK_Z) - m.LINK_THICKNESS / 2
-    assert abs(m.LINK_Z[1] - m.LINK_Z[0]) > m.LINK_THICKNESS
-    assert max(m.LINK_Z) + m.LINK_THICKNESS / 2 < m.PLATFORM_Z[0]
+    assert m.SLIDER_Z[1] < min(m.LINK_Z) - m.base.LINK_THICKNESS / 2
+    assert abs(m.LINK_Z[1] - m.LINK_Z[0]) > m.base.LINK_THICKNESS
+    assert max(m.LINK_Z) + m.base.LINK_THICKNESS / 2 < m.PLATFORM_Z[0]
 
 
 def test_segments_helpers():
