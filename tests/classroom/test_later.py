@@ -11,6 +11,7 @@ import weakref
 
 from tests.support.protocol import wait_for
 from tpm_viz.classroom import guard, runtime
+from tpm_viz.classroom import later as later_module
 from tpm_viz.classroom.later import Later
 
 
@@ -83,6 +84,46 @@ def test_tidy_frees_cyclic_garbage_at_the_next_quiet_moment_once():
         wait_for(lambda: gone() is None, what="the second collection")
     finally:
         gc.enable()
+
+
+def test_garbage_still_held_by_a_job_at_the_collection_is_collected_once_the_job_lets_go(monkeypatch, caplog):
+    monkeypatch.setattr(later_module, "TIDY_AGAIN", 0.05)
+    gc.disable()
+    try:
+        later = Later(quiet=0.0)
+        left = _Cycle()
+        gone = weakref.ref(left)
+        held = [left]  # a job of the tab that left still runs when the server is quiet
+        del left
+        first = threading.Event()
+        real = later._tidy
+        monkeypatch.setattr(later, "_tidy", lambda: (real(), first.set()))
+        alive = weakref.WeakSet([gone()])
+        later.tidy(kept=lambda: len(alive))
+        assert first.wait(30)
+        assert gone() is not None  # the first collection could not free it
+        held.clear()  # the job ends: now it is garbage, and nothing else allocates to wake the collector
+        wait_for(lambda: gone() is None, what="a later collection")
+        assert not [r for r in caplog.records if "still in memory" in r.getMessage()]
+    finally:
+        gc.enable()
+
+
+def test_a_tab_kept_alive_by_mistake_is_logged_once_and_the_collections_stop(monkeypatch, caplog):
+    monkeypatch.setattr(later_module, "TIDY_AGAIN", 0.01)
+    monkeypatch.setattr(later_module, "TIDY_TRIES", 4)
+    later = Later(quiet=0.0)
+    kept_forever = _Cycle()
+    alive = weakref.WeakSet([kept_forever])
+    asked: list[int] = []
+    later.tidy(kept=lambda: asked.append(1) or len(alive))
+    wait_for(lambda: any("still in memory" in r.getMessage() for r in caplog.records), what="the log line")
+    wait_for(lambda: later.pending() == 0, what="the last collection")
+    count = len(asked)
+    threading.Event().wait(0.2)  # twenty retry periods: nothing more is asked
+    assert count == len(asked) == 4
+    lines = [r for r in caplog.records if "still in memory" in r.getMessage()]
+    assert len(lines) == 1 and lines[0].getMessage().endswith("later: 1 (a reference kept by mistake)")
 
 
 def test_tune_for_serving_sets_the_collector_and_the_switch_interval():

@@ -9,7 +9,10 @@ tabs. A job is also run at once by whoever needs its result (a test or a lesson 
 owner makes it idempotent), so nothing ever depends on the timing here.
 
 A tab that leaves asks for a collection of its garbage at the next quiet moment (:meth:`Later.tidy`), so that it is
-not collected in the middle of the next storm.
+not collected in the middle of the next storm. What a job or a timer still held at that moment becomes garbage a
+moment later, and the collector's own schedule (thresholds raised for serving: :mod:`.runtime`) may not come for
+hours on a quiet server: so the collection is asked for again, :data:`TIDY_AGAIN` seconds apart, while the caller
+says garbage of tabs that left is still alive (at most :data:`TIDY_TRIES` times, then one log line).
 
 Bounded: at most :data:`LIMIT` jobs wait (a job beyond it is run by the thread at once, never dropped); the thread
 exists only while jobs wait.
@@ -18,6 +21,7 @@ exists only while jobs wait.
 from __future__ import annotations
 
 import gc
+import logging
 import threading
 import time
 from collections import deque
@@ -25,12 +29,18 @@ from collections.abc import Callable
 
 from tpm_viz.classroom.guard import report
 
-__all__ = ["LIMIT", "QUIET", "Later"]
+__all__ = ["LIMIT", "QUIET", "TIDY_AGAIN", "TIDY_TRIES", "Later"]
+
+log = logging.getLogger("tpm_viz.classroom")
 
 QUIET = 0.25
 """Seconds without a tab arriving before a waiting job runs (tabs of a storm arrive every ~50 ms)."""
 LIMIT = 2000
 """Jobs kept waiting at most (a class of 150 tabs leaves two jobs each)."""
+TIDY_AGAIN = 2.0
+"""Seconds between two collections while the garbage of tabs that left is still alive (:meth:`Later.tidy`)."""
+TIDY_TRIES = 30
+"""Collections at most for one departure before it is logged as kept alive (a minute: a leak, not a slow job)."""
 
 
 class Later:
@@ -46,6 +56,8 @@ class Later:
         self._thread: threading.Thread | None = None
         self._running = 0
         self._tidying = False  # a collection of the garbage of tabs that left is waiting
+        self._tries = 0  # collections since the last departure
+        self._kept: Callable[[], int] = lambda: 0
 
     def arrived(self) -> None:
         """A tab arrived (its build is starting): waiting jobs give it the next :data:`QUIET` seconds."""
@@ -64,12 +76,16 @@ class Later:
         if urgent:  # a queue this long is a bug or an attack: the oldest job runs now on this thread
             self._take_and_run()
 
-    def tidy(self) -> None:
+    def tidy(self, kept: Callable[[], int] | None = None) -> None:
         """A tab left: collect the garbage it left (its view's reference cycles, a few thousand objects that only
-        Python's cyclic collector frees) once, at the next quiet moment. Left to the collector's own schedule, the
-        garbage of 100 tabs is freed by a full collection of ~0.3-0.7 s in the middle of the next storm."""
+        Python's cyclic collector frees) at the next quiet moment. Left to the collector's own schedule, the
+        garbage of 100 tabs is freed by a full collection of ~0.3-0.7 s in the middle of the next storm.
+        ``kept()``: how many tabs that left are still alive after a collection (asked again while it is not 0)."""
         with self._cond:
             self._last = max(self._last, time.monotonic())  # after the departure is over, like an arrival's
+            self._tries = 0
+            if kept is not None:
+                self._kept = kept
             if self._tidying:
                 return
             self._tidying = True
@@ -78,7 +94,30 @@ class Later:
     def _tidy(self) -> None:
         with self._cond:
             self._tidying = False
+            self._tries += 1
+            tries, kept = self._tries, self._kept
         gc.collect()
+        alive = kept()
+        if alive == 0:
+            return
+        if tries >= TIDY_TRIES:
+            log.warning(
+                "tabs that left still in memory %.0f s later: %d (a reference kept by mistake)",
+                tries * TIDY_AGAIN,
+                alive,
+            )
+            return
+        timer = threading.Timer(TIDY_AGAIN, self._again)
+        timer.daemon = True
+        timer.name = f"{self.name}-tidy"
+        timer.start()
+
+    def _again(self) -> None:
+        with self._cond:
+            if self._tidying:
+                return
+            self._tidying = True
+        self.add(self._tidy)
 
     def pending(self) -> int:
         """Jobs waiting or running (tests and benchmarks wait for 0)."""

@@ -137,6 +137,7 @@ class TpmApp:
         self.arrived: weakref.WeakSet[ClientView] = weakref.WeakSet()
         """The views whose connection is fully handled (keys, classroom, guide, share link, class line)."""
         self._views_lock = threading.Lock()
+        self._gone: weakref.WeakSet[ClientView] = weakref.WeakSet()  # tabs that left, until their garbage is freed
         self._class_info_timer: threading.Timer | None = None
         position, look_at = camera_pose(self.hub.shared.state.params)
         server.initial_camera.position = position
@@ -206,8 +207,9 @@ class TpmApp:
             self.exercises.leaving(view)
             self.access.logout(view)
             view.close()
-            if self.services.later is not None:
-                self.services.later.tidy()  # its garbage freed at the next quiet moment, not in the next storm
+            self._gone.add(view)
+            if self.services.later is not None:  # its garbage freed at the next quiet moment, not in the next storm
+                self.services.later.tidy(kept=lambda: len(self._gone))
 
     @guarded
     def _login(self, event, view: ClientView) -> None:
