@@ -23,7 +23,7 @@ from tpm_viz.cli import main
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 DOC = ROOT / "docs" / "takehome.md"
-BLOCK = re.compile(r"(<!-- sizes: tpm-viz page --lesson N --output lesson-N.html[^\n]*-->\n```csv\n)(.*?)(```)", re.S)
+BLOCK = re.compile(r"(<!-- sizes: tpm-viz page --lesson N --output lesson-N.html[^\n]*-->\n```text\n)(.*?)(```)", re.S)
 LIMIT = 5_000_000
 
 

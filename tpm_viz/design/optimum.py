@@ -20,7 +20,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import differential_evolution, minimize
+from scipy import optimize
 
 from tpm_viz.design.atlas import Limits, Row, design_row, task_columns
 from tpm_viz.design.indices import Settings, Task
@@ -115,7 +115,7 @@ class Problem:
 def _nelder_mead(problem: Problem, x0: np.ndarray, evaluations: int, evaluate: Evaluate = _in_turn) -> np.ndarray:
     """Nelder-Mead from ``x0`` within the unit cube, each design through ``evaluate``; the better of its end and
     ``x0``."""
-    result = minimize(
+    result = optimize.minimize(
         lambda x: float(evaluate(problem.cost, [x])[0]),
         x0,
         method="Nelder-Mead",
@@ -170,7 +170,7 @@ def search(
         rng = np.random.default_rng(how.seed)
         known = np.clip([problem.scaled(s) for s in starts][:size], 0.0, 1.0)
         init = np.concatenate([known, _latin(rng, size - len(known), k)])
-    result = differential_evolution(
+    result = optimize.differential_evolution(
         problem.cost,
         [(0.0, 1.0)] * k,
         strategy=STRATEGY,

@@ -6,9 +6,10 @@ inverse kinematics (eq. 4).
 
 Velocity relation (eqs. 6-10): ``J_x ṗ = J_q ḋ`` with
 ``J_x = [[cos θ1, sin θ1], [sin θ2, cos θ2]]``, ``J_q = diag(cos θ1, cos θ2)`` and
-``J = J_q^{-1} J_x = [[1, tan θ1], [tan θ2, 1]]``. Both arrangements' Jacobians (eq. P4 for the parallel one) are
-built by :func:`jacobians_of` from their legs (:class:`~tpm_viz.paper.legs.Legs`), and both share the statuses
-(:func:`classify_of`, :func:`pose_status`), the condition number and the statics through the ``*_through`` functions.
+``J = J_q^{-1} J_x = [[1, tan θ1], [tan θ2, 1]]``. Both arrangements' Jacobians (eq. P4 for the parallel one)
+are built by :func:`~tpm_viz.paper.jacobians.jacobians_of` from their legs (:class:`~tpm_viz.paper.legs.Legs`), and
+both share the statuses (:func:`classify_of`, :func:`pose_status`), the condition number and the statics through
+the ``*_through`` functions.
 
 Erratum (eq. 15): the paper prints ``J̇_q = diag(+sin θ_i θ̇_i)``; the time derivative of
 ``cos θ_i`` is ``-sin θ_i θ̇_i``. :func:`actuator_acceleration` uses the corrected sign; the
@@ -112,7 +113,8 @@ def jacobians_of(legs: Legs, params: Params, p: ArrayLike, d: ArrayLike | None =
 
 def jacobians(params: Params, p: ArrayLike, d: ArrayLike | None = None) -> Jacobians:
     """The Jacobian matrices of eqs. (8) and (10) at ``p`` [m] (dimensionless): ``J_x = [[cos θ1, sin θ1],
-    [sin θ2, cos θ2]]``, ``J_q = diag(cos θ_i)``, ``J = [[1, tan θ1], [tan θ2, 1]]`` (:func:`jacobians_of`)."""
+    [sin θ2, cos θ2]]``, ``J_q = diag(cos θ_i)``, ``J = [[1, tan θ1], [tan θ2, 1]]``
+    (:func:`~tpm_viz.paper.jacobians.jacobians_of`)."""
     return jacobians_of(PERPENDICULAR, params, p, d)
 
 

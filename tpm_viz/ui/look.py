@@ -128,7 +128,7 @@ label wbr {{ display: none; }}
 </style>""")
 """The readout's room at the panel's edge (:data:`INSET`), the phone layout and touch targets (by viewport and
 pointer: no switch), in every tab; labels break at spaces only (viser puts a ``<wbr>`` after each ``_`` and ``/``:
-"F_max" was cut after "F_")."""
+``F_max`` was cut after ``F_``)."""
 
 BANNER_PX = 20
 """Font size of the pose status and its warnings in the box of live numbers [CSS px]."""
