@@ -174,6 +174,22 @@ def test_no_module_over_400_lines():
     assert long == {}, f"split these by concept: {long}"
 
 
+def test_outside_the_classroom_layer_the_hub_is_locked_through_its_one_context():
+    """``Hub.locked()`` is how a view takes the hub's lock: no module outside ``classroom/`` reads ``hub.lock``."""
+    found = []
+    for name, path in MODULES.items():
+        if name.startswith("tpm_viz.classroom."):
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Attribute) and node.attr == "lock":
+                owner = node.value
+                if (isinstance(owner, ast.Attribute) and owner.attr == "hub") or (
+                    isinstance(owner, ast.Name) and owner.id == "hub"
+                ):
+                    found.append(f"{name}:{node.lineno}")
+    assert found == [], f"take the lock with hub.locked(): {found}"
+
+
 PRIVATE_VISER = re.compile(
     r"\._(?:thread_executor|websock_connection|websock_server|handle_gui_updates|handle_file_transfer\w*|"
     r"current_file_upload_states|gui_input_handle_from_uuid|impl_aux|impl|share_tunnel|client_state_from_id|"

@@ -22,6 +22,7 @@ import threading
 import time
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
+from contextlib import AbstractContextManager
 from typing import Any, Protocol
 
 import numpy as np
@@ -115,6 +116,7 @@ class Hub:
         scene: Drawing | None = None,
     ) -> None:
         self.lock = threading.RLock()
+        """Re-entrant; outside the classroom layer it is taken through :meth:`locked` only."""
         self.shared = Session(state, shared=True, scene=scene)
         self.reference = reference
         self.access = access if access is not None else Access()
@@ -129,6 +131,11 @@ class Hub:
         self.drag_pool = ThreadPoolExecutor(max_workers=2, thread_name_prefix="tpm-viz-drag")
         """Where drags of a session shown by many tabs are committed: two threads (they serialise on the lock); a
         plain executor, not ``loop.run_in_executor``, so that finishing a drag does not wake the event loop."""
+
+    def locked(self) -> AbstractContextManager[bool]:
+        """The one context in which a view reads or draws the shared state and the private copies, and calls
+        :meth:`commit` (re-entrant: a callback under it may call code that takes it again)."""
+        return self.lock
 
     def evaluate(self, state: AppState, live: bool = False) -> Readout:
         """All numbers for ``state``: closed form and reference (Pinocchio) forces. ``live`` (an intermediate frame

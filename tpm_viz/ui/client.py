@@ -89,7 +89,7 @@ class ClientView:
         """The typed number fields of this tab (Enter, Apply, the quiet time: :mod:`.fields`)."""
         self.drags = Dragging(self)
         """The gizmo drags of this tab (:mod:`.dragging`)."""
-        with hub.lock, client.atomic():  # built and drawn, then sent as one: no wake-up of the loop per widget
+        with hub.locked(), client.atomic():  # built and drawn, then sent as one: no wake-up of the loop per widget
             state = hub.shared.state if saved is None else saved.state
             self.words = TabWords(self)  # the Language selector, first in the panel; switches lang (ui/language.py)
             self.scene = TabScene(client, cast(MechanismScene, hub.shared.scene))
@@ -201,7 +201,7 @@ class ClientView:
 
     def close(self) -> None:
         """The tab went away: stop drawing and leave the session."""
-        with self.hub.lock:
+        with self.hub.locked():
             self.closed = True
             self.typing.close()
             self.look.close()
@@ -334,7 +334,7 @@ class ClientView:
     def _on_show(self, event, what: str) -> None:
         if getattr(event, "client", None) is None:
             return
-        with self.hub.lock:
+        with self.hub.locked():
             self.scene.set_visible(what, bool(self.panel.show_toggles[what].value))
             if self.session.scene is not None and self.session.frame is not None:
                 self.session.scene.update(self.session.frame)  # a private copy: the flags apply at its next draw
@@ -345,6 +345,6 @@ class ClientView:
         """*Frame the mechanism* (the panel's, the box of live numbers'): the camera framed again for the canvas."""
         if getattr(event, "client", None) is None or self.closed:
             return
-        with self.hub.lock:
+        with self.hub.locked():
             self.frame_camera(self.session.state.params)
             self.client.flush()

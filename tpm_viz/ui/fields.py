@@ -269,7 +269,7 @@ def control(method: Any = None, *, place: str | None = None) -> Any:
         def wrapper(self: Any, event: Any, *args: Any) -> None:
             if getattr(event, "client", None) is None:
                 return
-            with self.hub.lock:
+            with self.hub.locked():
                 if self.closed:
                     return
                 where = None if place is None else cast(Place, getattr(self.panel, place))
@@ -310,7 +310,7 @@ class Typing:
     def _on_key(self, event: Any) -> None:
         if not self._live(event):
             return
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if not self.view.closed:
                 self._sync(time.monotonic())
                 for box, _apply in self.boxes:
@@ -322,13 +322,13 @@ class Typing:
     def _on_enter(self, event: Any, box: TypedBox) -> None:
         if not self._live(event):
             return
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if not self.view.closed:
                 self.settle(box)
 
     @guarded(on_error=_internal_error)
     def _tick(self) -> None:
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if self.view.closed:
                 return
             now = time.monotonic()

@@ -91,7 +91,7 @@ class Guides:
         panel = view.panel
         panel.guide_done.on_click(lambda event: self._done(view, identity, event))
         if not self.seen(identity):
-            with view.hub.lock:
+            with view.hub.locked():
                 panel.guide.visible = True
                 view.client.flush()
         self.greeted.add(view)
@@ -99,7 +99,7 @@ class Guides:
     @guarded
     def _done(self, view: Any, identity: str | None, event: Any) -> None:
         self.remember(identity)
-        with view.hub.lock:
+        with view.hub.locked():
             if view.closed:
                 return
             view.panel.guide.visible = False

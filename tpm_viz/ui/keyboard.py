@@ -209,7 +209,7 @@ class Keyboard:
     def _drain(self, tab: _Tab) -> None:
         """Apply ``tab``'s pending keys in order (in the drag pool, under the hub's lock)."""
         view = tab.view
-        with view.hub.lock:
+        with view.hub.locked():
             with self._lock:
                 keys = list(tab.pending)
                 tab.pending.clear()

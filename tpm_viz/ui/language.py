@@ -68,7 +68,7 @@ class TabWords:
     def set(self, lang: Lang) -> None:
         """Show this tab in ``lang``: every fixed text written again, then its live parts redrawn."""
         view = self.view
-        with view.hub.lock:
+        with view.hub.locked():
             if view.closed:
                 return
             if self.selector.value != lang.label:

@@ -59,14 +59,14 @@ class Launched:
         view.launch = launch
         if launch is None:
             if fresh:
-                with self.app.hub.lock:
+                with self.app.hub.locked():
                     view.tell(SPENT)
             return
         if not fresh:
             return
         self.arrived += 1
         presenter = launch.role is Role.PRESENTER
-        with self.app.hub.lock:
+        with self.app.hub.locked():
             if launch.lang:
                 view.words.set(Lang.parse(launch.lang, default=view.lang))
             if presenter:
@@ -97,11 +97,11 @@ class Launched:
         """Open lesson ``number`` (1-based): on the shared mechanism for the presenter, else on an own copy."""
         demos = view.teaching.demos
         if not 1 <= number <= len(demos.lessons):
-            with self.app.hub.lock:
+            with self.app.hub.locked():
                 view.tell(Phrase("The course's link names lesson {n}, which this tpm-viz does not have.", n=number))
             return
         if not presenter:
-            with self.app.hub.lock:
+            with self.app.hub.locked():
                 if view.session.shared:
                     view.switch(True)
                     view.panel.own_copy.value = True  # echoed with client=None: ignored
@@ -111,6 +111,6 @@ class Launched:
         if self.open_exercise is not None:
             self.open_exercise(view, launch)
             return
-        with self.app.hub.lock:
+        with self.app.hub.locked():
             view.tell(Phrase("The course's link names the exercise {id}: exercises are not in this tpm-viz yet.",
                              id=launch.exercise))  # fmt: skip

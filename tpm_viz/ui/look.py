@@ -250,7 +250,7 @@ class Look:
         if self._aspect is not None and abs(canvas[1] / self._aspect - 1.0) <= ASPECT_CHANGE:
             return
         view = self.view
-        with view.hub.lock:
+        with view.hub.locked():
             if view.closed:
                 return
             view.frame_camera(view.session.state.params)
@@ -269,7 +269,7 @@ class Look:
     @guarded
     def _ask(self) -> None:
         view = self.view
-        with view.hub.lock:
+        with view.hub.locked():
             if view.closed:
                 return
             camera = view.client.camera
@@ -293,7 +293,7 @@ class Look:
         if getattr(event, "client", None) is None:  # the server's own write, echoed
             return
         view = self.view
-        with view.hub.lock:
+        with view.hub.locked():
             if view.closed:
                 return
             self.set_presentation(bool(view.panel.presentation.value))

@@ -97,7 +97,7 @@ class Room:
         """A line about saving: on the terminal once, and in every lecturer's panel until the next one."""
         print(f"warning: {line}" if problem else line, file=sys.stderr, flush=True)
         self.notice = line
-        with self.app.hub.lock:
+        with self.app.hub.locked():
             for panel in list(self._lecturers.values()):
                 panel.show_notice(line)
 
@@ -144,7 +144,7 @@ class Room:
             self._keys[view] = key
         view.address = host
         hub = self.app.hub
-        with hub.lock:
+        with hub.locked():
             record = self._back.pop(view, None)
             here = self.classroom is not None and self.classroom.presenter_address(host)
             back = self.away.presenter(record, host)  # same address, within 2 minutes: never the cookie alone
@@ -176,7 +176,7 @@ class Room:
         key = self._keys.pop(view, None)
         if key is None or view.closed:
             return
-        with self.app.hub.lock:
+        with self.app.hub.locked():
             try:
                 camera = tuple(view.client.camera.position) + tuple(view.client.camera.wxyz)
             except Exception:
@@ -190,7 +190,7 @@ class Room:
         if getattr(event, "client", None) is None or view.closed:
             return
         key = self._keys.get(view)
-        with self.app.hub.lock:
+        with self.app.hub.locked():
             record = None if key is None else self.away.offer(key)
             view.panel.restore.visible = False
             if key is None or record is None or not self.away.claim(key, record):
@@ -215,7 +215,7 @@ class Room:
         """*Log out as presenter*: ``view`` is a student's tab from now on (its *Lecturer* folder goes), and no
         presenter tab that dropped from its address comes back as the presenter."""
         access = self.app.access
-        with self.app.hub.lock:
+        with self.app.hub.locked():
             if view.closed or not access.is_presenter_tab(view):
                 return
             access.logout(view)
@@ -241,7 +241,7 @@ class Room:
     def hand_to_class(self, view: Any, open_: bool) -> None:
         """The presenter lets the class change the shared mechanism, or takes it back."""
         access = self.app.access
-        with self.app.hub.lock:
+        with self.app.hub.locked():
             if not access.is_presenter_tab(view):
                 view.refuse("only the presenter can hand the shared mechanism to the class", resync=False)
                 return
@@ -256,7 +256,7 @@ class Room:
     def document(self) -> Document:
         """The shared mechanism, the lesson step and every tab's own copy (away or still here)."""
         app, hub = self.app, self.app.hub
-        with hub.lock:
+        with hub.locked():
             runs = app.services.runs
             ps = runs.of(hub.shared)
             source = ps.run.source if ps.run is not None else ps.loading
@@ -288,7 +288,7 @@ class Room:
     def open_session(self, view: Any, data: bytes) -> None:
         """*Open session*: the shared mechanism becomes the file's (refused with one line to this tab only)."""
         hub = self.app.hub
-        with hub.lock:
+        with hub.locked():
             try:
                 hub.authorize(view, hub.shared)
                 choice = getattr(getattr(view.teaching, "demos", None), "choice", None)
@@ -302,7 +302,7 @@ class Room:
     def _apply_shared(self, doc: Document, origin: Any) -> None:
         hub, runs = self.app.hub, self.app.services.runs
         shared = hub.shared
-        with hub.lock:
+        with hub.locked():
             shared.play_token += 1
             runs.unload(shared)
             hub.commit(shared, doc.shared.state, origin=origin)

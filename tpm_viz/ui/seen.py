@@ -56,7 +56,7 @@ class Sightings:
     def _apply(self, view: Any, what: str, count: int) -> None:
         """Apply what the page saw (in the drag pool, under the hub's lock), unless the page told something newer
         already (its ``count`` is lower: the pool may answer two requests out of order)."""
-        with view.hub.lock:
+        with view.hub.locked():
             with self._lock:
                 if view.closed or count <= self._counts.get(view, -1):
                     return

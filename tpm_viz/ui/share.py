@@ -108,14 +108,14 @@ class ShareDesk:
         try:  # outside the hub's lock: inflating and checking a large upload must not hold up the other tabs
             saved = decode_link(token, None if blobs is None else blobs.get_blob)
         except TpmVizError as exc:
-            with self.hub.lock:
+            with self.hub.locked():
                 self.refused += 1
                 log.info("client %s: share link refused (%s)", view.client.client_id, exc)
                 if not view.closed:
                     view.tell(Phrase("This tab was opened with a share link that is refused: {why}", why=reason(exc)))
                     view.client.flush()
             return False
-        with self.hub.lock:
+        with self.hub.locked():
             if view.closed:
                 return False
             mine = Saved(saved.state, saved.source, saved.playing_t, saved.show, view.lang.value)
@@ -132,7 +132,7 @@ class ShareDesk:
 
     def link(self, view: Any) -> str:
         """The link of what ``view`` shows now (refused in one line: an upload too large with no store here)."""
-        with self.hub.lock:
+        with self.hub.locked():
             saved = saved_of(view)
             origin = self._origins.get(view) or "http://127.0.0.1"
         blobs = self.blobs()
@@ -179,10 +179,10 @@ class ShareBox:
         try:
             url = desk.link(view)
         except TpmVizError as exc:
-            with view.hub.lock:
+            with view.hub.locked():
                 view.refuse(exc, resync=False, where=self.note)
             return
-        with view.hub.lock:
+        with view.hub.locked():
             if view.closed:
                 return
             self.text.value = url

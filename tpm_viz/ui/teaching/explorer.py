@@ -208,7 +208,7 @@ class ExplorerView:
         if getattr(event, "client", None) is None:
             return
         kinds = {label: kind for kind, label in MAP_KINDS.items()}
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             self.set(kind=kinds.get(self.map_kind.value, "off"))
             self.view.client.flush()
 
@@ -216,14 +216,14 @@ class ExplorerView:
     def _on_ellipses(self, event) -> None:
         if getattr(event, "client", None) is None:
             return
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             self.set(ellipses=bool(self.ellipses.value))
             self.view.client.flush()
 
     # -- drawing -------------------------------------------------------------------------------------------
     def map_ready(self, params: Params) -> None:
         """A map finished computing (worker thread): draw it if this tab shows those parameters."""
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if getattr(self.view, "closed", False) or self._frame is None:
                 return
             if self._frame.state.params == params:

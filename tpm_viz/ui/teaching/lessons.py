@@ -138,7 +138,7 @@ class DemosView:
             self.problems_note.content = problems_html(self.problems, self.view.lang)
 
     def _refuse(self, exc: Exception) -> None:
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             self.view.refuse(exc)
 
     def _user(self, event) -> bool:
@@ -180,7 +180,7 @@ class DemosView:
             return
         camera = (demo.camera.position, demo.camera.look_at) if demo.camera is not None else camera_pose(params)
         view = self.view
-        with view.hub.lock:
+        with view.hub.locked():
             self.index = index
             self._written = demo.title
             self.choice.value = demo.title

@@ -99,7 +99,7 @@ class MotionPlayer:
 
     def seek(self, t: float) -> None:
         """Stop playing and show the motion at ``t`` [s] (under the hub's lock)."""
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             session = self.view.session
             self.view.hub.authorize(self.view, session)
             self._usable()
@@ -109,7 +109,7 @@ class MotionPlayer:
 
     def pause(self) -> None:
         """Stop playing (the last frame is committed again in full)."""
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             session = self.view.session
             t = self.at(session.state)
             self.view.hub.authorize(self.view, session)
@@ -125,7 +125,7 @@ class MotionPlayer:
 
     def play(self, speed: float, loop: bool = False) -> None:
         """Play from the current sample (from the start if at the end or off the motion)."""
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             session = self.view.session
             self.view.hub.authorize(self.view, session)
             motion = self._usable()
@@ -150,7 +150,7 @@ class MotionPlayer:
         try:
             while True:
                 t = t0 + speed * (time.monotonic() - wall0)
-                with hub.lock:
+                with hub.locked():
                     if session.play_token != token or self.motion is not motion or self.view.closed:
                         return
                     if t >= motion.duration and loop:
@@ -170,7 +170,7 @@ class MotionPlayer:
                 k += 1
                 time.sleep(max(0.0, tick0 + k / FPS - time.monotonic()))
         finally:
-            with hub.lock:
+            with hub.locked():
                 if self._token == token:
                     self.playing = False
                     if self._on_stop is not None and not self.view.closed:

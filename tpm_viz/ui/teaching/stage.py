@@ -35,7 +35,7 @@ def bring(view: Any, what: str, redraw: bool = False) -> None:
         return
     _FRONT[view] = what
     if redraw:
-        with view.hub.lock:
+        with view.hub.locked():
             frame = getattr(view.session, "frame", None)
             if frame is not None and not view.closed:
                 view.teaching.render(frame)

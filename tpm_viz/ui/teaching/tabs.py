@@ -198,7 +198,7 @@ class Teaching:
         current frame, in presentation mode if the tab is in it (takes the hub's lock; idempotent). True: built
         now; False: built already, or the tab is closed or still being built (its panel does not exist yet)."""
         view = self.view
-        with view.hub.lock:
+        with view.hub.locked():
             panel = getattr(view, "panel", None)
             if group not in self.waiting or panel is None or getattr(view, "closed", False):
                 return False
@@ -221,7 +221,7 @@ class Teaching:
     def _attach(self, group: str) -> None:
         """The views of a built ``group`` of :data:`LATER` for the session the tab has joined."""
         if group == "teach":
-            with self.view.hub.lock:
+            with self.view.hub.locked():
                 self._player.refresh()
         if group == "lab":
             self._control.attach()
@@ -243,7 +243,7 @@ class Teaching:
 
     def switched(self, old: Session) -> None:
         """The tab moved from ``old`` to its current session (own copy on / off)."""
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             self.services.runs.adopt(self.view.session, old)
             self._abandon(old)
             self.run_changed()

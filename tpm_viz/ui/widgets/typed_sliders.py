@@ -132,7 +132,7 @@ class TypedSlider:
     @guarded
     def _on_slider(self, event: Any) -> None:
         """The slider moved (a drag, or the app wrote it): the field shows its value."""
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if self.view.closed:
                 return
             self.box.show({KEY: float(self.slider.value)}, force=not self._following)

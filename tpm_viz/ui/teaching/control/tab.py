@@ -173,7 +173,7 @@ class ControlView:
         try:
             fn(*args)
         except TpmVizError as exc:
-            with self.view.hub.lock:
+            with self.view.hub.locked():
                 self.view.refuse(exc, resync=False)
 
     def _show_gains(self) -> None:
@@ -186,7 +186,7 @@ class ControlView:
 
     def attach(self) -> None:
         """The tab joined its session: show the gains for its mechanism."""
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             self._show_gains()
 
     # -- callbacks -----------------------------------------------------------------------------------------
@@ -195,7 +195,7 @@ class ControlView:
         self._user(event, self._gains_changed)
 
     def _gains_changed(self) -> None:
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             self._show_gains()
             self.view.client.flush()
 
@@ -209,7 +209,7 @@ class ControlView:
 
     def _start(self, lesson: bool) -> None:
         """Read the widgets and simulate in the worker (the lesson: all three controllers, with a payload)."""
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if lesson and float(self.payload.value) == 0.0:
                 self.payload.value = LESSON_PAYLOAD
             setup = self._setup()
@@ -235,7 +235,7 @@ class ControlView:
         )
 
     def _done(self, request: int, params: Params, setup: ControlSetup, lesson: bool, result, error) -> None:
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if self.view.closed or request != self._request:
                 return
             self.busy = ""
@@ -307,7 +307,7 @@ class ControlView:
             self.player.pause()
         elif what == "To start":
             self.player.seek(0.0)
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             self._refresh_status()
 
     @guarded(on_error=_internal_error)
@@ -315,7 +315,7 @@ class ControlView:
         self._user(event, self._seek)
 
     def _seek(self) -> None:
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             t = self.player.at(self.view.session.state)
             if t is not None and abs(t - float(self.time.value)) < 1e-9:
                 return  # the echo of a value written by playback
@@ -335,7 +335,7 @@ class ControlView:
         self._user(event, self._magnified)
 
     def _magnified(self) -> None:
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             motion = self.player.motion
             if not isinstance(motion, ControlMotion):
                 return

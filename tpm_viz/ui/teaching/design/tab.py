@@ -132,7 +132,7 @@ class DesignView:
         if getattr(event, "client", None) is None or view.closed or getattr(view, "session", None) is None:
             return
         after = None
-        with view.hub.lock:
+        with view.hub.locked():
             try:
                 after = fn(*args)
             except TpmVizError as exc:
@@ -216,7 +216,7 @@ class DesignView:
     def _chunk(self, request: int, spec: MapSpec, start: int, rows, error) -> None:
         """A chunk is done (worker thread): store it, draw the map, submit the next one."""
         more = False
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if self.view.closed or request != self._request:
                 return
             if error is not None:
@@ -333,7 +333,7 @@ class DesignView:
         return lambda: start_comparison(params, task, hold, evaluate, done)
 
     def _compared(self, request: int, hold: Hold, rows, error) -> None:
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if self.view.closed or request != self._compare_request:
                 return
             if error is not None:

@@ -168,7 +168,7 @@ class ExerciseDesk:
             lines, total, seed = book.summary(TABLE_LINES), book.rows.lines(), book.class_seed  # outside the lock
         except sqlite3.Error:  # the store closed (the app stops): nothing to show
             return
-        with self.hub.lock:
+        with self.hub.locked():
             for view, section in list(self._sections.items()):
                 if view.closed or section.gone or not self._lecturer(view):
                     self._sections.pop(view, None)
@@ -184,13 +184,13 @@ class ExerciseDesk:
     def fix(self, view: Any, seed: object) -> None:
         """The lecturer fixes ``seed`` for the class (None: a variant per student again); every tab's numbers follow."""
         if not self._lecturer(view):
-            with self.hub.lock:
+            with self.hub.locked():
                 view.refuse(LECTURER_ONLY, resync=False)
             return
         try:
             fixed = self._book().fix(seed)
         except (TpmVizError, sqlite3.Error) as exc:
-            with self.hub.lock:
+            with self.hub.locked():
                 view.refuse(exc if isinstance(exc, TpmVizError) else _unreadable(exc), resync=False)
             return
         log.info("exercises: %s", "a variant per student" if fixed is None else f"class seed {fixed}")
@@ -203,13 +203,13 @@ class ExerciseDesk:
     def download(self, view: Any) -> None:
         """*Download results (CSV)* (the lecturer's tab only)."""
         if not self._lecturer(view):
-            with self.hub.lock:
+            with self.hub.locked():
                 view.refuse(LECTURER_ONLY, resync=False)
             return
         try:
             data = self._book().csv().encode("utf-8")
         except sqlite3.Error as exc:
-            with self.hub.lock:
+            with self.hub.locked():
                 view.refuse(_unreadable(exc), resync=False)
             return
         view.client.send_file_download(CSV_NAME, data, save_immediately=True)

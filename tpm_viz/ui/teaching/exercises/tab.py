@@ -134,7 +134,7 @@ class ExercisesView:
     def _on_lesson(self, event: Any) -> None:
         if not self._user(event):
             return
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             self._fill_tab()
             self.view.client.flush()
 
@@ -213,7 +213,7 @@ class ExercisesView:
         )
 
     def _states(self, result: object, error: Exception | None) -> None:
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if self.view.closed:
                 return
             if error is not None or not isinstance(result, tuple):
@@ -239,7 +239,7 @@ class ExercisesView:
     def on_key(self, card: Card, event: Any) -> None:
         if not self._user(event):
             return
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             entered = card.entered()
         if entered:
             self._submit(card)
@@ -253,14 +253,14 @@ class ExercisesView:
     def on_pose(self, card: Card, event: Any) -> None:
         if not self._user(event):
             return
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             p = self.view.session.state.pose.p
             card.write(f"{p[0] * 1e3:.2f}; {p[1] * 1e3:.2f}")
             self.view.client.flush()
 
     def _submit(self, card: Card) -> None:
         desk, mine = self.services.exercises, self.mine[card.id]
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if desk is None or self.identity is None or mine.prompt is None or mine.grading or self.view.closed:
                 return
             text, identity, heavy = card.text(), self.identity, mine.exercise.heavy
@@ -297,7 +297,7 @@ class ExercisesView:
 
     def _answered(self, key: str, result: object, error: Exception | None) -> None:
         """A submission's outcome (``result`` a :class:`Submitted`; None with no ``error``: dropped unanswered)."""
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if self.view.closed:
                 return
             mine = self.mine[key]

@@ -171,7 +171,7 @@ class PlannerView:
         try:
             fn(*args)
         except TpmVizError as exc:
-            with self.view.hub.lock:
+            with self.view.hub.locked():
                 self.view.refuse(exc, resync=False)
 
     @guarded(on_error=_internal_error)
@@ -184,7 +184,7 @@ class PlannerView:
         self.waypoints.visible = self.clear.visible = kind == "waypoints"
         force, speed = float(self.force.value), float(self.speed.value)
         text = str(self.waypoints.value)
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             params = self._planned_for = self.view.session.state.params
             self._request += 1
             request = self._request
@@ -196,7 +196,7 @@ class PlannerView:
         )
 
     def _done(self, request: int, params: Params, result, error) -> None:
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if self.view.closed or request < self._shown:
                 return
             self._shown = request
@@ -256,7 +256,7 @@ class PlannerView:
     def _add_waypoint(self, item: str) -> None:
         """Append ``item`` (``x,y`` in mm) to the list, read and written in one locked step: clicks that arrive
         together each add their point."""
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             text = str(self.waypoints.value).strip() if self.path.value == "waypoints" else ""
             self._set_waypoints(f"{text}; {item}" if text else item)
 
@@ -264,7 +264,7 @@ class PlannerView:
         raise InputError(Phrase("Shift+click on the floor to add a waypoint"))
 
     def _set_waypoints(self, text: str) -> None:
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             self.path.value = "waypoints"
             self.waypoints.value = text
         self.request()

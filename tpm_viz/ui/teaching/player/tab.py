@@ -151,12 +151,12 @@ class PlayerView:
         except TpmVizError as exc:
             self._refused(exc)
         else:
-            with self.view.hub.lock:
+            with self.view.hub.locked():
                 self.note.tell(None, self.view.lang)
 
     def _refused(self, error: Exception) -> None:
         """Tell this tab why its player input was refused, under the upload button (any thread)."""
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if not getattr(self.view, "closed", False):
                 phrase = error.args[0] if error.args and isinstance(error.args[0], Phrase) else str(error)
                 self.view.refuse(phrase, where=self.note)
@@ -192,7 +192,7 @@ class PlayerView:
     def _choose(self, duration: float | None = None) -> None:
         """Load the chosen trajectory: a newly chosen paper trajectory with its default duration
         (``docs/conventions.md``: line 0.2 s, circle 0.5 s), or with the typed ``duration`` [s]."""
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if duration is None and self._is_echo(self.choice):
                 return
             label = self.choice.value
@@ -237,7 +237,7 @@ class PlayerView:
         self._guard(event, self._seek)
 
     def _seek(self) -> None:
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if self._is_echo(self.time):
                 return
             t = read_number(self.time.value, T("time t"), lo=0.0, hi=1e4)

@@ -83,13 +83,13 @@ class TakeOut:
 
     def _tell(self, phrase: Phrase | None) -> None:
         """The progress line (any thread)."""
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if self.line is not None and not self.view.closed:
                 text = "" if phrase is None else say(self.view.lang, phrase)
                 self.line.content = html('<p style="margin:0;font-size:0.85em">{text}</p>', text=text) if text else ""
 
     def _refuse(self, what) -> None:
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if not self.view.closed:
                 self.view.refuse(what, resync=False)
 
@@ -110,7 +110,7 @@ class TakeOut:
             self._refuse(exc)
 
     def _start_clip(self) -> None:
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if self.recording is not None:
                 raise InputError(T("a clip is already being recorded in this tab: wait for it to finish"))
             size = SIZE_PRESETS.get(self.size.value, SIZE_PRESETS["800×450"])
@@ -153,7 +153,7 @@ class TakeOut:
     def _end(self, recording: Recording, error) -> None:
         """The recording is over (finished, refused, failed, dropped): its canvas, encoder and slot go back."""
         recording.close()
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if self.recording is not recording:
                 return
             self.recording = None
@@ -175,7 +175,7 @@ class TakeOut:
             self._refuse(exc)
 
     def _start_report(self) -> None:
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             if self.reporting:
                 raise InputError(T("the report is being written: wait for it to finish"))
             material = self._current()
@@ -196,7 +196,7 @@ class TakeOut:
             )
 
     def _reported(self, result, error) -> None:
-        with self.view.hub.lock:
+        with self.view.hub.locked():
             self.reporting = False
         if self.view.closed:
             return
