@@ -22,7 +22,8 @@ the presenter drags the shared mechanism at 20 Hz, and ``--own`` of them, defaul
 same time; reported: the presenter's input -> the watchers' scene update (target p95 <= 100 ms) and each own-copy
 tab's p95 (target: none over 150 ms)).
 
-Run: ``python benchmarks/bench_load.py`` (about a minute); ``--quick`` for 4 s per N. Target: p95 < 50 ms at N = 30
+Run: ``python benchmarks/bench_load.py`` (about a minute); ``--quick`` for 4 s per N; ``--root DIR`` serves another
+checkout (before/after a change: ``git worktree add DIR COMMIT``). Target: p95 < 50 ms at N = 30
 (every mode). Bounded: every loop has a count and a time limit; the servers stop by themselves (their own pid).
 """
 
@@ -210,6 +211,7 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=10.0, help="drag time per N (max 120)")
     parser.add_argument("--rate", type=float, default=20.0, help="drag updates per second per tab")
     parser.add_argument("--quick", action="store_true", help="4 s per N")
+    parser.add_argument("--root", type=Path, help="serve this checkout's app.py (e.g. a worktree of an older commit)")
     parser.add_argument("--profile", type=Path, help="write py-spy's collapsed stacks of the drag window here")
     args = parser.parse_args()
     if args.profile is not None:
@@ -220,7 +222,7 @@ def main() -> None:
     _HALL_OWN[0] = max(0, min(args.own, args.hall - 1))
     for n in [min(max(args.hall, 2), 190)] if args.mode == "hall" else args.tabs:
         n = n if args.mode == "hall" else max(1, min(n, 60))
-        server = ServerProcess(TOKEN if args.mode in ("presenter", "hall") else None)
+        server = ServerProcess(TOKEN if args.mode in ("presenter", "hall") else None, root=args.root)
         progress = {"opened": 0, "step": "opening tabs"}
         budget = seconds + 60.0 + OPEN_SECONDS * n
         try:
