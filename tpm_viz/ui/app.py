@@ -146,7 +146,9 @@ class TpmApp:
         self.room = Room(self, classroom, store)
         """Classroom mode, tabs that come back, the session file (:mod:`.room`)."""
         self.room.start()
-        self.exercises = self.services.exercises = ExerciseDesk(self.hub, self.services, self._tabs, self.room.lecturer)
+        self.exercises = self.services.exercises = ExerciseDesk(
+            self.hub, self.services, self._tabs, self.room.reads_results
+        )
         """Gradebook, students, results; ``.score_sink``: LTI's hook (:mod:`.teaching.exercises.desk`)."""
         self.exercises.start(self.room.store)
         self.room.lecturer_hooks.append(self.exercises.lecturer_added)

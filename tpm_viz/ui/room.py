@@ -205,6 +205,16 @@ class Room:
         access = self.app.access
         return access.is_presenter_tab(view) if access.enabled else True
 
+    def reads_results(self, view: Any) -> bool:
+        """Whether ``view`` may read the class's exercise results and fix the class seed: the presenter in presenter
+        mode; without it (every tab has the *Lecturer* folder), only a tab on the serving machine, so that a student
+        never reads another's answers."""
+        access = self.app.access
+        if access.enabled:
+            return bool(access.is_presenter_tab(view))
+        local = self.classroom.lecturer_address if self.classroom is not None else is_loopback
+        return local(str(getattr(view, "address", "") or ""))
+
     def promoted(self, view: Any) -> None:
         """``view`` logged in as the presenter."""
         self.away.end_presenters()  # a new presenter: no dropped tab comes back as one

@@ -193,6 +193,31 @@ def test_a_student_never_sees_the_results_only_the_presenter_does(classroom_app)
         page.close()
 
 
+def test_without_presenter_mode_only_the_serving_machine_reads_the_results(monkeypatch, tmp_path):
+    """``tpm-viz serve --host 0.0.0.0`` without classroom mode: every tab gets the *Lecturer* folder, but the results
+    (everyone's answers, the CSV, the class seed) only a tab on the serving machine (here: exactly 127.0.0.1; a
+    student is 127.0.0.2)."""
+    monkeypatch.setattr("tpm_viz.ui.room.is_loopback", lambda host: host == "127.0.0.1")
+    app = _serve(tmp_path / "lecture.sqlite")
+    try:
+        here, lv = _visit(app, page_cookie(app.port))
+        there, sv = _visit(app, page_cookie(app.port), source="127.0.0.2")
+        assert not app.access.enabled and sv.address == "127.0.0.2"
+        assert app.room.lecturer(sv)  # the Lecturer folder as before: nobody holds the mechanism
+        wait_for(lambda: app.exercises.section(lv) is not None, what="the results in the local tab")
+        assert app.exercises.section(sv) is None
+        assert "Exercise results" not in there.uuids and "Class seed" not in there.uuids
+        app.exercises.fix(sv, 7)  # forged from the student's tab: refused, the class keeps its own variants
+        wait_for(lambda: "only the lecturer" in sv.panel.message.content, what="the refusal")
+        assert app.exercises.book.class_seed is None
+        app.exercises.download(sv)
+        assert "only the lecturer" in sv.panel.message.content
+        for page in (here, there):
+            page.close()
+    finally:
+        app.stop()
+
+
 class _Results(Page):
     """A tab that also keeps the exercise results the server sends (the HTML of a card's result)."""
 

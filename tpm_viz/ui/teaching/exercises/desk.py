@@ -136,7 +136,10 @@ class ExerciseDesk:
 
     # -- the lecturer ----------------------------------------------------------------------------------------------
     def lecturer_added(self, view: Any, panel: Any) -> None:
-        """``view`` got its *Lecturer* folder (``panel``; under the hub's lock): the results section in it."""
+        """``view`` got its *Lecturer* folder (``panel``; under the hub's lock): the results section in it, if
+        ``view`` may read the results (``lecturer(view)``)."""
+        if not self._lecturer(view):
+            return
         with panel.folder:
             self._sections[view] = ResultsSection(view.gui, self, view, self._book().class_seed)
         self._schedule()
