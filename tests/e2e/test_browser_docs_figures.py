@@ -87,6 +87,8 @@ def test_the_apps_screenshot_is_the_circle_at_0_17_s(app, browser, tmp_path):
     page.locator(f'[id="{widget_uuid(player.choice)}"]').click()
     page.get_by_role("option", name="circle (Fig. 5)", exact=True).click()
     page.get_by_text("circle (Fig. 5), T = 0.5 s").first.wait_for(timeout=30_000)
+    run = lambda: player.runs.of(view.session).run  # noqa: E731
+    wait_for(lambda: run() is not None and run().source.kind == "circle", timeout=60, what="the circle's run")
     _scrub(page, view, 0.17)
     p = tv.circle_state(0.17, 0.5)[0] * 1e3  # mm
     open_tab(page, "Move")
