@@ -34,6 +34,7 @@ from tpm_viz.core.words import Phrase, T
 from tpm_viz.multibody.forward import PlatformPlant
 from tpm_viz.multibody.model import model_for
 from tpm_viz.paper.control import ControlLaw, ControllerKind, Gains, model_with_errors, reference_state
+from tpm_viz.paper.tracking import failed_at, held_rk4
 from tpm_viz.paper.trajectories import Trajectory, paper_duration, positive_seconds
 
 __all__ = ["COLUMNS", "DEFAULT_RATE", "MAX_PLANT_STEP", "MAX_SAMPLES", "ControlRun", "ControlSetup", "simulate"]
@@ -226,7 +227,6 @@ def simulate(
     period = 1.0 / setup.rate
     sub = max(1, math.ceil(period / MAX_PLANT_STEP - 1e-9))
     h = period / sub
-    hh, h6 = 0.5 * h, h / 6.0
     p1, p2 = (float(x) for x in p_ref[0] + np.asarray(setup.offset))
     v1, v2 = (float(x) for x in dp_ref[0])
     k = 0
@@ -238,22 +238,9 @@ def simulate(
             out[k] = (p1, p2, v1, v2, u1, u2, ff1, ff2, u1 != tau1 or u2 != tau2, 0.0)
             if k == n:
                 break
-            for _ in range(sub):  # RK4 with τ held (zero-order hold)
-                a11, a12 = acc(p1, p2, v1, v2, u1, u2)
-                x1, x2, y1, y2 = p1 + hh * v1, p2 + hh * v2, v1 + hh * a11, v2 + hh * a12
-                a21, a22 = acc(x1, x2, y1, y2, u1, u2)
-                x1, x2, w1, w2 = p1 + hh * y1, p2 + hh * y2, v1 + hh * a21, v2 + hh * a22
-                a31, a32 = acc(x1, x2, w1, w2, u1, u2)
-                x1, x2, s1, s2 = p1 + h * w1, p2 + h * w2, v1 + h * a31, v2 + h * a32
-                a41, a42 = acc(x1, x2, s1, s2, u1, u2)
-                p1, p2 = p1 + h6 * (v1 + 2 * y1 + 2 * w1 + s1), p2 + h6 * (v2 + 2 * y2 + 2 * w2 + s2)
-                v1, v2 = v1 + h6 * (a11 + 2 * a21 + 2 * a31 + a41), v2 + h6 * (a12 + 2 * a22 + 2 * a32 + a42)
+            p1, p2, v1, v2 = held_rk4(acc, p1, p2, v1, v2, u1, u2, h, sub)
     except (TpmVizError, ZeroDivisionError, OverflowError, ValueError) as exc:
-        at = k * period
-        if isinstance(exc, TpmVizError):
-            first = exc.args[0] if exc.args and isinstance(exc.args[0], Phrase) else str(exc)
-            raise type(exc)(Phrase("at t = {t:.4f} s: {why}", t=at, why=first)) from None
-        raise InputError(Phrase("at t = {t:.4f} s the simulation diverged (unstable loop?)", t=at)) from None
+        raise failed_at(exc, k * period) from None
     return ControlRun(
         name=name,
         setup=setup,

@@ -24,12 +24,11 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from tpm_viz.core.errors import SingularConfigurationError, UnreachablePoseError
-from tpm_viz.core.numbers import fixed
+from tpm_viz.core.errors import SingularConfigurationError
 from tpm_viz.core.params import Params
-from tpm_viz.core.words import Phrase
 from tpm_viz.multibody.assembly import DOF, NEWTON_FLOOR, NEWTON_MAX_ITER, NEWTON_TOL
 from tpm_viz.multibody.rank import RankedSvd, ranked_svd
+from tpm_viz.paper.plant import leg_cosines
 
 __all__ = ["ClosedLoopModel", "PlatformPlant", "forward_dynamics", "project"]
 
@@ -128,19 +127,7 @@ class PlatformPlant:
 
     def _legs(self, p1: float, p2: float) -> tuple[float, float]:
         """``c_i = l_a cos θ_i`` [m]; raises when the pose leaves the working mode's domain."""
-        la2 = self._la * self._la
-        r1, r2 = la2 - p2 * p2, la2 - p1 * p1
-        if not (r1 > 1e-12 * la2 and r2 > 1e-12 * la2):  # also catches NaN
-            raise UnreachablePoseError(
-                Phrase(
-                    "the simulated platform reached ({x}, {y}) mm: |p_j| must stay below l_a = {l_a} mm "
-                    "(unstable motion?)",
-                    x=fixed(p1, ".1f", 1e3),
-                    y=fixed(p2, ".1f", 1e3),
-                    l_a=fixed(self._la, ".1f", 1e3),
-                )
-            )
-        return math.sqrt(r1), math.sqrt(r2)
+        return leg_cosines(self._la, p1, p2)
 
     def joint_state(
         self,

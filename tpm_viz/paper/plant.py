@@ -23,10 +23,28 @@ from tpm_viz.core.params import Params
 from tpm_viz.core.words import Phrase
 from tpm_viz.paper.dynamics import SINGULAR_TOL, _procedure
 
-__all__ = ["Acceleration", "closed_form_plant"]
+__all__ = ["Acceleration", "closed_form_plant", "leg_cosines"]
 
 Acceleration = Callable[[float, float, float, float, float, float], tuple[float, float]]
 """``f(p1, p2, ṗ1, ṗ2, τ1, τ2) -> (p̈1, p̈2)`` [m, m/s, N -> m/s²]: a plant, one state, floats."""
+
+
+def leg_cosines(la: float, p1: float, p2: float) -> tuple[float, float]:
+    """``c_i = l_a cos θ_i = sqrt(l_a² - p_j²)`` [m] (eq. 4, working mode) of a simulated platform at ``(p1, p2)``
+    [m]. :class:`~tpm_viz.core.errors.UnreachablePoseError` once ``|p_j|`` reaches ``l_a`` (or a NaN: the motion
+    diverged)."""
+    la2 = la * la
+    r1, r2 = la2 - p2 * p2, la2 - p1 * p1
+    if not (r1 > 1e-12 * la2 and r2 > 1e-12 * la2):  # also catches NaN
+        raise UnreachablePoseError(
+            Phrase(
+                "the simulated platform reached ({x}, {y}) mm: |p_j| must stay below l_a = {l_a} mm (unstable motion?)",
+                x=fixed(p1, ".1f", 1e3),
+                y=fixed(p2, ".1f", 1e3),
+                l_a=fixed(la, ".1f", 1e3),
+            )
+        )
+    return math.sqrt(r1), math.sqrt(r2)
 
 
 def closed_form_plant(params: Params) -> Acceleration:
@@ -40,18 +58,7 @@ def closed_form_plant(params: Params) -> Acceleration:
     la2 = la * la
 
     def acceleration(p1: float, p2: float, v1: float, v2: float, tau1: float, tau2: float) -> tuple[float, float]:
-        r1, r2 = la2 - p2 * p2, la2 - p1 * p1
-        if not (r1 > 1e-12 * la2 and r2 > 1e-12 * la2):  # also catches NaN
-            raise UnreachablePoseError(
-                Phrase(
-                    "the simulated platform reached ({x}, {y}) mm: |p_j| must stay below l_a = {l_a} mm "
-                    "(unstable motion?)",
-                    x=fixed(p1, ".1f", 1e3),
-                    y=fixed(p2, ".1f", 1e3),
-                    l_a=fixed(la, ".1f", 1e3),
-                )
-            )
-        c1, c2 = math.sqrt(r1), math.sqrt(r2)
+        c1, c2 = leg_cosines(la, p1, p2)
         if abs(c1 * c2) < SINGULAR_TOL * la2 or abs(c1 * c2 - p1 * p2) < SINGULAR_TOL * la2:
             raise SingularConfigurationError(Phrase("the simulated platform reached a singularity (eqs. 11-12)"))
         h = _procedure(params, p1, p2, v1, v2, 0.0, 0.0, c1, c2, 0.0, 0.0)

@@ -26,7 +26,7 @@ from tpm_viz.paper.control import ControlLaw, reference_state
 from tpm_viz.paper.plant import Acceleration
 from tpm_viz.paper.trajectories import paper_duration
 
-__all__ = ["MAX_PLANT_STEP", "Tracking", "track"]
+__all__ = ["MAX_PLANT_STEP", "Tracking", "failed_at", "held_rk4", "track"]
 
 MAX_PLANT_STEP = 1e-3
 """Largest RK4 step of the plant [s] (as the control lab's)."""
@@ -61,6 +61,34 @@ class Tracking:
         return bool(np.any(self.commanded != self.tau))
 
 
+def held_rk4(
+    acc: Acceleration, p1: float, p2: float, v1: float, v2: float, u1: float, u2: float, h: float, sub: int
+) -> tuple[float, float, float, float]:
+    """``sub`` classic Runge-Kutta steps of ``h`` [s] of ``p̈ = acc(p, ṗ, u)`` with the actuator forces ``u`` [N]
+    held (a zero-order hold over one control period). -> ``(p1, p2, ṗ1, ṗ2)`` [m, m/s]."""
+    hh, h6 = 0.5 * h, h / 6.0
+    for _ in range(sub):
+        a11, a12 = acc(p1, p2, v1, v2, u1, u2)
+        x1, x2, y1, y2 = p1 + hh * v1, p2 + hh * v2, v1 + hh * a11, v2 + hh * a12
+        a21, a22 = acc(x1, x2, y1, y2, u1, u2)
+        x1, x2, w1, w2 = p1 + hh * y1, p2 + hh * y2, v1 + hh * a21, v2 + hh * a22
+        a31, a32 = acc(x1, x2, w1, w2, u1, u2)
+        x1, x2, s1, s2 = p1 + h * w1, p2 + h * w2, v1 + h * a31, v2 + h * a32
+        a41, a42 = acc(x1, x2, s1, s2, u1, u2)
+        p1, p2 = p1 + h6 * (v1 + 2 * y1 + 2 * w1 + s1), p2 + h6 * (v2 + 2 * y2 + 2 * w2 + s2)
+        v1, v2 = v1 + h6 * (a11 + 2 * a21 + 2 * a31 + a41), v2 + h6 * (a12 + 2 * a22 + 2 * a32 + a42)
+    return p1, p2, v1, v2
+
+
+def failed_at(exc: Exception, at: float) -> TpmVizError:
+    """What a simulation that failed at ``at`` [s] raises: ``exc``'s own kind and words with the time, or a
+    divergence (a float error: an unstable loop)."""
+    if isinstance(exc, TpmVizError):
+        first = exc.args[0] if exc.args and isinstance(exc.args[0], Phrase) else str(exc)
+        return type(exc)(Phrase("at t = {t:.4f} s: {why}", t=at, why=first))
+    return InputError(Phrase("at t = {t:.4f} s the simulation diverged (unstable loop?)", t=at))
+
+
 def track(
     law: ControlLaw,
     plant: Acceleration,
@@ -88,7 +116,6 @@ def track(
     period = 1.0 / rate
     sub = max(1, math.ceil(period / MAX_PLANT_STEP - 1e-9))
     h = period / sub
-    hh, h6 = 0.5 * h, h / 6.0
     out = np.empty((n + 1, 6))  # p (2), τ applied (2), τ commanded (2)
     p1, p2 = (float(x) for x in p_ref[0])
     v1, v2 = (float(x) for x in dp_ref[0])
@@ -100,20 +127,7 @@ def track(
             out[k] = (p1, p2, u1, u2, tau1, tau2)
             if k == n:
                 break
-            for _ in range(sub):  # RK4 with τ held (zero-order hold)
-                a11, a12 = plant(p1, p2, v1, v2, u1, u2)
-                x1, x2, y1, y2 = p1 + hh * v1, p2 + hh * v2, v1 + hh * a11, v2 + hh * a12
-                a21, a22 = plant(x1, x2, y1, y2, u1, u2)
-                x1, x2, w1, w2 = p1 + hh * y1, p2 + hh * y2, v1 + hh * a21, v2 + hh * a22
-                a31, a32 = plant(x1, x2, w1, w2, u1, u2)
-                x1, x2, s1, s2 = p1 + h * w1, p2 + h * w2, v1 + h * a31, v2 + h * a32
-                a41, a42 = plant(x1, x2, s1, s2, u1, u2)
-                p1, p2 = p1 + h6 * (v1 + 2 * y1 + 2 * w1 + s1), p2 + h6 * (v2 + 2 * y2 + 2 * w2 + s2)
-                v1, v2 = v1 + h6 * (a11 + 2 * a21 + 2 * a31 + a41), v2 + h6 * (a12 + 2 * a22 + 2 * a32 + a42)
+            p1, p2, v1, v2 = held_rk4(plant, p1, p2, v1, v2, u1, u2, h, sub)
     except (TpmVizError, ZeroDivisionError, OverflowError, ValueError) as exc:
-        at = k * period
-        if isinstance(exc, TpmVizError):
-            first = exc.args[0] if exc.args and isinstance(exc.args[0], Phrase) else str(exc)
-            raise type(exc)(Phrase("at t = {t:.4f} s: {why}", t=at, why=first)) from None
-        raise InputError(Phrase("at t = {t:.4f} s the simulation diverged (unstable loop?)", t=at)) from None
+        raise failed_at(exc, k * period) from None
     return Tracking(t=t, p_ref=p_ref, p=out[:, 0:2].copy(), tau=out[:, 2:4].copy(), commanded=out[:, 4:6].copy())
