@@ -42,13 +42,19 @@ UNITS = {
 }
 
 
-def on_terminal(argv: list[str], cwd: pathlib.Path, timeout: float = 300) -> tuple[int, str, str]:
-    """``tpm-viz ARGV`` with its stdout on a pseudo-terminal and its stderr on a pipe: status, what the terminal
-    showed (newlines as written), stderr."""
+def on_terminal(
+    argv: list[str], cwd: pathlib.Path, timeout: float = 300, stderr_too: bool = False
+) -> tuple[int, str, str]:
+    """``tpm-viz ARGV`` with its stdout on a pseudo-terminal and its stderr on a pipe (``stderr_too``: on the
+    terminal as well): status, what the terminal showed (newlines as written), stderr."""
     leader, follower = os.openpty()
     try:
         child = subprocess.Popen(
-            [*installed(), *argv], stdout=follower, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL, cwd=cwd
+            [*installed(), *argv],
+            stdout=follower,
+            stderr=follower if stderr_too else subprocess.PIPE,
+            stdin=subprocess.DEVNULL,
+            cwd=cwd,
         )
     finally:
         os.close(follower)
@@ -154,3 +160,15 @@ def test_docs_cli_shows_what_the_terminal_printed(terminal):
     assert command in docs
     block = docs.split(command, 1)[1].split("```", 1)[0]  # the lines after the command in its code block
     assert block.strip("\n") == shown.strip("\n")
+
+
+def test_on_a_terminal_an_error_after_the_progress_bar_is_a_line_of_its_own(tmp_path):
+    """The bar is drawn in place on a terminal; a refusal after it (here: the perpendicular design at ``a = 200 mm``
+    covers no task, so there is no footprint to hold) starts a new line, and nothing is written."""
+    argv = ["compare", "--task=-0.1,0.1,-0.05,0.05", "--hold", "footprint", "--set", "a=0.2", "--output", "c.csv"]
+    status, shown, _ = on_terminal(argv, tmp_path, stderr_too=True)
+    assert status == 2
+    bar, error = shown.strip("\n").split("\n")
+    assert bar.startswith("\r[") and "0/" in bar
+    assert error.startswith("tpm-viz: error: --hold footprint needs the perpendicular design")
+    assert not (tmp_path / "c.csv").exists()

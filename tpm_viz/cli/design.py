@@ -84,10 +84,14 @@ def _cmd_compare(args) -> int:
 
     task, hold, params = Task.parse(args.task), Hold.parse(args.hold), params_from_args(args)
     settings, how = _settings(args), _search(args)
-    tally = Tally(populations(params, hold, how), how, _Progress(0))
-    tally.progress(0, tally.total)
-    rows = compare(params, task, hold, settings, how, evaluate=tally)
-    tally.finish()
+    progress = _Progress(0)
+    tally = Tally(populations(params, hold, how), how, progress)
+    progress(0, tally.total)
+    try:
+        rows = compare(params, task, hold, settings, how, evaluate=tally)
+        tally.finish()
+    finally:
+        progress.close()  # an error's line (or ^C) starts on a line of its own
     people = args.output != "-" and sys.stdout.isatty()
     if args.output not in (None, "-") or not people:
         write_output(args.output, _table(rows, list(COMPARE_COLUMNS)))
@@ -116,6 +120,13 @@ class _Progress:
         sys.stderr.write(f"\r{text:<{self.width}}{end}" if self.tty else f"{text}{end}")
         self.width = 0 if end else len(text)
         sys.stderr.flush()
+
+    def close(self) -> None:
+        """End a bar left drawn in place (the work stopped before its end)."""
+        if self.width:
+            sys.stderr.write("\n")
+            sys.stderr.flush()
+            self.width = 0
 
 
 def _footprint_limit(text: str | None) -> tuple[float | None, float | None]:
