@@ -72,7 +72,7 @@ def _independent(samples: int, polished: int, budget: int, seed: int) -> float:
     return best
 
 
-@pytest.mark.slow  # about two minutes on the 2-core machine: the search, 1200 designs, five compass searches
+@pytest.mark.heavy  # two to ten minutes on the 2-core machine: the search, 1200 designs, five compass searches
 def test_no_independent_search_beats_the_global_search_by_half_a_percent():
     found = search(
         PERP,

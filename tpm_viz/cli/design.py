@@ -2,7 +2,8 @@
 
 :func:`register` adds the subcommands (:mod:`tpm_viz.cli`). The design modules (toppra, which loads matplotlib;
 scipy; Dask for ``--scheduler``) are imported by the handler that runs. CSV out, SI units; an infeasible design
-has empty index cells (never NaN). Definitions: ``docs/design.md``.
+has empty index cells (never NaN); ``compare`` shows a terminal a table in mm, N, kg, s instead
+(:mod:`tpm_viz.design.compare_text`), its searches' progress on stderr. Definitions: ``docs/design.md``.
 """
 
 from __future__ import annotations
@@ -74,32 +75,58 @@ def _search(args):
 
 
 def _cmd_compare(args) -> int:
-    from tpm_viz.design.compare import COMPARE_COLUMNS, Hold, compare
+    """The comparison: a table for people when stdout is a terminal (as well as the CSV when ``--output FILE``), the
+    CSV on stdout otherwise; the searches' progress on stderr."""
+    from tpm_viz.design.compare import COMPARE_COLUMNS, Hold, compare, populations
+    from tpm_viz.design.compare_text import compare_text
     from tpm_viz.design.indices import Task
+    from tpm_viz.design.tally import Tally
 
-    task = Task.parse(args.task)
-    rows = compare(params_from_args(args), task, Hold.parse(args.hold), _settings(args), _search(args))
-    write_output(args.output, _table(rows, list(COMPARE_COLUMNS)))
+    task, hold, params = Task.parse(args.task), Hold.parse(args.hold), params_from_args(args)
+    settings, how = _settings(args), _search(args)
+    progress = _Progress(0)
+    tally = Tally(populations(params, hold, how), how, progress)
+    progress(0, tally.total)
+    try:
+        rows = compare(params, task, hold, settings, how, evaluate=tally)
+        tally.finish()
+    finally:
+        progress.close()  # an error's line (or ^C) starts on a line of its own
+    people = args.output != "-" and sys.stdout.isatty()
+    if args.output not in (None, "-") or not people:
+        write_output(args.output, _table(rows, list(COMPARE_COLUMNS)))
+    if people:
+        print(compare_text(rows, hold, task, settings, how))
     return 0
 
 
 class _Progress:
-    """A progress bar on stderr: redrawn in place on a terminal, one line per tenth otherwise."""
+    """A progress bar on stderr: redrawn in place on a terminal (when the percentage changes), one line per tenth
+    otherwise."""
 
     def __init__(self, total: int) -> None:
-        self.total, self.start, self.shown = total, time.monotonic(), -1
+        self.total, self.start, self.shown, self.width = total, time.monotonic(), -1, 0
         self.tty = sys.stderr.isatty()
 
     def __call__(self, done: int, total: int) -> None:
-        tenth = 10 * done // max(total, 1)
-        if not self.tty and tenth == self.shown:
+        step = (100 if self.tty else 10) * done // max(total, 1)
+        if step == self.shown and done < total:
             return
-        self.shown = tenth
+        self.shown = step
         rate = done / max(time.monotonic() - self.start, 1e-9)
         bar = "#" * (30 * done // max(total, 1))
+        text = f"[{bar:<30}] {done}/{total} designs, {rate:.1f} designs/s"
         end = "\n" if (not self.tty or done >= total) else ""
-        sys.stderr.write(f"\r[{bar:<30}] {done}/{total} designs, {rate:.1f} designs/s{end}")
+        sys.stderr.write(f"\r{text:<{self.width}}{end}" if self.tty else f"{text}{end}")
+        self.width = 0 if end else len(text)
         sys.stderr.flush()
+
+    def close(self) -> None:
+        """End a bar left drawn in place (the work stopped before its end)."""
+        if self.width:
+            sys.stderr.write("\n")
+            sys.stderr.flush()
+            self.width = 0
 
 
 def _footprint_limit(text: str | None) -> tuple[float | None, float | None]:
@@ -216,7 +243,11 @@ def register(sub, common) -> None:
     _common_design(co)
     co.add_argument("--hold", choices=("link", "footprint", "mass"), default="link")
     _common_search(co)
-    co.add_argument("--output", metavar="FILE", help="CSV out (default stdout)")
+    co.add_argument(
+        "--output",
+        metavar="FILE",
+        help="CSV out, SI (default: stdout when piped; a terminal gets a table in mm, N, kg, s; - forces the CSV)",
+    )
     co.set_defaults(func=_cmd_compare)
     at = sub.add_parser(
         "atlas", parents=[common], help="indices of a grid of designs, Pareto front, best design under constraints"

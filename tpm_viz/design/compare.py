@@ -22,13 +22,14 @@ from dataclasses import dataclass
 
 from tpm_viz.core.errors import InputError
 from tpm_viz.core.params import Params
+from tpm_viz.core.words import T
 from tpm_viz.design.atlas import PARAMETER_COLUMNS, Limits, Row, design_row, task_columns, values_of
 from tpm_viz.design.indices import INDEX_COLUMNS, Settings, Task
-from tpm_viz.design.optimum import Evaluate, Search, search
+from tpm_viz.design.optimum import Evaluate, Search, population, search
 from tpm_viz.paper import arrangement as arr
 from tpm_viz.paper.arrangement import Arrangement
 
-__all__ = ["COMPARE_COLUMNS", "Hold", "compare"]
+__all__ = ["COMPARE_COLUMNS", "NONE_FOUND", "Hold", "compare", "populations"]
 
 COMPARE_COLUMNS = (
     "case",
@@ -41,6 +42,8 @@ COMPARE_COLUMNS = (
     "task_y1",
 )
 """Columns of ``tpm-viz compare`` (SI units)."""
+NONE_FOUND = T("no design found within the limits")
+"""Why an arrangement has no optimum: no design the search met is feasible within the hold."""
 
 
 class Hold(enum.Enum):
@@ -94,6 +97,12 @@ class _LinkMass:
         return {**values, "m_b": self.density * values["l_a"]}
 
 
+def populations(params: Params, hold: Hold, how: Search = Search()) -> list[int]:
+    """The population of each of :func:`compare`'s searches, in order (perpendicular, parallel): what
+    :class:`~tpm_viz.design.tally.Tally` counts with."""
+    return [population(how, len(_bounds(a, params, hold))) for a in Arrangement]
+
+
 def compare(
     params: Params,
     task: Task,
@@ -126,7 +135,7 @@ def compare(
         centre = (start["task_x0"] + start["task_x1"]) / 2, (start["task_y0"] + start["task_y1"]) / 2
         known.update(task_cx=float(centre[0]), task_cy=float(centre[1]))
         found = search(arrangement, base, bounds, task, settings, limits, adjust, how, [known], evaluate)
-        row = found if found is not None else {"arrangement": arrangement.value, "feasible": 0.0}
+        row = found if found is not None else {"arrangement": arrangement.value, "feasible": 0.0, "why": NONE_FOUND}
         row["case"] = "optimum"
         rows.append(row)
     return rows

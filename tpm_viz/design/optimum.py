@@ -26,7 +26,7 @@ from tpm_viz.design.atlas import Limits, Row, design_row, task_columns
 from tpm_viz.design.indices import Settings, Task
 from tpm_viz.paper.arrangement import Arrangement
 
-__all__ = ["PENALTY", "STRATEGY", "Evaluate", "Problem", "Search", "optimise", "search"]
+__all__ = ["PENALTY", "STRATEGY", "Evaluate", "Problem", "Search", "optimise", "population", "search"]
 
 PENALTY = 1e3
 """Objective [s] of a design that breaks a constraint."""
@@ -38,7 +38,9 @@ default, tended to settle in a neighbouring basin of the paper's ``--hold link``
 Adjust = Callable[[dict[str, float]], dict[str, float]]
 Evaluate = Callable[[Callable[[np.ndarray], float], Sequence[np.ndarray]], Sequence[float]]
 """``evaluate(cost, points)``: the costs of a batch of points, in order (a ``map``; the app runs the batches as
-jobs of its fair worker)."""
+jobs of its fair worker). ``cost`` is the search's :meth:`Problem.cost` (a bound method: ``cost.__self__`` tells
+one search from the next, :class:`~tpm_viz.design.tally.Tally`); a batch is a generation of differential evolution
+(the population) or one design of the Nelder-Mead polish."""
 
 
 def _in_turn(cost: Callable[[np.ndarray], float], points: Sequence[np.ndarray]) -> list[float]:
@@ -57,6 +59,12 @@ class Search:
     generations: int = 100
     tol: float = 1e-4
     polish: int = 120
+
+
+def population(how: Search, free: int) -> int:
+    """Members of the search's population with ``free`` variables: a batch of every generation (and of the first
+    population), so a search evaluates at most ``(generations + 1) * population + polish`` designs."""
+    return max(how.population * free, 5)
 
 
 class Problem:
@@ -164,7 +172,7 @@ def search(
     evaluate = _in_turn if evaluate is None else evaluate
     problem = Problem(arrangement, base, bounds, task, settings, limits, adjust)
     k = len(problem.names)
-    size = max(how.population * k, 5)
+    size = population(how, k)
     init: str | np.ndarray = "latinhypercube"
     if starts:
         rng = np.random.default_rng(how.seed)
@@ -181,7 +189,7 @@ def search(
         init=init,
         polish=False,
         updating="deferred",
-        workers=lambda cost, points: evaluate(cost, list(points)),
+        workers=lambda _, points: evaluate(problem.cost, list(points)),  # SciPy's wrapper of it calls it as it is
     )
     if not problem.limits.allows(problem.row(result.x)):
         return None
