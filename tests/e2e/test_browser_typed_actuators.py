@@ -38,7 +38,7 @@ def test_typing_1_5e2_into_d1_puts_the_actuator_at_150_mm(app, browser):
     assert slider.evaluate("e => getComputedStyle(e.nextElementSibling).display") == "none"
 
     field = text_input(page, view.panel.d_typed.inputs["d1"])
-    assert field.input_value() == "130"
+    assert field.input_value() == "130.0"  # one decimal, as the readout
     field.click()
     field.press("Control+a")
     started = time.monotonic()

@@ -46,6 +46,9 @@ NOT_TYPED_NUMBERS = {
     "Presenter token": "a secret, not a number (masked, cleared once read)",
     "Waypoints x,y; x,y (mm)": "a list of points; each coordinate is read with parse_number "
     "(tests/app/test_planning_waypoints.py: 1e2, the Unicode minus, a refusal naming the waypoint)",
+    "Answer": "an exercise's answer: a number with its unit, a pose, gains or a choice, read by the exercise's own "
+    "reader (tests/app/test_exercise_answers.py: units, decimal commas, the Unicode minus, format errors)",
+    "Class seed": "a whole number read by parse_seed (tests/app/test_exercise_variants.py)",
 }
 """Text fields that are not typed numbers, by label, with the reason."""
 SLIDER_FIELDS = {"Actuator d1 (mm)": "d1 (mm)", "Actuator d2 (mm)": "d2 (mm)"}

@@ -100,7 +100,8 @@ def english_runs(text: str) -> list[str]:
     words = plain(text)
     words = re.sub(r"\b(?:eqs?|Eqs?|Fig|Figs|Table|Tables|Section|Sections)\.?\s*\(?[\d\s,()–-]+\)?", " ", words)
     words = re.sub(r"\b[A-Za-z]+_[A-Za-z0-9]+\b", " ", words)  # symbols: ω_n, K_p, J_x, f_ext, l_a
-    words = re.sub(r"\S+\.(?:csv|json|png|svg|html|toml|xml|urdf)\b", " ", words, flags=re.I)  # file names
+    # file names and docs pages (a Korean particle may follow: "docs/model.md와")
+    words = re.sub(r"[\w./-]+\.(?:csv|json|png|svg|html|toml|xml|urdf|md)(?![A-Za-z0-9])", " ", words, flags=re.I)
     words = re.sub(r"https?://\S+", " ", words)
     words = re.sub(r"\{\w+\}", " ", words)  # a template's field, filled by the page script (a panel's name)
     kept = re.sub(WORD, lambda m: " " if m.group(0).lower() in NAMES else m.group(0), words)

@@ -114,4 +114,4 @@ def register(sub, common: argparse.ArgumentParser) -> None:
         help=f"port to serve on (default {DEFAULT_PORT}; the next free one if busy; 0: any free port)",
     )
     d.add_argument("--strict", action="store_true", help="warnings are errors (as CI builds it)")
-    d.set_defaults(func=_cmd_docs)
+    d.set_defaults(func=_cmd_docs, output_is_folder=True)

@@ -237,7 +237,9 @@
   }
 
   function unitEntry(unit) {
-    // tpm_viz.core.numbers._entry: [quantity, multiplier, divisor] of a unit as people write it, or null
+    // tpm_viz.core.numbers._entry: [quantity, multiplier, divisor] of a unit as people write it, or null; a capital
+    // M is never taken (mega is not a prefix here: "MN" must not read as "mN")
+    if (unit.startsWith("M")) return null;
     let key = unit.toLowerCase().replace(/ /g, "").replace(/[µμ]/g, "u").replace(/²/g, "^2");
     if (key.endsWith("/s2")) key = key.slice(0, -1) + "^2";
     return Object.prototype.hasOwnProperty.call(CONFIG.units, key) ? CONFIG.units[key] : null;

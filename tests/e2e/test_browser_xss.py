@@ -197,11 +197,12 @@ def test_no_user_string_becomes_markup_in_the_page(attack):
         _assert_clean(page, listener, f"share link label {name}")
         context.close()
 
-    # 2. a link naming an upload this server lacks: the refusal quotes the label (its first 80 characters)
+    # 2. a link naming an upload this server lacks, with markup beside the digest: the refusal quotes nothing of it
     raw = encode_saved(Saved(state))
     raw["trajectory"] = {"stored": "ab" * 32, "label": payloads["img"]}
     context, page, view = _open(app, browser, f"?share={_pack(raw)}")
-    _shows(page, listener, payloads["img"][:40], "the refusal quoting the label")
+    _shows(page, listener, "kept on the server that made the link", "the refusal of the link")
+    assert payloads["img"][:40] not in page.evaluate("() => document.body.innerText")
     assert view.session.shared and app.shares.refused >= 1
     _assert_clean(page, listener, "refused link")
 
