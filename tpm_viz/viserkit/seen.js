@@ -31,7 +31,7 @@
     if (now !== open) { open = now; tell(n, "tabs:" + now); }
   }
   // A tab the server asks the page to show (a hidden [data-tpmviz-show] element: a stamp, and the labels of the tabs
-  // to open, outermost first): one click per look, each tab once it is drawn, for at most SHOW_LOOKS looks.
+  // to open, outermost first): one Enter on a tab per look, each tab once it is drawn, for at most SHOW_LOOKS looks.
   const shown = new Map();
   function reveal() {
     const el = document.querySelector("[data-tpmviz-show]");
@@ -45,7 +45,10 @@
     for (const name of Array.isArray(path) ? path : []) {
       const tab = [...document.querySelectorAll('[role="tab"]')].find((t) => t.getAttribute("title") === name);
       if (!tab) return;  // not drawn yet: the next look
-      if (tab.getAttribute("aria-selected") !== "true") { tab.click(); return; }
+      if (tab.getAttribute("aria-selected") !== "true") {  // viser's dock tabs open on a press, or on Enter
+        tab.dispatchEvent(new KeyboardEvent("keydown", { key: "Enter", code: "Enter", bubbles: true, cancelable: true }));
+        return;
+      }
     }
     shown.set(stamp, -1);  // every tab of the path open: done
   }
