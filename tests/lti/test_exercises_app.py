@@ -23,7 +23,8 @@ from tests.support.pages import Page, views_of
 from tpm_viz.app.exercises.grading import variant_of
 from tpm_viz.app.lessons import DEMOS
 from tpm_viz.classroom.launches import News
-from tpm_viz.core.words import Phrase, say
+from tpm_viz.cli.lti import lti_plug
+from tpm_viz.core.words import Lang, Phrase, catalogue, say
 from tpm_viz.lti.exercises import POINTS, exercises_catalogue
 from tpm_viz.lti.grades import Backoff
 from tpm_viz.lti.run import LtiPlug
@@ -177,5 +178,48 @@ def test_an_unknown_exercise_is_one_line_and_an_instructor_s_answers_are_not_sen
         _answer(page, card, f"{_tau1(mine):.4f}")
         assert mine.score == 1.0 and app.exercises.book.rows.of(teacher.launch.key)
         assert platform.posts == [] and plug.ledger.outbox() == []  # an instructor's score is not the course's
+    finally:
+        page.close()
+
+
+def test_serve_lti_offers_every_exercise_of_its_lessons_graded(tmp_path, platform):
+    plug = lti_plug(write_config(tmp_path, platform), "127.0.0.1", None, [], [])  # what `serve --lti` builds
+    try:
+        offered = [item for item in plug.catalogue() if item.kind == "exercise"]
+    finally:
+        plug.stop()
+    expected = [(e.id, e.title.en, e.title.ko or e.title.en) for d in DEMOS for e in d.exercises]
+    assert [(i.id, i.title_en.split(". ", 1)[1], i.title_ko.split(". ", 1)[1]) for i in offered] == expected
+    assert expected and all(i.graded and i.score_maximum == POINTS for i in offered)
+
+
+def test_an_instructor_deep_links_an_exercise_with_its_line_item(served, platform):
+    _, plug = served
+    urls = plug.tool.urls
+    with httpx.Client(timeout=10, follow_redirects=False) as browser:
+        answer = browser.get(urls.login, params=platform.login_query(urls.deeplink, "teacher", "dl"))
+        action, fields = form_fields(browser.get(answer.headers["location"]).text)
+        picker = browser.post(action, data=fields)
+        assert picker.status_code == 200 and f'value="exercise:{FORCE}"' in picker.text
+        assert f"graded, out of {POINTS:g} points" in picker.text
+        _, fields = form_fields(picker.text)
+        chosen = browser.post(urls.picked, data={"pick": fields["pick"], "item": [f"exercise:{FORCE}"], "do": "add"})
+        action, fields = form_fields(chosen.text)
+        assert browser.post(action, data=fields).status_code == 200  # to the platform, which checks it
+    (claims,) = platform.deep_link_answers
+    (item,) = claims["https://purl.imsglobal.org/spec/lti-dl/claim/content_items"]
+    title = next(e.title.en for d in DEMOS for e in d.exercises if e.id == FORCE)
+    assert item["custom"] == {"exercise": FORCE} and title in item["title"]
+    assert item["lineItem"]["scoreMaximum"] == POINTS
+
+
+def test_a_korean_tab_is_asked_to_show_the_tabs_by_their_korean_names(served, platform):
+    app, plug = served
+    page, view = _arrive(app, plug, platform, "student", "force")  # the LMS speaks Korean (ko-KR)
+    try:
+        _opened(view)
+        (path,) = re.findall(r'data-path="([^"]*)"', app.graded.shown[view])
+        assert view.lang is Lang.KO
+        assert json.loads(html.unescape(path)) == [catalogue(Lang.KO)["Teach"], catalogue(Lang.KO)["Exercises"]]
     finally:
         page.close()
