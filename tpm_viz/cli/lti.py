@@ -29,11 +29,12 @@ def lti_plug(config: Path, host: str, lessons: Path | None, trusted: list[str], 
     from tpm_viz.classroom.network import Network
 
     try:
+        from tpm_viz.lti.exercises import exercises_catalogue
         from tpm_viz.lti.run import LtiPlug
     except ImportError as exc:
         raise _missing(exc) from None
     tour = DEMOS if lessons is None else load_lessons(lessons)[0]
-    return LtiPlug(config, host, tour, Network.of(trusted, allowed))
+    return LtiPlug(config, host, tour, Network.of(trusted, allowed), exercises_catalogue(tour))
 
 
 def _cmd_keygen(args) -> int:

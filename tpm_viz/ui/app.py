@@ -44,6 +44,7 @@ from tpm_viz.ui.announce import nobody, serving
 from tpm_viz.ui.classroom import Classroom, Handshakes, local_addresses
 from tpm_viz.ui.client import ClientView
 from tpm_viz.ui.continuity import LectureStore, lecture_store
+from tpm_viz.ui.graded import grade_launches
 from tpm_viz.ui.guide import Guides
 from tpm_viz.ui.keyboard import keyboard_of
 from tpm_viz.ui.launched import Launched
@@ -151,6 +152,8 @@ class TpmApp:
         )
         """Gradebook, students, results; ``.score_sink``: LTI's hook (:mod:`.teaching.exercises.desk`)."""
         self.exercises.start(self.room.store)
+        self.graded = None if self.launched is None else grade_launches(self)
+        """A launch's exercise opened in its tab, its score back to the course (:mod:`.graded`), or None."""
         self.room.lecturer_hooks.append(self.exercises.lecturer_added)
         self.guides = Guides(self.room.store)
         """Which browsers dismissed the first visit's guide (:mod:`.guide`)."""

@@ -8,7 +8,7 @@ keeps its LMS user and grades, never the presenter's right (that comes back only
 allows). :meth:`Launched.connected` runs after the classroom's part: an Instructor's launch makes the tab the
 presenter (:meth:`~tpm_viz.classroom.access.Access.grant`), any other a student; the tab says which and the course;
 a link to a lesson opens it (the presenter's on the shared mechanism, a student's on their own copy) and a link to
-an exercise is handed to ``Launched.open_exercise`` (the exercise engine's, once it is there).
+an exercise is handed to ``Launched.open_exercise`` (:meth:`tpm_viz.ui.graded.Graded.open`).
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ class Launched:
     def __init__(self, app: Any, tickets: Tickets) -> None:
         self.app, self.tickets = app, tickets
         self.open_exercise: Callable[[Any, Launch], None] | None = None
-        """Opens a launch's exercise in a tab (set by the exercise UI; until then the tab is told it is coming)."""
+        """Opens a launch's exercise in a tab (set by :mod:`tpm_viz.ui.graded`; None: the tab says it is not here)."""
         self.arrived = 0
         """Tabs that arrived with a launch (tests)."""
 

@@ -9,6 +9,12 @@ keyboard put in the panel: :mod:`tpm_viz.ui.keyboard`), as ``GET`` requests to :
   ``tabs:``), told when that changes: a click on a tab, the panel folded or unfolded. Looked at each click on a tab
   and every :data:`EVERY_MS` ms (bounded: one ``querySelectorAll`` of the markers).
 
+The script also shows a tab the server asks for: a hidden element ``[data-tpmviz-show="STAMP"]`` whose ``data-path``
+is the JSON list of the tabs' labels as the page shows them, outermost first (*Teach*, *Exercises*); it presses
+Enter on each tab that is not selected yet (viser's dock tabs open on Enter or a press, not on a bare ``click()``),
+one per look (every 250 ms; a stamp at most 120 looks), as a user would (:mod:`tpm_viz.ui.graded`: an exercise
+launched from the LMS).
+
 The server answers in :mod:`tpm_viz.ui.seen`. Nothing here is trusted beyond the nonce: a request only tells the
 server what a tab shows, and :func:`seen_request` refuses any other word.
 """

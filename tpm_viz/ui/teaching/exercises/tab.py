@@ -130,6 +130,17 @@ class ExercisesView:
                 for exercise in demo.exercises:
                     self._card(self._gui, exercise.id)
 
+    def show(self, key: str) -> bool:
+        """Choose the lesson of exercise ``key`` in the *Exercises* tab (built) and draw its cards (under the hub's
+        lock). False: no exercise ``key`` in this tab's lessons."""
+        demo = next((d for d in self.lessons if any(e.id == key for e in d.exercises)), None)
+        if demo is None or self.choice is None:
+            return False
+        if self.choice.value != demo.title:
+            self.choice.value = demo.title  # echoed with client=None: _on_lesson ignores it
+        self._fill_tab()
+        return True
+
     @guarded(on_error=_failed)
     def _on_lesson(self, event: Any) -> None:
         if not self._user(event):
