@@ -5,8 +5,8 @@ to the course's gradebook (``tpm-viz serve --lti``; docs/lti.md, "Exercises in t
 :class:`~tpm_viz.ui.launched.Launched` and the exercises' score sink
 (:attr:`~tpm_viz.ui.teaching.exercises.desk.ExerciseDesk.score_sink`).
 
-- **Open** (:meth:`Graded.open`, a fresh launch whose link says ``custom`` ``exercise=ID``): a student's tab moves to
-  its own copy (as a lesson link does: *Use current pose* reads the student's own mechanism); the *Teach ›
+- **Open** (:meth:`Graded.open_exercise`, a fresh launch whose link says ``custom`` ``exercise=ID``): a student's
+  tab moves to its own copy (as a lesson link does: *Use current pose* reads the student's own mechanism); the *Teach ›
   Exercises* tab is built, that exercise's lesson chosen and its cards drawn, with the student's own numbers (the
   seed of the LMS user's identity, or the class seed: :class:`~tpm_viz.classroom.results.Gradebook`); the presenter
   gets the same. The page is asked to show that tab (a hidden ``data-tpmviz-show`` element naming the tabs to click,
@@ -65,17 +65,17 @@ class Graded:
         """The *show this tab* element each tab was given (its HTML; tests)."""
 
     # -- a launch's exercise, in its tab ---------------------------------------------------------------------------
-    def open(self, view: Any, launch: Launch) -> None:
+    def open_exercise(self, view: Any, launch: Launch) -> None:
         """Open ``launch.exercise`` in ``view`` (not under the hub's lock; see the module docstring)."""
         ident = str(launch.exercise)
         exercises = view.teaching.exercises
         if not any(e.id == ident for d in exercises.lessons for e in d.exercises):
-            with self.app.hub.lock:
+            with self.app.hub.locked():
                 view.tell(_unknown(ident))
                 view.client.flush()
             return
         view.teaching.open("teach")  # the Exercises tab, built now (it takes the lock)
-        with self.app.hub.lock:
+        with self.app.hub.locked():
             if view.closed:
                 return
             if launch.role is Role.STUDENT and view.session.shared:
@@ -133,7 +133,7 @@ class Graded:
             return
         phrase = Phrase(template.template, title=title)
         for view in self._tabs(identity):
-            with self.app.hub.lock:
+            with self.app.hub.locked():
                 if not view.closed:
                     view.tell(phrase)
                     view.client.flush()
@@ -142,6 +142,6 @@ class Graded:
 def grade_launches(app: Any) -> Graded:
     """A :class:`Graded` for ``app`` (its launches opened, its scores sent back)."""
     graded = Graded(app)
-    app.launched.open_exercise = graded.open
+    app.launched.open_exercise = graded.open_exercise
     app.exercises.score_sink = graded.sink
     return graded

@@ -8,7 +8,7 @@ keeps its LMS user and grades, never the presenter's right (that comes back only
 allows). :meth:`Launched.connected` runs after the classroom's part: an Instructor's launch makes the tab the
 presenter (:meth:`~tpm_viz.classroom.access.Access.grant`), any other a student; the tab says which and the course;
 a link to a lesson opens it (the presenter's on the shared mechanism, a student's on their own copy) and a link to
-an exercise is handed to ``Launched.open_exercise`` (:meth:`tpm_viz.ui.graded.Graded.open`).
+an exercise is handed to ``Launched.open_exercise`` (:meth:`tpm_viz.ui.graded.Graded.open_exercise`).
 """
 
 from __future__ import annotations
