@@ -17,6 +17,7 @@ import pytest
 
 from tests.support.protocol import ProtocolClient, wait_for
 from tpm_viz import Params
+from tpm_viz.ui.widgets import typed
 from tpm_viz.ui.widgets.typed import QUIET
 from tpm_viz.viserkit.probe import arrive, widget_uuid
 
@@ -35,11 +36,16 @@ def _run(view):
         return view.teaching.services.runs.of(view.session).run
 
 
-def _keystrokes(client, handle, text: str, gap: float = 0.03) -> None:
-    """Type ``text`` one character at a time, as a browser sends it (the whole text at each keystroke)."""
+def _keystrokes(client, handle, text: str, gap: float = 0.03) -> float:
+    """Type ``text`` one character at a time, as a browser sends it (the whole text at each keystroke). -> the
+    longest time between two keystrokes [s] (a loaded machine may stall this process past the quiet time)."""
+    longest, last = 0.0, time.monotonic()
     for k in range(1, len(text) + 1):
         client.set_value(handle, text[:k])
+        now = time.monotonic()
+        longest, last = max(longest, now - last), now
         time.sleep(gap)
+    return longest
 
 
 def _circle(client, view, label: str = "circle (Fig. 5)") -> None:
@@ -60,13 +66,16 @@ def test_a_number_typed_one_key_at_a_time_is_applied_once_when_typing_stops(conn
         loads.append(source) or original(session, source, *a, **k)
     )
     client.set_value(field, "")  # the old text deleted first
-    _keystrokes(client, field, "5e-1")
+    stalled = _keystrokes(client, field, "5e-1") > 0.5 * QUIET  # then a prefix may be applied, by design
+    typed_at = time.monotonic()
     time.sleep(0.5 * QUIET)
-    assert loads == []  # nothing mid-typing, nothing yet
+    if not stalled and time.monotonic() - typed_at < 0.9 * QUIET:
+        assert loads == []  # nothing mid-typing, nothing yet
     wait_for(lambda: (r := _run(view)) is not None and r.duration == 0.5, timeout=QUIET + 5, what="T = 0.5 s")
-    assert [s.duration for s in loads] == [0.5]  # once
+    assert [s.duration for s in loads][-1:] == [0.5] and (stalled or len(loads) == 1)  # once
+    count = len(loads)
     time.sleep(QUIET)
-    assert len(loads) == 1 and field.value == "5e-1"
+    assert len(loads) == count and field.value == "5e-1"  # not again
     assert view.teaching.player.duration.note.handle.content == ""  # it shows the value in use: nothing to say
 
 
@@ -89,9 +98,12 @@ def test_a_very_short_duration_is_applied_with_its_plausibility_notes(connect):
     assert "|τ| = 4.43e+05 N is more than 10 times the usual 200 N" in note.content
 
 
-def test_a_prefix_is_never_applied_and_a_value_out_of_range_is_refused_next_to_the_field(connect):
+def test_a_prefix_is_never_applied_and_a_value_out_of_range_is_refused_next_to_the_field(connect, monkeypatch):
     """``-100000`` mm into p1: ``-1``, ``-10``, ... are never applied; Enter refuses the whole text (beyond ±10 m)
-    under the fields, with the value in use; the app keeps its pose."""
+    under the fields, with the value in use; the app keeps its pose. The quiet time is made long: a loaded machine
+    once held this process for more than the 1.5 s between two keystrokes, and a pause that long applies the text
+    typed so far, by design (the duration test above)."""
+    monkeypatch.setattr(typed, "QUIET", 60.0)
     client, view = connect()
     before = _state(view)
     field = view.panel.p.inputs["p1"]
