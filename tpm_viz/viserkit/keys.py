@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from urllib.parse import parse_qs, urlsplit
 
-__all__ = ["KEYS", "KEY_PATH", "NONCE_CHARS", "QUEUED", "KeyRequest", "key_request"]
+__all__ = ["KEYS", "KEY_PATH", "NONCE_CHARS", "QUEUED", "KeyRequest", "key_request", "page_query"]
 
 KEY_PATH = "/tpm-viz/key"
 """The path the page script sends a key to (``GET``: websockets' HTTP server reads nothing else)."""
@@ -39,19 +39,29 @@ class KeyRequest:
     shift: bool
 
 
-def key_request(path: str) -> KeyRequest | None:
-    """The key of a request for ``path`` (its query ``n``, ``k``, ``s``), or None when the path is not
-    :data:`KEY_PATH`. Raises ``ValueError`` (one line) for a malformed one."""
+def page_query(path: str, route: str, names: tuple[str, str, str], kind: str) -> tuple[str, str, str] | None:
+    """The three fields ``names`` of a page-script request for ``path`` (the first is the tab's nonce, checked), or
+    None when the path is not ``route``. Raises ``ValueError`` (one line, ``malformed <kind>: ...``)."""
     try:
         parts = urlsplit(path)
     except ValueError as exc:
-        raise ValueError("malformed key request") from exc
-    if parts.path != KEY_PATH:
+        raise ValueError(f"malformed {kind}") from exc
+    if parts.path != route:
         return None
     query = parse_qs(parts.query, max_num_fields=4)
-    nonce, code, shift = (query.get(name, [""])[0] for name in ("n", "k", "s"))
+    nonce, second, third = (query.get(name, [""])[0] for name in names)
     if not 16 <= len(nonce) <= 64 or not set(nonce) <= NONCE_CHARS:
-        raise ValueError("malformed key request: nonce")
+        raise ValueError(f"malformed {kind}: nonce")
+    return nonce, second, third
+
+
+def key_request(path: str) -> KeyRequest | None:
+    """The key of a request for ``path`` (its query ``n``, ``k``, ``s``), or None when the path is not
+    :data:`KEY_PATH`. Raises ``ValueError`` (one line) for a malformed one."""
+    fields = page_query(path, KEY_PATH, ("n", "k", "s"), "key request")
+    if fields is None:
+        return None
+    nonce, code, shift = fields
     if code not in KEYS:
         raise ValueError("malformed key request: key")
     return KeyRequest(nonce, code, shift == "1")

@@ -24,10 +24,9 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from importlib import resources
-from urllib.parse import parse_qs, urlsplit
 
 from tpm_viz.core.markup import Html
-from tpm_viz.viserkit.keys import NONCE_CHARS
+from tpm_viz.viserkit.keys import page_query
 
 __all__ = ["EVERY_MS", "SEEN_PATH", "SEEN_SCRIPT", "SETTINGS", "SeenRequest", "seen_request", "tab_marker"]
 
@@ -51,16 +50,10 @@ class SeenRequest:
 def seen_request(path: str) -> SeenRequest | None:
     """The request for ``path`` (its query ``n``, ``w``, ``c``), or None when the path is not :data:`SEEN_PATH`. Raises
     ``ValueError`` (one line) for a malformed one."""
-    try:
-        parts = urlsplit(path)
-    except ValueError as exc:
-        raise ValueError("malformed request") from exc
-    if parts.path != SEEN_PATH:
+    fields = page_query(path, SEEN_PATH, ("n", "w", "c"), "request")
+    if fields is None:
         return None
-    query = parse_qs(parts.query, max_num_fields=4)
-    nonce, what, count = (query.get(name, [""])[0] for name in ("n", "w", "c"))
-    if not 16 <= len(nonce) <= 64 or not set(nonce) <= NONCE_CHARS:
-        raise ValueError("malformed request: nonce")
+    nonce, what, count = fields
     if not _WHAT.fullmatch(what):
         raise ValueError("malformed request: what")
     if not (count.isdigit() and len(count) <= 9):
