@@ -54,16 +54,19 @@ class Sightings:
 
     @guarded
     def _apply(self, view: Any, what: str, count: int) -> None:
-        """Apply what the page saw (in the drag pool, under the hub's lock), unless the page told something newer
-        already (its ``count`` is lower: the pool may answer two requests out of order)."""
+        """Apply what the page saw (in the drag pool, under the hub's lock). The open tabs are applied unless the
+        page told newer ones already (their ``count`` is lower: the pool may answer two requests out of order); a
+        coarse pointer always (it never changes back, and the open tabs told right after it must not hide it)."""
         with view.hub.locked():
-            with self._lock:
-                if view.closed or count <= self._counts.get(view, -1):
-                    return
-                self._counts[view] = count
+            if view.closed:
+                return
             if what == "touch":
                 view.scene.set_touch(True)
             elif what.startswith("tabs:"):
+                with self._lock:
+                    if count <= self._counts.get(view, -1):
+                        return
+                    self._counts[view] = count
                 try:
                     view.teaching.shown(frozenset(name for name in what[5:].split(",") if name))
                 except TpmVizError:  # nothing to show there for this tab (e.g. a student on the shared mechanism)
