@@ -140,7 +140,7 @@ def test_a_touch_phone_without_a_phones_user_agent_gets_the_touch_handle(served,
         print(f"{lang.value}: a 36 px finger move moved the platform {moved * 1e3:.1f} mm")
         assert 0.0 < moved <= 36 * 1.0e-3 * 1.02, f"{moved * 1e3:.1f} mm for a 36 px drag"
 
-        framed = _camera(view)
+        framed = _still(view)  # the framing done (presentation mode frames again for its canvas)
         for k in range(3):  # three touches that miss the handle: the camera orbits
             _touch_drag(cdp, page, rect[0] + 30.0, rect[3] - 30.0 - 10 * k, 60.0)
         wait_for(lambda: np.linalg.norm(_camera(view) - framed) > 0.05, what="the camera orbited")
@@ -161,7 +161,7 @@ def test_frame_the_mechanism_on_a_laptop_and_on_a_projector(served, chromium):  
     try:
         assert not view.scene.touch  # a mouse: viser's gizmo with its arrows
         _framed(page, view)
-        framed = _camera(view)
+        framed = _still(view)  # the framing done (presentation mode frames again for its canvas)
         rect = page.evaluate(CANVAS)
         page.mouse.move(rect[0] + 60, rect[3] - 60)
         page.mouse.down()
@@ -180,7 +180,7 @@ def test_frame_the_mechanism_on_a_laptop_and_on_a_projector(served, chromium):  
         _presentation_on(page, view)
         page.wait_for_selector("[data-dock-rail-root]")
         _framed(page, view)
-        framed = _camera(view)
+        framed = _still(view)  # the framing done (presentation mode frames again for its canvas)
         rect = page.evaluate(CANVAS)
         page.mouse.move(rect[2] - 120, rect[1] + 120)  # clear of the WebGL notice, the mechanism and the live box
         page.mouse.down()

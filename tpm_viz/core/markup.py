@@ -66,7 +66,8 @@ def markdown_text(value: object) -> Markdown:
     """``value`` as Markdown text: shown literally (see the module docstring; a :class:`Markdown` as it is)."""
     if isinstance(value, Markdown):
         return value
-    text = " ".join(str(value).splitlines())
+    # one line; no leading spaces or tabs (four of them, or one tab, start a code block; a page shows none anyway)
+    text = " ".join(str(value).splitlines()).lstrip(" \t")
     return Markdown("".join("\\" + c if c in _PUNCTUATION else c for c in text))
 
 
