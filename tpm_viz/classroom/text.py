@@ -16,6 +16,7 @@ import numpy as np
 from tpm_viz.app.readouts import Readout
 from tpm_viz.app.state import AppState
 from tpm_viz.core.markup import Html
+from tpm_viz.core.numbers import fixed
 from tpm_viz.core.words import Lang, Phrase, T, say
 from tpm_viz.drawing.palette import hex_colour
 
@@ -35,17 +36,8 @@ TAU_POS, TAU_NEG = hex_colour("tau_pos"), hex_colour("tau_neg")
 
 
 def num(x: object, fmt: str = ".1f", scale: float = 1.0) -> str:
-    """``x * scale`` formatted with ``fmt``; a dash for None, NaN or infinity."""
-    if x is None:
-        return DASH
-    try:
-        v = float(x) * scale  # type: ignore[arg-type]  # anything float() takes; the rest prints a dash
-    except (TypeError, ValueError):
-        return DASH
-    if not math.isfinite(v):
-        return DASH
-    text = format(v, fmt)
-    return text[1:] if text.startswith("-") and float(text) == 0.0 else text  # no "-0.0"
+    """``x * scale`` formatted with ``fmt``; a dash for None, NaN or infinity (:func:`tpm_viz.core.numbers.fixed`)."""
+    return fixed(x, fmt, scale)
 
 
 def banner_level(readout: Readout) -> str:

@@ -12,6 +12,7 @@ import textwrap
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from tpm_viz.core.numbers import fixed
 from tpm_viz.core.words import Lang, say
 from tpm_viz.design.atlas import Row
 from tpm_viz.design.compare import NONE_FOUND, Hold
@@ -72,16 +73,9 @@ HOLDS = {
 
 
 def number(value: object, fmt: str, scale: float = 1.0) -> str:
-    """``value * scale`` formatted with ``fmt`` (no ``-0.0``); :data:`DASH` for anything that is not a finite
-    number."""
-    try:
-        v = float(value) * scale  # type: ignore[arg-type]  # anything float() takes; the rest is a dash
-    except (TypeError, ValueError):
-        return DASH
-    if not math.isfinite(v):
-        return DASH
-    text = format(v, fmt)
-    return text[1:] if text.startswith("-") and float(text) == 0.0 else text
+    """``value * scale`` formatted with ``fmt`` as people read it (:func:`tpm_viz.core.numbers.fixed`: no ``-0.0``,
+    :data:`DASH` for anything that is not a finite number)."""
+    return fixed(value, fmt, scale)
 
 
 def _lines(heads: list[list[str]], body: list[tuple[list[str], str | None]]) -> list[str]:
